@@ -1,0 +1,13 @@
+#pragma once
+// Eccentricity tables: CSV `test,LB_mm,RB_mm,RC_mm,ZC_mm,ex_um,ey_um,ez_um`; empty cells allowed.
+#include <string>
+#include <vector>
+
+#include "cnccomp/eccentricity.hpp"
+
+namespace cnccomp {
+
+std::vector<EccentricityRow> readEccentricityCsv(const std::string& path);
+void writeEccentricityCsv(const std::string& path, const std::vector<EccentricityRow>& rows);
+
+}  // namespace cnccomp

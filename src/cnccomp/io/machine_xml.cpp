@@ -1,0 +1,147 @@
+#include "cnccomp/io/machine_xml.hpp"
+
+#include <cmath>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/xml_util.hpp"
+
+namespace cnccomp {
+namespace {
+
+using tinyxml2::XMLElement;
+
+int componentIndex(const XMLElement& e, const std::string& path) {
+    static constexpr std::string_view names[] = {"x", "y", "z", "a", "b", "c"};
+    const std::string c = xml::text(e, path, "component");
+    for (int i = 0; i < 6; ++i)
+        if (c == names[i]) return i;
+    xml::fail(e, path, fmt::format("component '{}' is not one of x, y, z, a, b, c", c));
+}
+
+Link readLink(const XMLElement& e, const std::string& path) {
+    Link l;
+    l.name = xml::text(e, path, "name");
+    const std::string element = e.Name();
+    if (element == "fixed") {
+        l.kind = AxisKind::Fixed;
+    } else if (element == "axis") {
+        const std::string type = xml::text(e, path, "type");
+        if (type == "linear") l.kind = AxisKind::Linear;
+        else if (type == "rotary") l.kind = AxisKind::Rotary;
+        else xml::fail(e, path, fmt::format("type '{}' is not 'linear' or 'rotary'", type));
+        const Vec3 dir = xml::vec3(e, path, "direction", Vec3::Zero());
+        if (!xml::has(e, "direction")) xml::fail(e, path, "missing attribute 'direction'");
+        if (dir.norm() < 1e-12) xml::fail(e, path, "direction must not be zero");
+        l.direction = dir.normalized();
+        const double unit = l.kind == AxisKind::Rotary ? kDeg : 1.0;
+        l.min = xml::number(e, path, "min", -HUGE_VAL) * unit;
+        l.max = xml::number(e, path, "max", HUGE_VAL) * unit;
+        if (!(l.min <= l.max)) xml::fail(e, path, "min must not exceed max");
+        l.modulo = xml::boolean(e, path, "modulo", false);
+        if (l.modulo && l.kind != AxisKind::Rotary) xml::fail(e, path, "only a rotary axis can be modulo");
+    } else {
+        xml::fail(e, path, "expected <axis> or <fixed>");
+    }
+    // Nominal placement: offset (mm) then rotation Rz(c)·Ry(b)·Rx(a), angles in degrees.
+    const Vec3 off = xml::vec3(e, path, "offset", Vec3::Zero());
+    const Vec3 rot = xml::vec3(e, path, "rotation", Vec3::Zero()) * kDeg;
+    l.placement = Pose::Identity();
+    l.placement.translation() = off;
+    l.placement.linear() = (Eigen::AngleAxisd(rot.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rot.y(), Vec3::UnitY()) *
+                            Eigen::AngleAxisd(rot.x(), Vec3::UnitX()))
+                               .toRotationMatrix();
+    return l;
+}
+
+void readChain(const XMLElement* e, const std::string& path, Chain& chain) {
+    if (!e) return;
+    for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) chain.links.push_back(readLink(*c, path));
+}
+
+ComponentBasis readBasis(const XMLElement& e, const std::string& path, const Link& link) {
+    ComponentBasis b;
+    const std::string type = xml::text(e, path, "basis");
+    const double unit = link.kind == AxisKind::Rotary ? kDeg : 1.0;
+    if (type == "polynomial" || type == "fourier") {
+        b.type = type == "polynomial" ? ComponentBasis::Type::Polynomial : ComponentBasis::Type::Fourier;
+        const double order = xml::number(e, path, "order");
+        if (order < 1 || order > 50 || order != std::floor(order)) xml::fail(e, path, "order must be a whole number 1..50");
+        b.order = static_cast<int>(order);
+        if (b.type == ComponentBasis::Type::Fourier && link.kind != AxisKind::Rotary)
+            xml::fail(e, path, "a Fourier basis needs a rotary axis");
+    } else if (type == "table") {
+        b.type = ComponentBasis::Type::Table;
+        for (double v : xml::numbers(e, path, "nodes")) b.nodes.push_back(v * unit);
+        if (b.nodes.size() < 2) xml::fail(e, path, "a table needs at least two nodes");
+        for (size_t i = 1; i < b.nodes.size(); ++i)
+            if (!(b.nodes[i] > b.nodes[i - 1])) xml::fail(e, path, "table nodes must be strictly increasing");
+        if (link.modulo && b.nodes.back() - b.nodes.front() >= 2 * kPi - 1e-12)
+            xml::fail(e, path, "nodes of a modulo axis must span less than 360 deg (the table closes on itself)");
+    } else {
+        xml::fail(e, path, fmt::format("basis '{}' is not polynomial, fourier or table", type));
+    }
+    return b;
+}
+
+}  // namespace
+
+MachineModel readMachineXml(const std::string& path) {
+    tinyxml2::XMLDocument doc;
+    xml::load(doc, path);
+    const XMLElement& root = xml::root(doc, path, "machine");
+    MachineModel m;
+    m.sourceFile = path;
+    m.name = xml::text(root, path, "name");
+    m.description = xml::textOr(root, "description", "");
+    readChain(root.FirstChildElement("workpiece"), path, m.workpiece);
+    const XMLElement* tool = root.FirstChildElement("tool");
+    if (!tool) xml::fail(root, path, "missing <tool> chain");
+    readChain(tool, path, m.tool);
+    const Vec3 td = xml::vec3(*tool, path, "direction", -Vec3::UnitZ());
+    if (td.norm() < 1e-12) xml::fail(*tool, path, "tool direction must not be zero");
+    m.toolDirection = td.normalized();
+
+    if (const XMLElement* devs = root.FirstChildElement("deviations")) {
+        for (const XMLElement* e = devs->FirstChildElement(); e; e = e->NextSiblingElement()) {
+            DeviationDef d;
+            const std::string kind = e->Name();
+            if (kind == "location") d.kind = DeviationKind::Location;
+            else if (kind == "component") d.kind = DeviationKind::Component;
+            else xml::fail(*e, path, "expected <location> or <component>");
+            d.name = xml::text(*e, path, "name");
+            d.alias = xml::textOr(*e, "alias", "");
+            d.description = xml::textOr(*e, "description", "");
+            const std::string link = xml::text(*e, path, "link");
+            bool found = false;
+            for (Side s : {Side::Workpiece, Side::Tool}) {
+                const Chain& c = m.chain(s);
+                for (int i = 0; i < static_cast<int>(c.links.size()); ++i)
+                    if (c.links[i].name == link) {
+                        if (found) xml::fail(*e, path, fmt::format("link name '{}' is ambiguous", link));
+                        d.side = s;
+                        d.link = i;
+                        found = true;
+                    }
+            }
+            if (!found) xml::fail(*e, path, fmt::format("no link named '{}' in the chains", link));
+            d.component = componentIndex(*e, path);
+            if (d.kind == DeviationKind::Component) {
+                const Link& l = m.chain(d.side).links[d.link];
+                if (l.kind == AxisKind::Fixed) xml::fail(*e, path, "a component error needs a moving axis");
+                d.basis = readBasis(*e, path, l);
+            }
+            m.deviations.push_back(std::move(d));
+        }
+    }
+    try {
+        m.finalize();
+    } catch (const ModelError& ex) {
+        throw InputError(path, root.GetLineNum(), ex.what());
+    }
+    return m;
+}
+
+}  // namespace cnccomp

@@ -1,0 +1,56 @@
+#pragma once
+// Exact forward kinematics of a machine with a deviation set (full rotation matrices, no small-angle
+// truncation). Seed 000: the tool chain reproduces T = E_Z M_YZ E_Y M_XY E_X M_XB E_B M_BT T_T (eq. (7)),
+// the workpiece chain W = M_CZ E_C W_C (eq. (10)).
+#include <vector>
+
+#include "cnccomp/deviations.hpp"
+#include "cnccomp/machine.hpp"
+
+namespace cnccomp {
+
+/// A machine with its deviations folded into per-link constant transforms. Cheap to evaluate:
+/// no allocation per call, safe to share between threads.
+class Kinematics {
+public:
+    /// Nominal machine (all deviations zero).
+    explicit Kinematics(const MachineModel& machine);
+    /// Erroneous machine.
+    Kinematics(const MachineModel& machine, const DeviationSet& deviations);
+
+    const MachineModel& machine() const { return *machine_; }
+
+    /// bMw: pose of the workpiece frame (after the last workpiece-side link) in the bed frame.
+    Pose baseToWorkpiece(const AxisVector& q) const;
+    /// bMt: pose of the tool frame (after the last tool-side link) in the bed frame.
+    Pose baseToTool(const AxisVector& q) const;
+    /// wMt = bMw⁻¹ · bMt.
+    Pose workpieceToTool(const AxisVector& q) const;
+    /// A point fixed in the tool frame (e.g. the tool tip), seen from the workpiece frame.
+    Vec3 toolPointInWorkpiece(const AxisVector& q, const Vec3& pointInToolFrame) const;
+    /// Point in the tool frame at distance `length` along the tool direction, plus an offset (seed 000 eq. (15)).
+    Vec3 toolPoint(double length, const Vec3& offset = Vec3::Zero()) const {
+        return machine_->toolDirection * length + offset;
+    }
+
+    /// Throws ModelError when a command is outside an axis' travel or not finite.
+    void checkTravel(const AxisVector& q) const;
+
+private:
+    struct LinkData {
+        Pose placed;             ///< placement · E_location
+        Vec3 direction;
+        AxisKind kind;
+        int axis;                ///< index into AxisVector, -1 fixed
+        bool modulo;
+        std::vector<int> components;  ///< indices of component deviations on this link
+    };
+    Pose chainPose(const std::vector<LinkData>& links, const AxisVector& q) const;
+    void build(const DeviationSet* deviations);
+
+    const MachineModel* machine_;
+    std::vector<LinkData> workpiece_, tool_;
+    Eigen::VectorXd values_;  ///< deviation values (for component errors)
+};
+
+}  // namespace cnccomp

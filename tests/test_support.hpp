@@ -1,0 +1,36 @@
+#pragma once
+// Shared fixtures for the tests: sample paths, a scratch folder, running the CLI.
+#include <filesystem>
+#include <string>
+
+#include "cnccomp/io/machine_xml.hpp"
+
+namespace cnccomp::test {
+
+inline std::string sourcePath(const std::string& rel) { return std::string(CNCCOMP_SOURCE_DIR) + "/" + rel; }
+inline std::string sharedPath(const std::string& rel) { return std::string(CNCCOMP_SHARED_DIR) + "/" + rel; }
+inline const MachineModel& multitasking() {
+    static const MachineModel m = readMachineXml(sourcePath("samples/machines/multitasking.xml"));
+    return m;
+}
+
+/// A fresh empty folder under the system temp dir, removed at destruction.
+struct ScratchDir {
+    std::filesystem::path path;
+    explicit ScratchDir(const std::string& tag);
+    ~ScratchDir();
+    std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+/// Writes `text` to a file.
+void writeText(const std::string& path, const std::string& text);
+std::string readText(const std::string& path);
+
+struct CliResult {
+    int exitCode;
+    std::string out;  ///< stdout and stderr together
+};
+/// Runs the cnccomp executable with `args` (shell-quoted by the caller).
+CliResult runCli(const std::string& args);
+
+}  // namespace cnccomp::test
