@@ -41,10 +41,14 @@ void Kinematics::build(const DeviationSet* deviations) {
     }
 }
 
-Pose Kinematics::chainPose(const std::vector<LinkData>& links, const AxisVector& q) const {
+Pose Kinematics::chainPose(const std::vector<LinkData>& links, const AxisVector& q, Side side,
+                           JointFrames* joints) const {
     Pose m = Pose::Identity();
     for (const LinkData& l : links) {
         m = m * l.placed;
+        if (joints && l.kind != AxisKind::Fixed)
+            joints->items[joints->count++] = {side, l.axis, l.kind == AxisKind::Rotary, m.linear() * l.direction,
+                                              m.translation()};
         if (l.kind == AxisKind::Linear) {
             m.translation() += m.linear() * (l.direction * q[l.axis]);
         } else if (l.kind == AxisKind::Rotary) {
@@ -60,6 +64,13 @@ Pose Kinematics::chainPose(const std::vector<LinkData>& links, const AxisVector&
         }
     }
     return m;
+}
+
+JointFrames Kinematics::jointFrames(const AxisVector& q) const {
+    JointFrames j;
+    chainPose(workpiece_, q, Side::Workpiece, &j);
+    chainPose(tool_, q, Side::Tool, &j);
+    return j;
 }
 
 Pose Kinematics::baseToWorkpiece(const AxisVector& q) const { return chainPose(workpiece_, q); }

@@ -1,0 +1,43 @@
+#pragma once
+// Tool pose of a set of axis commands, its analytic Jacobian, and the inverse: axis commands that put the
+// tool tip and tool axis of a (possibly erroneous) machine at a target pose. Newton/Gauss–Newton on the exact model.
+#include "cnccomp/kinematics.hpp"
+
+namespace cnccomp {
+
+/// Tool tip position and unit tool axis (spindle → tip), in the workpiece frame.
+struct ToolPose {
+    Vec3 tip = Vec3::Zero();
+    Vec3 axis = -Vec3::UnitZ();
+};
+
+using PoseJacobian = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxAxes>;
+
+/// Pose of the point `tipInToolFrame` (see Kinematics::toolPoint) and of the tool axis.
+ToolPose toolPose(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame);
+
+/// d(tip, axis)/dq, 6 × axisCount, workpiece frame; rows 0–2 tip (mm per mm or rad), rows 3–5 axis.
+/// Exact for location errors; component errors' own slope is neglected (fine for Newton, tested against
+/// finite differences on machines without component errors).
+void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, PoseJacobian& J);
+
+struct IkOptions {
+    double tolerance = 1e-9;     ///< mm on the tip, and rad × axisWeight on the axis
+    int maxIterations = 30;
+    double axisWeight = 100.0;   ///< mm per rad: how much an axis error counts against a tip error
+};
+
+struct IkResult {
+    AxisVector q;
+    double tipError = 0.0;   ///< mm
+    double axisError = 0.0;  ///< rad
+    int iterations = 0;
+    bool converged = false;
+};
+
+/// Axis commands near `start` at which machine `k` puts its tool at `target`. With fewer than five moving
+/// axes the problem is solved in the least-squares sense (e.g. a 3-axis machine matches the tip only).
+IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& tipInToolFrame, const AxisVector& start,
+                       const IkOptions& options = {});
+
+}  // namespace cnccomp
