@@ -64,7 +64,9 @@ TEST_P(PerMachine, InverseRecoversCommandsOnErroneousMachine) {
         const ToolPose got = toolPose(actual, r.q, tip);
         EXPECT_LT((got.tip - target.tip).norm(), 1e-8);
         // A four-axis machine cannot always match the axis; five axes must.
-        if (m.axisCount() >= 5) EXPECT_LT((got.axis - target.axis).norm(), 1e-10);
+        if (m.axisCount() >= 5) {
+            EXPECT_LT((got.axis - target.axis).norm(), 1e-10);
+        }
         EXPECT_LT(r.iterations, 6);
     }
 }
