@@ -1,0 +1,68 @@
+#pragma once
+// A controller backend writes compensation files in one controller's own syntax and can read them back into
+// an "apply" model: how that controller moves once the files are loaded. Each backend lives in
+// controllers/<family>/ and registers itself with a RegisterBackend object.
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cnccomp/deviations.hpp"
+
+namespace cnccomp::controllers {
+
+struct EmitRequest {
+    const MachineModel& machine;
+    const DeviationSet& deviations;
+    std::string deviationSource;  ///< file name of the deviation set, for the header comment
+    std::string date;             ///< ISO date for the header comment
+};
+
+struct OutputFile {
+    std::string name;     ///< file name inside the output folder
+    std::string content;  ///< exact bytes
+};
+
+/// One line of the coverage report: a deviation and how it is compensated, or why it is not.
+struct Coverage {
+    std::string deviation;
+    std::string note;
+};
+
+struct EmitResult {
+    std::vector<OutputFile> files;
+    std::vector<Coverage> compensated;
+    std::vector<Coverage> notCompensated;  ///< never dropped silently: also listed in every file header
+};
+
+/// The controller with the files loaded. The program commands axis positions meant for the nominal machine;
+/// the controller sends other positions to the drives (table trims added to the commands, or a TCP
+/// transformation recomputed with corrected kinematic parameters).
+class AppliedCompensation {
+public:
+    virtual ~AppliedCompensation() = default;
+    virtual AxisVector driveCommands(const AxisVector& programmed) const = 0;
+};
+
+class Backend {
+public:
+    virtual ~Backend() = default;
+    virtual std::string_view name() const = 0;         ///< e.g. "linuxcnc", "siemens-840d"
+    virtual std::string_view description() const = 0;
+    /// Throws ModelError when a limit of the controller is exceeded (table points, value ranges).
+    virtual EmitResult emit(const EmitRequest& request) const = 0;
+    /// Parses the files (InputError with file:line on syntax errors) and models how the controller uses them.
+    virtual std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
+                                                       const std::vector<OutputFile>& files) const = 0;
+};
+
+/// All registered backends, sorted by name.
+std::vector<const Backend*> backends();
+/// Backend by name; throws ModelError listing the known names.
+const Backend& backend(std::string_view name);
+
+struct RegisterBackend {
+    explicit RegisterBackend(std::unique_ptr<Backend> b);
+};
+
+}  // namespace cnccomp::controllers
