@@ -35,6 +35,8 @@ struct BallbarRun {
     double startDeg = 0.0, endDeg = 360.0, stepDeg = 1.0;
     Vec3 toolBallOffset = Vec3::Zero();  ///< (xT, yT, zT) of eq. (15), mm, tool frame
     Vec3 workBallOffset = Vec3::Zero();  ///< (xW, yW, zW) of eq. (16), mm, workpiece frame
+    bool estimateToolBallOffset = false;  ///< identification: treat (xT, yT, zT) as nuisance parameters
+    bool estimateWorkBallOffset = false;  ///< identification: treat (xW, yW, zW) as nuisance parameters
     std::string headAxis = "B";
     std::string tableAxis = "C";
 

@@ -41,6 +41,11 @@ MeasurementPlan readPlanXml(const std::string& path) {
         r.stepDeg = xml::number(*e, path, "step", 1.0);
         r.toolBallOffset = xml::vec3(*e, path, "tool-ball-offset", Vec3::Zero());
         r.workBallOffset = xml::vec3(*e, path, "work-ball-offset", Vec3::Zero());
+        const std::string est = xml::textOr(*e, "estimate-mounting", "none");
+        if (est != "none" && est != "tool" && est != "work" && est != "both")
+            xml::fail(*e, path, fmt::format("estimate-mounting '{}' is not none, tool, work or both", est));
+        r.estimateToolBallOffset = est == "tool" || est == "both";
+        r.estimateWorkBallOffset = est == "work" || est == "both";
         r.headAxis = xml::textOr(*e, "head-axis", "B");
         r.tableAxis = xml::textOr(*e, "table-axis", "C");
         try {
@@ -66,6 +71,10 @@ std::string formatPlanXml(const MeasurementPlan& plan) {
             o << fmt::format(" tool-ball-offset=\"{:g} {:g} {:g}\"", r.toolBallOffset.x(), r.toolBallOffset.y(), r.toolBallOffset.z());
         if (!r.workBallOffset.isZero())
             o << fmt::format(" work-ball-offset=\"{:g} {:g} {:g}\"", r.workBallOffset.x(), r.workBallOffset.y(), r.workBallOffset.z());
+        if (r.estimateToolBallOffset || r.estimateWorkBallOffset)
+            o << fmt::format(" estimate-mounting=\"{}\"", r.estimateToolBallOffset && r.estimateWorkBallOffset ? "both"
+                                                           : r.estimateToolBallOffset                             ? "tool"
+                                                                                                                  : "work");
         if (r.headAxis != "B") o << fmt::format(" head-axis=\"{}\"", r.headAxis);
         if (r.tableAxis != "C") o << fmt::format(" table-axis=\"{}\"", r.tableAxis);
         o << "/>\n";

@@ -14,7 +14,8 @@ struct MeasurementPlan {
 };
 
 /// Attributes of <run>: name, test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
-/// tool-ball-offset / work-ball-offset ("x y z" mm), head-axis / table-axis (default B / C).
+/// tool-ball-offset / work-ball-offset ("x y z" mm),
+/// estimate-mounting (none|tool|work|both: mounting offsets as nuisance parameters), head-axis / table-axis (default B / C).
 MeasurementPlan readPlanXml(const std::string& path);
 void writePlanXml(const std::string& path, const MeasurementPlan& plan);
 std::string formatPlanXml(const MeasurementPlan& plan);
