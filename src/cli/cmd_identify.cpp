@@ -20,6 +20,7 @@ namespace {
 struct Options {
     std::string method = "closed-form";
     std::string machine, eccentricities, traces, plan, out;
+    int refine = 3;
 };
 
 void run(const Options& o) {
@@ -36,7 +37,8 @@ void run(const Options& o) {
         const MeasurementPlan plan = readPlanXml(o.plan);
         rows = eccentricitiesFromTraces(m, plan.runs, readRunTraces(o.traces, plan.runs));
     }
-    const DeviationSet d = identifyClosedForm(m, rows);
+    if (o.refine < 0 || o.refine > 20) throw ModelError("--refine takes 0..20 passes");
+    const DeviationSet d = identifyClosedForm(m, rows, {o.refine, 1.0});
     writeDeviationCsv(o.out, d);
     fmt::print("identified {} deviations of '{}' (closed form, seed 000 eq. (17)-(28)) -> {}\n",
                std::count(d.present.begin(), d.present.end(), 1), m.name, o.out);
@@ -52,6 +54,9 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--traces", o->traces, "folder of trace CSVs, one <run>.csv per run")->check(CLI::ExistingDirectory);
     c->add_option("--plan", o->plan, "measurement plan XML")->check(CLI::ExistingFile);
     c->add_option("--out", o->out, "deviation CSV to write")->required();
+    c->add_option("--refine", o->refine,
+                  "closed form: defect-correction passes on the exact model (0 = the paper's formulas only)")
+        ->capture_default_str();
     c->callback([o] { run(*o); });
 });
 

@@ -72,8 +72,10 @@ ClosedFormInputs selectClosedFormInputs(const std::vector<EccentricityRow>& rows
         "RB != RB''");
 }
 
-DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<EccentricityRow>& rows) {
-    const ClosedFormInputs in = selectClosedFormInputs(rows);
+namespace {
+
+/// Equations (17)-(28) applied to one selection of rows; returns the 12 values in `d`.
+void applyFormulas(const ClosedFormInputs& in, DeviationSet& d) {
     const double RB = in.cr.RB, RB2 = in.crR.RB, ZC = in.cr.ZC, ZC1 = in.crZ.ZC, RC = in.ca.RC;
     if (!(RC > 0)) throw ModelError("closed form: the C-axial run needs RC > 0");
     const double exBX = need(in.bx, 0), ezBX = need(in.bx, 2);
@@ -83,8 +85,6 @@ DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<E
     const double exCR1 = need(in.crZ, 0), eyCR1 = need(in.crZ, 1);  // ' : at ZC'
     const double exCR2 = need(in.crR, 0), eyCR2 = need(in.crR, 1);  // '': at ZC', RB''
     const double dZ = ZC1 - ZC;
-
-    DeviationSet d(machine);
     d.set("gXB", -exBY / RB);                                                   // (17)
     d.set("dzBT", exBX);                                                        // (18)
     d.set("dxCZ", exCR + ezBX - ZC * (exCR1 - exCR) / dZ);                      // (19)
@@ -97,6 +97,42 @@ DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<E
     d.set("bXB", (exCR1 - exCR2) / (RB - RB2) - (exCR1 - exCR) / dZ + exCA / RC);  // (26)
     d.set("aBT", (eyCR2 - eyCR1) / (RB - RB2) - ezBY / RB);                     // (27)
     d.set("dyCZ", RB * (eyCR1 - eyCR2) / (RB2 - RB) + (ZC1 * eyCR - ZC * eyCR1) / dZ);  // (28)
+}
+
+BallbarRun runOf(const EccentricityRow& row, double stepDeg) {
+    BallbarRun r;
+    r.name = std::string(testName(row.test)) + " (" + row.source + ")";
+    r.test = row.test;
+    r.LB = row.LB;
+    r.RB = row.RB;
+    r.RC = row.RC;
+    r.ZC = row.ZC;
+    r.startDeg = rotatesHead(row.test) ? -180.0 : 0.0;
+    r.endDeg = r.startDeg + 360.0;
+    r.stepDeg = stepDeg;
+    return r;
+}
+
+}  // namespace
+
+DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<EccentricityRow>& rows,
+                                const ClosedFormOptions& options) {
+    const ClosedFormInputs measured = selectClosedFormInputs(rows);
+    DeviationSet d(machine);
+    applyFormulas(measured, d);
+    for (int pass = 0; pass < options.refinements; ++pass) {
+        // Simulate the six runs on the current estimate; the defect goes back through the (linear) formulas.
+        const Kinematics k(machine, d);
+        ClosedFormInputs defect = measured;
+        for (EccentricityRow* row : {&defect.bx, &defect.by, &defect.ca, &defect.cr, &defect.crZ, &defect.crR}) {
+            const BallbarRun run = runOf(*row, options.stepDeg);
+            const Vec3 sim = traceEccentricity(machine, run, simulateRun(k, run));
+            for (int c = 0; c < 3; ++c) row->e[c] = row->e[c] - sim[c];
+        }
+        DeviationSet step(machine);
+        applyFormulas(defect, step);
+        d.values += step.values;
+    }
     return d;
 }
 

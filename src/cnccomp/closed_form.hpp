@@ -16,8 +16,18 @@ struct ClosedFormInputs {
 };
 ClosedFormInputs selectClosedFormInputs(const std::vector<EccentricityRow>& rows);
 
+struct ClosedFormOptions {
+    /// Defect-correction passes on the exact model. The formulas are first order; the exact ball-bar length adds
+    /// second-order terms (e.g. |δ0|²/LB in the C-axial ex, δ0 = setup offset of the W-side ball ≈ 0.1 µm, i.e.
+    /// 0.5 arcsec in βXB, βYZ after division by RC). Each pass simulates the rows' runs on the identified set,
+    /// and feeds the eccentricity defect (measured − simulated) back through the same formulas. 0 = formulas only.
+    int refinements = 3;
+    double stepDeg = 1.0;  ///< sweep step of the simulated runs in the refinement
+};
+
 /// Equations (17)–(28). The machine must define the deviations by their seed-000 aliases
 /// (dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ); the result marks those 12 present.
-DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<EccentricityRow>& rows);
+DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<EccentricityRow>& rows,
+                                const ClosedFormOptions& options = {});
 
 }  // namespace cnccomp
