@@ -1,0 +1,83 @@
+#include "controllers/common/header.hpp"
+
+#include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+namespace cnccomp::controllers {
+namespace {
+
+void line(std::string& out, std::string_view prefix, std::string_view suffix, std::string_view eol, std::string text) {
+    if (!suffix.empty() && suffix.front() == ')') {
+        // Fanuc-style comments do not nest: parentheses inside become brackets.
+        std::replace(text.begin(), text.end(), '(', '[');
+        std::replace(text.begin(), text.end(), ')', ']');
+    } else if (!suffix.empty()) {
+        std::replace(text.begin(), text.end(), suffix.front(), '_');
+    }
+    // A comment must not hold a line break of its own.
+    std::replace(text.begin(), text.end(), '\n', ' ');
+    std::replace(text.begin(), text.end(), '\r', ' ');
+    std::string l = std::string(prefix) + text + std::string(suffix);
+    if (suffix.empty())
+        while (!l.empty() && l.back() == ' ') l.pop_back();
+    out += l;
+    out += eol;
+}
+
+void list(std::string& out, std::string_view prefix, std::string_view suffix, std::string_view eol,
+          const std::vector<Coverage>& items) {
+    if (items.empty()) line(out, prefix, suffix, eol, "  (none)");
+    size_t w = 0;
+    for (const Coverage& c : items) w = std::max(w, c.deviation.size());
+    for (const Coverage& c : items) line(out, prefix, suffix, eol, fmt::format("  {:<{}}  {}", c.deviation, w, c.note));
+}
+
+}  // namespace
+
+HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controller, const EmitResult& coverage,
+                          std::vector<std::string> notes) {
+    HeaderInfo h;
+    h.controller = std::string(controller);
+    h.machine = request.machine.name;
+    h.machineFile = request.machine.sourceFile;
+    h.deviationSource = request.deviationSource;
+    h.date = request.date;
+    h.compensated = coverage.compensated;
+    h.notCompensated = coverage.notCompensated;
+    h.notes = std::move(notes);
+    return h;
+}
+
+std::string formatHeader(const HeaderInfo& h, std::string_view prefix, std::string_view suffix, std::string_view eol) {
+    std::string out;
+    line(out, prefix, suffix, eol, fmt::format("cnccomp compensation for {}", h.controller));
+    const std::string file = std::filesystem::path(h.machineFile).filename().string();
+    line(out, prefix, suffix, eol, file.empty() ? fmt::format("machine: {}", h.machine)
+                                                : fmt::format("machine: {} ({})", h.machine, file));
+    line(out, prefix, suffix, eol, fmt::format("deviation set: {}", h.deviationSource.empty() ? "-" : h.deviationSource));
+    line(out, prefix, suffix, eol, fmt::format("date: {}", h.date.empty() ? "-" : h.date));
+    line(out, prefix, suffix, eol, "compensated:");
+    list(out, prefix, suffix, eol, h.compensated);
+    line(out, prefix, suffix, eol, "NOT compensated:");
+    list(out, prefix, suffix, eol, h.notCompensated);
+    for (const std::string& n : h.notes) line(out, prefix, suffix, eol, n);
+    return out;
+}
+
+std::string formatCoverage(const EmitResult& r) {
+    std::string out = "compensated:\n";
+    const auto add = [&](const std::vector<Coverage>& items) {
+        if (items.empty()) out += "  (none)\n";
+        size_t w = 0;
+        for (const Coverage& c : items) w = std::max(w, c.deviation.size());
+        for (const Coverage& c : items) out += fmt::format("  {:<{}}  {}\n", c.deviation, w, c.note);
+    };
+    add(r.compensated);
+    out += "NOT compensated:\n";
+    add(r.notCompensated);
+    return out;
+}
+
+}  // namespace cnccomp::controllers

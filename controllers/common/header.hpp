@@ -1,0 +1,37 @@
+#pragma once
+// The header comment every controller file carries: controller, machine, deviation set, date, and the
+// deviations compensated and NOT compensated (never dropped silently). Each line is wrapped in the caller's
+// comment syntax, e.g. prefix "; " for Heidenhain/Sinumerik, "(" + ")" for Fanuc, "# " for INI/HAL.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "controllers/backend.hpp"
+
+namespace cnccomp::controllers {
+
+struct HeaderInfo {
+    std::string controller;            ///< e.g. "LinuxCNC 2.9 (COMP_FILE_TYPE 1, xyzac-trt-kins)"
+    std::string machine;               ///< machine name
+    std::string machineFile;           ///< machine description file (may be empty; only its file name is printed)
+    std::string deviationSource;       ///< deviation set file
+    std::string date;                  ///< ISO date
+    std::vector<Coverage> compensated;
+    std::vector<Coverage> notCompensated;
+    std::vector<std::string> notes;    ///< free lines, e.g. "[G] sign convention not confirmed"
+};
+
+/// Header info from an emit request and the coverage found so far.
+HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controller, const EmitResult& coverage,
+                          std::vector<std::string> notes = {});
+
+/// The header as text: one line per item, each `prefix + text + suffix` (trailing blanks of an empty text
+/// trimmed), lines ended by `eol`. Characters that would end the comment early are replaced inside the text:
+/// with suffix ")" (Fanuc) parentheses become brackets; another suffix's first character becomes '_'.
+std::string formatHeader(const HeaderInfo& info, std::string_view prefix, std::string_view suffix = "",
+                         std::string_view eol = "\n");
+
+/// The coverage report as printed by `cnccomp emit` (two indented lists).
+std::string formatCoverage(const EmitResult& result);
+
+}  // namespace cnccomp::controllers
