@@ -15,3 +15,5 @@ echo; echo "== simulate: six ball-bar runs of seed 000 section 5.3 on the errone
 echo; echo "== identify (closed form, seed 000 eq. (17)-(28))"
 ./build/cnccomp identify --method closed-form --machine $M --traces "$out/traces" --plan $P --out "$out/closed-form.csv" >/dev/null
 ./build/cnccomp compare --machine $M --truth $T --estimate "$out/closed-form.csv"
+echo; echo "== verify: the six runs on the true machine, as programmed and compensated with the identified set"
+./build/cnccomp verify --machine $M --plan $P --truth $T --identified "$out/closed-form.csv"

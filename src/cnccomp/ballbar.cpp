@@ -129,11 +129,11 @@ AxisVector runCommands(const MachineModel& m, const BallbarRun& run, double a) {
     return q;
 }
 
-BallbarTrace simulateRun(const Kinematics& k, const BallbarRun& run) {
+BallbarTrace simulateRun(const Kinematics& k, const BallbarRun& run, const CommandMap& drive) {
     const MachineModel& m = k.machine();
     const std::vector<double> angles = run.anglesDeg();
     const Vec3 tBall = k.toolPoint(run.RB, run.toolBallOffset);
-    const AxisVector q0 = setupCommands(m, run);
+    const AxisVector q0 = drive ? drive(setupCommands(m, run)) : setupCommands(m, run);
     try {
         k.checkTravel(q0);
     } catch (const ModelError& e) {
@@ -145,7 +145,7 @@ BallbarTrace simulateRun(const Kinematics& k, const BallbarRun& run) {
     t.angleDeg = angles;
     t.dL.resize(angles.size());
     for (size_t i = 0; i < angles.size(); ++i) {
-        const AxisVector q = runCommands(m, run, angles[i] * kDeg);
+        const AxisVector q = drive ? drive(runCommands(m, run, angles[i] * kDeg)) : runCommands(m, run, angles[i] * kDeg);
         try {
             k.checkTravel(q);
         } catch (const ModelError& e) {

@@ -1,5 +1,6 @@
 #pragma once
 // Double-ball-bar runs of seed 000 (Table 2) and their simulation on an exact machine model (eq. (14)–(16)).
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -56,9 +57,13 @@ struct BallbarTrace {
     std::vector<double> dL;  ///< ΔL = L − LB, mm (eq. (14))
 };
 
+/// Maps the commands a program asks for to the commands the drives receive (a compensation); identity if empty.
+using CommandMap = std::function<AxisVector(const AxisVector&)>;
+
 /// Simulates a run: sets the W-side ball where the T-side ball is at the setup commands, then ΔL along the
-/// sweep. Throws ModelError if a command leaves an axis' travel.
-BallbarTrace simulateRun(const Kinematics& machine, const BallbarRun& run);
+/// sweep. With `drive`, every command (setup included) passes through it first, as a compensating controller would.
+/// Throws ModelError if a command leaves an axis' travel.
+BallbarTrace simulateRun(const Kinematics& machine, const BallbarRun& run, const CommandMap& drive = {});
 
 /// Unit vectors (u, v) of the plane of the run's rotary axis, angle 0 along u, 90° along v (cyclic:
 /// C about Z → (X, Y); B about Y → (Z, X)), and the index of the out-of-plane machine axis.

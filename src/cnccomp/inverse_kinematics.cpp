@@ -1,5 +1,6 @@
 #include "cnccomp/inverse_kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -40,35 +41,68 @@ void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipI
 
 IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& tipInToolFrame, const AxisVector& start,
                        const IkOptions& o) {
+    using System = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6 + kMaxAxes, kMaxAxes>;
+    using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6 + kMaxAxes, 1>;
+    const MachineModel& m = k.machine();
+    const int n = static_cast<int>(start.size());
     IkResult r;
     r.q = start;
     PoseJacobian J;
-    Eigen::Matrix<double, 6, 1> res;
-    for (r.iterations = 0; r.iterations <= o.maxIterations; ++r.iterations) {
+    System A(6 + n, n);
+    Rhs b(6 + n);
+    for (r.iterations = 0; r.iterations < o.maxIterations; ++r.iterations) {
         const ToolPose p = toolPose(k, r.q, tipInToolFrame);
-        res.head<3>() = target.tip - p.tip;
-        res.tail<3>() = (target.axis - p.axis) * o.axisWeight;
         r.tipError = (target.tip - p.tip).norm();
         r.axisError = (target.axis - p.axis).norm();
-        if (r.tipError <= o.tolerance && r.axisError * o.axisWeight <= o.tolerance) {
-            r.converged = true;
-            break;
-        }
-        if (r.iterations == o.maxIterations) break;
         toolPoseJacobian(k, r.q, tipInToolFrame, J);
-        J.bottomRows<3>() *= o.axisWeight;
-        const AxisVector step = J.colPivHouseholderQr().solve(res);
+        A.setZero();
+        A.topRows<3>() = J.topRows<3>();
+        A.middleRows<3>(3) = J.bottomRows<3>() * o.axisWeight;
+        b.head<3>() = target.tip - p.tip;
+        b.segment<3>(3) = (target.axis - p.axis) * o.axisWeight;
+        for (int i = 0; i < n; ++i) {
+            const bool rotary = m.axisLink(i).kind == AxisKind::Rotary;
+            A(6 + i, i) = rotary ? o.rotaryRegularization : 0.0;
+            b[6 + i] = rotary ? o.rotaryRegularization * (start[i] - r.q[i]) : 0.0;
+        }
+        const AxisVector step = A.colPivHouseholderQr().solve(b);
         r.q += step;
-        // With fewer than five axes the pose cannot always be met: a vanishing step is the least-squares optimum.
-        if (step.norm() <= 1e-13 * (1.0 + r.q.norm())) {
-            const ToolPose f = toolPose(k, r.q, tipInToolFrame);
-            r.tipError = (target.tip - f.tip).norm();
-            r.axisError = (target.axis - f.axis).norm();
+        if (step.norm() <= std::max(1e-13 * (1.0 + r.q.norm()), 0.1 * o.tolerance)) {
             r.converged = true;
             ++r.iterations;
             break;
         }
     }
+    // Polish without the pull, so that regular poses meet the axis fully; a polish step that would swing a rotary
+    // axis (a singular direction) or does not lower the cost is refused.
+    const auto cost = [&](const AxisVector& q) {
+        const ToolPose p = toolPose(k, q, tipInToolFrame);
+        return (target.tip - p.tip).squaredNorm() + (o.axisWeight * (target.axis - p.axis)).squaredNorm();
+    };
+    double current = cost(r.q);
+    for (int polish = 0; polish < 4 && r.converged; ++polish) {
+        const ToolPose p = toolPose(k, r.q, tipInToolFrame);
+        toolPoseJacobian(k, r.q, tipInToolFrame, J);
+        A.setZero();
+        A.topRows<3>() = J.topRows<3>();
+        A.middleRows<3>(3) = J.bottomRows<3>() * o.axisWeight;
+        b.setZero();
+        b.head<3>() = target.tip - p.tip;
+        b.segment<3>(3) = (target.axis - p.axis) * o.axisWeight;
+        const AxisVector step = A.topRows(6).colPivHouseholderQr().solve(b.head<6>());
+        double rotaryStep = 0;
+        for (int i = 0; i < n; ++i)
+            if (m.axisLink(i).kind == AxisKind::Rotary) rotaryStep = std::max(rotaryStep, std::abs(step[i]));
+        if (!(rotaryStep < o.rotaryRegularization / o.axisWeight)) break;
+        const AxisVector trial = r.q + step;
+        const double c = cost(trial);
+        if (!(c < current)) break;
+        r.q = trial;
+        current = c;
+    }
+    const ToolPose f = toolPose(k, r.q, tipInToolFrame);
+    r.tipError = (target.tip - f.tip).norm();
+    r.axisError = (target.axis - f.axis).norm();
     return r;
 }
 

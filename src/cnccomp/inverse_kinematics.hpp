@@ -25,6 +25,12 @@ struct IkOptions {
     double tolerance = 1e-9;     ///< mm on the tip, and rad × axisWeight on the axis
     int maxIterations = 30;
     double axisWeight = 100.0;   ///< mm per rad: how much an axis error counts against a tip error
+    /// mm per rad: pull of every rotary axis towards its start value. Keeps the solution next to the commanded one
+    /// where the tool axis cannot be matched: with the tool axis parallel to a rotary axis (B = 0 on a mill-turn
+    /// machine) a tilt of ε could only be removed by turning C by up to 90°; with this pull the solver leaves C alone
+    /// for tilts below regularization/axisWeight (1e-3 rad) and still meets the tip exactly (the slides can).
+    /// Away from such poses it costs a relative (regularization/axisWeight)² = 1e-6 of the axis correction.
+    double rotaryRegularization = 0.1;
 };
 
 struct IkResult {
@@ -35,8 +41,10 @@ struct IkResult {
     bool converged = false;
 };
 
-/// Axis commands near `start` at which machine `k` puts its tool at `target`. With fewer than five moving
-/// axes the problem is solved in the least-squares sense (e.g. a 3-axis machine matches the tip only).
+/// Axis commands near `start` at which machine `k` puts its tool at `target`: Gauss–Newton on
+/// |tip error|² + axisWeight²·|axis error|² + regularization²·|rotary − start|². The tip is met exactly whenever the
+/// slides can reach it; where the axis cannot be matched (too few axes, singular pose) the result is the
+/// least-squares compromise closest to the commanded rotary positions. `converged` says the iteration settled.
 IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& tipInToolFrame, const AxisVector& start,
                        const IkOptions& options = {});
 
