@@ -42,6 +42,12 @@ class AppliedCompensation {
 public:
     virtual ~AppliedCompensation() = default;
     virtual AxisVector driveCommands(const AxisVector& programmed) const = 0;
+    /// The same with the active tool length (mm) known: controllers that compensate at the tool tip (TCP-based
+    /// volumetric compensation) use it; table-based models need not override it. The evaluation harness calls this.
+    virtual AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const {
+        (void)toolLength;
+        return driveCommands(programmed);
+    }
 };
 
 class Backend {

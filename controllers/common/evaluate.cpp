@@ -29,7 +29,7 @@ CompensationFigures evaluateCompensation(const MachineModel& m, const DeviationS
             throw ModelError(fmt::format("machine '{}' has {} axes, a sample has {}", m.name, m.axisCount(), q.size()));
         const ToolPose target = toolPose(nominal, q, tip);
         const ToolPose before = toolPose(actual, q, tip);
-        const AxisVector drive = comp.driveCommands(q);
+        const AxisVector drive = comp.driveCommandsForTool(q, toolLength);
         if (drive.size() != q.size() || !drive.allFinite())
             throw ModelError("compensation model returned drive commands of the wrong size or not finite");
         const ToolPose after = toolPose(actual, drive, tip);

@@ -11,7 +11,8 @@
 namespace cnccomp::controllers {
 
 /// Tool-tip (and tool-axis) error of the erroneous machine vs the nominal one over a set of programmed axis
-/// commands, without and with a controller's compensation applied (q_drive = comp.driveCommands(q)).
+/// commands, without and with a controller's compensation applied (q_drive = comp.driveCommandsForTool(q, toolLength),
+/// which is comp.driveCommands(q) unless the model uses the tool length).
 struct CompensationFigures {
     double maxBefore = 0, maxAfter = 0, rmsBefore = 0, rmsAfter = 0;  ///< mm, tip error
     double maxAxisBefore = 0, maxAxisAfter = 0;                       ///< rad

@@ -1,5 +1,7 @@
-// cnccomp identify: deviations from ball-bar measurements.
+// cnccomp identify: deviations from ball-bar measurements — general least squares on the raw traces (default,
+// issue 3) or the closed-form formulas of seed 000 (--method closed-form).
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -7,10 +9,15 @@
 #include "cli/print.hpp"
 #include "cnccomp/closed_form.hpp"
 #include "cnccomp/error.hpp"
+#include "cnccomp/identification/eccentricity_observation.hpp"
+#include "cnccomp/identification/lsq.hpp"
+#include "cnccomp/identification/parameters.hpp"
+#include "cnccomp/identification/plan_observations.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/eccentricity_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_csv.hpp"
 
@@ -18,15 +25,18 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string method = "closed-form";
+    std::string method = "least-squares";
     std::string machine, eccentricities, traces, plan, out;
     int refine = 3;
+    // least squares
+    std::string params = "all", report, solver = "lm", bounds, start, observe = "traces";
+    int monteCarlo = 0, maxIterations = 50;
+    unsigned long seed = 1;
+    double rankTolerance = 1e-7;
 };
 
-void run(const Options& o) {
-    const MachineModel m = readMachineXml(o.machine);
+void runClosedForm(const Options& o, const MachineModel& m) {
     refuseToOverwrite(o.out, {o.machine, o.eccentricities, o.plan});
-    if (o.method != "closed-form") throw ModelError(fmt::format("unknown --method '{}'", o.method));
     std::vector<EccentricityRow> rows;
     if (!o.eccentricities.empty()) {
         if (!o.traces.empty()) throw ModelError("give either --eccentricities or --traces with --plan, not both");
@@ -45,10 +55,129 @@ void run(const Options& o) {
     printDeviations(d, nullptr);
 }
 
+/// "dxBT=-20:10, EB0B=-5:5" (µm for lengths, arcsec for angles) → bounds in internal units.
+std::vector<ParameterBound> parseBounds(const MachineModel& m, const std::string& text) {
+    std::vector<ParameterBound> out;
+    size_t pos = 0;
+    while (pos < text.size()) {
+        size_t end = text.find(',', pos);
+        if (end == std::string::npos) end = text.size();
+        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
+        pos = end + 1;
+        if (item.empty()) continue;
+        const size_t eq = item.find('='), colon = item.find(':', eq == std::string::npos ? 0 : eq);
+        if (eq == std::string::npos || colon == std::string::npos)
+            throw ModelError(fmt::format("--bounds item '{}': expected NAME=LOWER:UPPER (um or arcsec)", item));
+        const std::string name(trim(std::string_view(item).substr(0, eq)));
+        const auto lo = parseNumber(trim(std::string_view(item).substr(eq + 1, colon - eq - 1)));
+        const auto hi = parseNumber(trim(std::string_view(item).substr(colon + 1)));
+        if (!lo || !hi) throw ModelError(fmt::format("--bounds item '{}': bounds must be numbers", item));
+        std::string base = name.substr(0, name.find('['));
+        const int di = m.deviationIndex(base);
+        // Nuisance names ("run.xT") are lengths; deviations take their own unit.
+        const double unit = di >= 0 && m.deviations[di].isAngle() ? kArcsec : kUm;
+        if (di < 0 && name.find('.') == std::string::npos)
+            throw ModelError(fmt::format("--bounds: unknown deviation '{}' for machine '{}'", name, m.name));
+        out.push_back({name, *lo * unit, *hi * unit});
+    }
+    return out;
+}
+
+std::string cell(double v, double scale, int width = 10, int prec = 4) {
+    return std::isfinite(v) ? fmt::format("{:{}.{}f}", v / scale, width, prec) : fmt::format("{:>{}}", "-", width);
+}
+
+void printReport(const IdentificationReport& r) {
+    fmt::print("{}: {} after {} iteration(s); cost {:.6g} -> {:.6g} um^2; rank {}/{}, condition number {:.4g}, "
+               "sigma {} um\n",
+               r.solver, r.termination, r.iterations, r.costBefore, r.costAfter, r.rank, r.unknowns,
+               r.conditionNumber, std::isfinite(r.sigma) ? fmt::format("{:.4f}", r.sigma / kUm) : "-");
+    const bool mc = r.monteCarloSamples > 0;
+    fmt::print("{:<14} {:<8} {:>12} {:>10} {:>10} {:>10}{}  {}\n", "name", "alias", "value", "std", "low95", "high95",
+               mc ? fmt::format(" {:>10} {:>10} {:>10}", "mc std", "mc low95", "mc high95") : "", "unit");
+    for (const ParameterEstimate& p : r.parameters) {
+        const double s = p.displayScale();
+        if (!p.identified) {
+            fmt::print("{:<14} {:<8} {:>12} {:>10} {:>10} {:>10}  {}\n", p.name, p.alias, "unidentified", "-", "-", "-",
+                       p.unit());
+            continue;
+        }
+        fmt::print("{:<14} {:<8} {} {} {} {}{}  {}\n", p.name, p.alias, cell(p.value, s, 12), cell(p.stddev, s),
+                   cell(p.lower95, s), cell(p.upper95, s),
+                   mc ? fmt::format(" {} {} {}", cell(p.mcStddev, s), cell(p.mcLower95, s), cell(p.mcUpper95, s)) : "",
+                   p.unit());
+    }
+    if (!r.identifiable.empty()) {
+        fmt::print("identifiable combinations of the unidentified parameters (coefficients in mm, rad):\n");
+        for (const Combination& c : r.identifiable)
+            fmt::print("  {} = {} ± {} {}  (identifiable, not each term)\n", c.text,
+                       cell(c.value, c.angle ? kArcsec : kUm, 0), cell(c.stddev, c.angle ? kArcsec : kUm, 0),
+                       c.angle ? "arcsec" : "um");
+    }
+    if (!r.unobservable.empty()) {
+        fmt::print("directions these measurements cannot see:\n");
+        for (const Combination& c : r.unobservable) fmt::print("  {}\n", c.text);
+    }
+    fmt::print("{:<18} {:>8} {:>14} {:>14}\n", "run", "samples", "rms before um", "rms after um");
+    for (const RunResidual& rr : r.runs)
+        fmt::print("{:<18} {:>8} {:>14.4f} {:>14.4f}\n", rr.run, rr.samples, rr.rmsBefore / kUm, rr.rmsAfter / kUm);
+    for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
+}
+
+void runLeastSquares(const Options& o, const MachineModel& m) {
+    if (!o.eccentricities.empty())
+        throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (eccentricities are "
+                         "for --method closed-form)");
+    if (o.traces.empty() || o.plan.empty()) throw ModelError("least squares needs --traces DIR and --plan P.xml");
+    refuseToOverwrite(o.out, {o.machine, o.plan, o.start});
+    if (!o.report.empty()) {
+        refuseToOverwrite(o.report, {o.machine, o.plan, o.start, o.out});
+    }
+    const MeasurementPlan plan = readPlanXml(o.plan);
+    Observations obs;
+    if (o.observe == "eccentricity") {
+        if (plan.runCount() != plan.runs.size())
+            throw ModelError("--observe eccentricity works on ball-bar <run> elements only");
+        obs = eccentricityObservations(m, plan.runs, readRunTraces(o.traces, plan.runs));
+    } else if (o.observe == "traces") {
+        obs = planObservations(m, plan, o.traces);
+    } else {
+        throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", o.observe));
+    }
+    IdentifyOptions io;
+    io.deviations = parseDeviationList(m, o.params);
+    io.solver = o.solver;
+    io.maxIterations = o.maxIterations;
+    io.rankTolerance = o.rankTolerance;
+    io.monteCarlo = o.monteCarlo;
+    io.seed = o.seed;
+    io.bounds = parseBounds(m, o.bounds);
+    if (!o.start.empty()) io.start = readDeviationCsv(o.start, m);
+    const IdentificationResult r = identify(m, obs, io);
+    writeDeviationCsv(o.out, r.deviations);
+    if (!o.report.empty()) writeReportJson(o.report, r.report);
+    const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
+                                          [&](int i) { return r.deviations.present[i] != 0; });
+    fmt::print("identified {} of {} requested deviations of '{}' (least squares on {} samples of {} runs) -> {}{}\n",
+               identified, io.deviations.size(), m.name, r.report.observations, plan.runCount(), o.out,
+               o.report.empty() ? "" : ", report -> " + o.report);
+    printReport(r.report);
+}
+
+void run(const Options& o) {
+    const MachineModel m = readMachineXml(o.machine);
+    if (o.method == "closed-form") return runClosedForm(o, m);
+    if (o.method != "least-squares" && o.method != "lsq")
+        throw ModelError(fmt::format("unknown --method '{}' (least-squares, closed-form)", o.method));
+    runLeastSquares(o, m);
+}
+
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
     auto* c = app.add_subcommand("identify", "Identify the machine's deviations from ball-bar measurements");
-    c->add_option("--method", o->method, "closed-form (seed 000 eq. (17)-(28))")->capture_default_str();
+    c->add_option("--method", o->method,
+                  "least-squares (exact model, raw traces) or closed-form (seed 000 eq. (17)-(28))")
+        ->capture_default_str();
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--eccentricities", o->eccentricities, "eccentricity CSV (closed form)")->check(CLI::ExistingFile);
     c->add_option("--traces", o->traces, "folder of trace CSVs, one <run>.csv per run")->check(CLI::ExistingDirectory);
@@ -56,6 +185,24 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--out", o->out, "deviation CSV to write")->required();
     c->add_option("--refine", o->refine,
                   "closed form: defect-correction passes on the exact model (0 = the paper's formulas only)")
+        ->capture_default_str();
+    c->add_option("--params", o->params, "least squares: deviations to identify, ISO names or aliases (comma list), or all")
+        ->capture_default_str();
+    c->add_option("--observe", o->observe,
+                  "least squares: traces (every raw sample) or eccentricity (fitted circle centres of ball-bar runs)")
+        ->capture_default_str();
+    c->add_option("--report", o->report, "least squares: JSON report to write");
+    c->add_option("--solver", o->solver, "least squares: lm (Levenberg-Marquardt) or nlopt:<ALGORITHM>, e.g. nlopt:LD_SLSQP")
+        ->capture_default_str();
+    c->add_option("--bounds", o->bounds, "NLopt: NAME=LOWER:UPPER,... in um / arcsec (default +-1000)");
+    c->add_option("--start", o->start,
+                  "least squares: deviation CSV with starting values; deviations not in --params keep these values")
+        ->check(CLI::ExistingFile);
+    c->add_option("--monte-carlo", o->monteCarlo, "least squares: number of resampled solutions for sampled intervals");
+    c->add_option("--seed", o->seed, "random seed for --monte-carlo");
+    c->add_option("--max-iterations", o->maxIterations, "least squares: iteration limit")->capture_default_str();
+    c->add_option("--rank-tolerance", o->rankTolerance,
+                  "relative singular value below which a direction counts as unobservable")
         ->capture_default_str();
     c->callback([o] { run(*o); });
 });

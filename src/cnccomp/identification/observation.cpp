@@ -42,97 +42,136 @@ Vec3 errorTransformDerivative(const Vec6& e, const Mat3& Jl, int c, const Vec3& 
 
 }  // namespace
 
+constexpr int kMaxLinks = 16;
+
+/// Frames of every link of one chain at commands q: before the location error (after the placement) and before
+/// the component error (after the motion), with the component error vectors — the same composition as
+/// Kinematics::chainPose.
+struct DifferentiableMachine::Frames {
+    std::array<Pose, kMaxLinks> beforeLocation, beforeComponent;
+    std::array<Vec6, kMaxLinks> component;
+    std::array<double, kMaxLinks> q;
+    Pose end = Pose::Identity();
+};
+
 DifferentiableMachine::DifferentiableMachine(const MachineModel& machine, const DeviationSet& deviations)
-    : machine_(&machine), deviations_(deviations), kinematics_(machine, deviations_) {}
+    : machine_(&machine), deviations_(deviations), kinematics_(machine, deviations_) {
+    const Eigen::VectorXd& v = deviations_.values;
+    owner_.assign(static_cast<size_t>(v.size()), FlatOwner{});
+    for (int k = 0; k < static_cast<int>(machine.deviations.size()); ++k) {
+        const DeviationDef& d = machine.deviations[k];
+        for (int c = 0; c < d.size(); ++c) owner_[d.offset + c] = {k, c};
+    }
+    for (Side side : {Side::Workpiece, Side::Tool}) {
+        const Chain& chain = machine.chain(side);
+        if (chain.links.size() > static_cast<size_t>(kMaxLinks))
+            throw ModelError(fmt::format("machine '{}': chain longer than {} links", machine.name, kMaxLinks));
+        auto& links = side == Side::Tool ? tool_ : workpiece_;
+        links.assign(chain.links.size(), LinkConstants{});
+        for (const DeviationDef& d : machine.deviations) {
+            if (d.side != side) continue;
+            if (d.kind == DeviationKind::Location) links[d.link].location[d.component] += v[d.offset];
+            else links[d.link].hasComponent = true;
+        }
+        for (LinkConstants& l : links) l.locationJl = leftJacobian(l.location.tail<3>());
+    }
+}
+
+void DifferentiableMachine::chainFrames(Side side, const AxisVector& q, Frames& f) const {
+    const MachineModel& m = *machine_;
+    const Chain& chain = m.chain(side);
+    const auto& consts = side == Side::Tool ? tool_ : workpiece_;
+    const Eigen::VectorXd& v = deviations_.values;
+    Pose p = Pose::Identity();
+    for (size_t i = 0; i < chain.links.size(); ++i) {
+        const Link& l = chain.links[i];
+        const double qi = l.axisIndex >= 0 ? q[l.axisIndex] : 0.0;
+        f.q[i] = qi;
+        p = p * l.placement;
+        f.beforeLocation[i] = p;
+        p = p * errorTransform(consts[i].location);
+        if (l.kind == AxisKind::Linear) p.translation() += p.linear() * (l.direction * qi);
+        else if (l.kind == AxisKind::Rotary) p.linear() = p.linear() * axisRotation(l.direction, qi);
+        f.beforeComponent[i] = p;
+        f.component[i].setZero();
+        if (consts[i].hasComponent) {
+            for (const DeviationDef& d : m.deviations)
+                if (d.side == side && d.link == static_cast<int>(i) && d.kind == DeviationKind::Component)
+                    f.component[i][d.component] += d.basis.evaluate(qi, v.data() + d.offset, l.modulo);
+            p = p * errorTransform(f.component[i]);
+        }
+    }
+    f.end = p;
+}
+
+void DifferentiableMachine::chainDerivative(Side side, const Frames& f, const Vec3& pBed, int idx, Vec3& out) const {
+    const FlatOwner& o = owner_[idx];
+    const DeviationDef& def = machine_->deviations[o.deviation];
+    const auto& consts = side == Side::Tool ? tool_ : workpiece_;
+    const int i = def.link;
+    if (def.kind == DeviationKind::Location) {
+        const Pose& g = f.beforeLocation[i];
+        const Vec3 z = g.linear().transpose() * (pBed - g.translation());
+        out = g.linear() * errorTransformDerivative(consts[i].location, consts[i].locationJl, def.component, z);
+        return;
+    }
+    // basis_k(q): evaluate with the k-th unit coefficient vector (e_k of length n is unit + n − 1 − k).
+    const int n = def.size();
+    static thread_local std::vector<double> unit;
+    if (static_cast<int>(unit.size()) < 2 * n - 1) {
+        unit.assign(2 * static_cast<size_t>(n) - 1, 0.0);
+        unit[n - 1] = 1.0;
+    }
+    std::fill(unit.begin(), unit.end(), 0.0);
+    unit[n - 1] = 1.0;
+    const double b = def.basis.evaluate(f.q[i], unit.data() + (n - 1 - o.coefficient), machine_->chain(side).links[i].modulo);
+    if (b == 0.0) {
+        out.setZero();
+        return;
+    }
+    const Pose& g = f.beforeComponent[i];
+    const Vec3 z = g.linear().transpose() * (pBed - g.translation());
+    const Mat3 Jl = leftJacobian(f.component[i].tail<3>());
+    out = b * (g.linear() * errorTransformDerivative(f.component[i], Jl, def.component, z));
+}
 
 void DifferentiableMachine::bedPointJacobian(Side side, const AxisVector& q, const Vec3& point,
                                              const std::vector<int>& flat, Eigen::Ref<Eigen::MatrixXd> out) const {
-    const MachineModel& m = *machine_;
-    const Chain& chain = m.chain(side);
-    const Eigen::VectorXd& v = deviations_.values;
-    out.setZero();
-    const int nLinks = static_cast<int>(chain.links.size());
-    // Frames of every link: before the location error (after the placement) and before the component error
-    // (after the motion), with the error vectors — the same composition as Kinematics::chainPose.
-    constexpr int kMaxLinks = 32;
-    if (nLinks > kMaxLinks) throw ModelError(fmt::format("machine '{}': chain longer than {} links", m.name, kMaxLinks));
-    std::array<Pose, kMaxLinks> beforeLocation, beforeComponent;
-    std::array<Vec6, kMaxLinks> location, component;
-    Pose f = Pose::Identity();
-    for (int i = 0; i < nLinks; ++i) {
-        const Link& l = chain.links[i];
-        location[i].setZero();
-        component[i].setZero();
-        const double qi = l.axisIndex >= 0 ? q[l.axisIndex] : 0.0;
-        bool hasComponent = false;
-        for (const DeviationDef& d : m.deviations) {
-            if (d.side != side || d.link != i) continue;
-            if (d.kind == DeviationKind::Location) {
-                location[i][d.component] += v[d.offset];
-            } else {
-                component[i][d.component] += d.basis.evaluate(qi, v.data() + d.offset, l.modulo);
-                hasComponent = true;
-            }
-        }
-        f = f * l.placement;
-        beforeLocation[i] = f;
-        f = f * errorTransform(location[i]);
-        if (l.kind == AxisKind::Linear) f.translation() += f.linear() * (l.direction * qi);
-        else if (l.kind == AxisKind::Rotary) f.linear() = f.linear() * axisRotation(l.direction, qi);
-        beforeComponent[i] = f;
-        if (hasComponent) f = f * errorTransform(component[i]);
-    }
-    const Vec3 p = f * point;  // bed coordinates
-
-    // Unit coefficient vectors for basis values without allocation: e_j of length n is unit.data() + n-1-j.
+    Frames f;
+    chainFrames(side, q, f);
+    const Vec3 pBed = f.end * point;
+    Vec3 d;
     for (size_t j = 0; j < flat.size(); ++j) {
         const int idx = flat[j];
-        if (idx < 0 || idx >= static_cast<int>(v.size()))
+        if (idx < 0 || idx >= static_cast<int>(owner_.size()))
             throw ModelError(fmt::format("parameter index {} outside the deviation vector", idx));
-        // Which deviation owns this flat index.
-        const DeviationDef* def = nullptr;
-        for (const DeviationDef& d : m.deviations)
-            if (idx >= d.offset && idx < d.offset + d.size()) { def = &d; break; }
-        if (!def || def->side != side) continue;
-        const int i = def->link;
-        const Link& l = chain.links[i];
-        if (def->kind == DeviationKind::Location) {
-            const Pose& g = beforeLocation[i];
-            const Vec3 z = g.inverse(Eigen::Isometry) * p;
-            const Mat3 Jl = leftJacobian(location[i].tail<3>());
-            out.col(j) = g.linear() * errorTransformDerivative(location[i], Jl, def->component, z);
-        } else {
-            const double qi = l.axisIndex >= 0 ? q[l.axisIndex] : 0.0;
-            const int k = idx - def->offset;
-            // basis_k(q): evaluate with the k-th unit coefficient vector.
-            const int n = def->size();
-            double coefStorage[64];
-            std::vector<double> big;
-            double* coef = coefStorage;
-            if (n > 64) { big.assign(n, 0.0); coef = big.data(); }
-            else std::fill(coef, coef + n, 0.0);
-            coef[k] = 1.0;
-            const double b = def->basis.evaluate(qi, coef, l.modulo);
-            if (b == 0.0) continue;
-            const Pose& g = beforeComponent[i];
-            const Vec3 z = g.inverse(Eigen::Isometry) * p;
-            const Mat3 Jl = leftJacobian(component[i].tail<3>());
-            out.col(j) = b * (g.linear() * errorTransformDerivative(component[i], Jl, def->component, z));
+        if (machine_->deviations[owner_[idx].deviation].side != side) {
+            out.col(j).setZero();
+            continue;
         }
+        chainDerivative(side, f, pBed, idx, d);
+        out.col(j) = d;
     }
 }
 
 void DifferentiableMachine::toolPointJacobian(const AxisVector& q, const Vec3& toolPoint, const std::vector<int>& flat,
                                               Eigen::Ref<Eigen::MatrixXd> out) const {
-    // p_w = bMw⁻¹ · bMt · P:  ∂p_w = Rwᵀ (∂(bMt P) − ∂(bMw p_w)|p_w fixed).
-    const Pose bMw = kinematics_.baseToWorkpiece(q);
-    const Pose bMt = kinematics_.baseToTool(q);
-    const Vec3 pBed = bMt * toolPoint;
-    const Vec3 pW = bMw.inverse(Eigen::Isometry) * pBed;
-    Eigen::MatrixXd jt(3, flat.size()), jw(3, flat.size());
-    bedPointJacobian(Side::Tool, q, toolPoint, flat, jt);
-    bedPointJacobian(Side::Workpiece, q, pW, flat, jw);
-    out = bMw.linear().transpose() * (jt - jw);
+    // p_w = bMw⁻¹ · bMt · P. A tool-chain parameter moves the bed point p = bMt·P: ∂p_w = Rwᵀ ∂p. A workpiece-chain
+    // parameter moves the workpiece frame: ∂p_w = −Rwᵀ ∂(bMw·p_w)|p_w fixed, and bMw·p_w is the same bed point p.
+    Frames ft, fw;
+    chainFrames(Side::Tool, q, ft);
+    chainFrames(Side::Workpiece, q, fw);
+    const Vec3 pBed = ft.end * toolPoint;
+    const Mat3 RwT = fw.end.linear().transpose();
+    Vec3 d;
+    for (size_t j = 0; j < flat.size(); ++j) {
+        const int idx = flat[j];
+        if (idx < 0 || idx >= static_cast<int>(owner_.size()))
+            throw ModelError(fmt::format("parameter index {} outside the deviation vector", idx));
+        const Side side = machine_->deviations[owner_[idx].deviation].side;
+        chainDerivative(side, side == Side::Tool ? ft : fw, pBed, idx, d);
+        out.col(j) = side == Side::Tool ? Vec3(RwT * d) : Vec3(-(RwT * d));
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -53,9 +53,24 @@ public:
                           Eigen::Ref<Eigen::MatrixXd> out) const;
 
 private:
+    struct FlatOwner {
+        int deviation = -1;  ///< index into machine.deviations
+        int coefficient = 0;
+    };
+    struct LinkConstants {
+        Vec6 location = Vec6::Zero();  ///< summed location errors of the link
+        Mat3 locationJl = Mat3::Identity();  ///< left Jacobian of SO(3) at the location rotation
+        bool hasComponent = false;
+    };
+    struct Frames;
+    void chainFrames(Side side, const AxisVector& q, Frames& f) const;
+    void chainDerivative(Side side, const Frames& f, const Vec3& pBed, int flat, Vec3& out) const;
+
     const MachineModel* machine_;
     DeviationSet deviations_;
     Kinematics kinematics_;
+    std::vector<FlatOwner> owner_;
+    std::vector<LinkConstants> tool_, workpiece_;
 };
 
 /// One measured run as seen by the least-squares engine. Residual = measured − predicted.

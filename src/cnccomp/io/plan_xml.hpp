@@ -1,21 +1,37 @@
 #pragma once
-// Measurement plans: <plan machine="..."> with one <run> element per ball-bar run.
+// Measurement plans: <plan machine="..."> with one element per run. Run names are unique across all kinds (each
+// run's data is DIR/<name>.csv).
+//  <run>          ball-bar run of seed 000 Table 2 (W-side ball set on the T-side ball at the setup commands);
+//  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute (seed 002);
+//  <rtest>        R-test run (seed 001/004): ball on the table, nest on the spindle, rotary sweeps;
+//  <dbb5>         DBB5 run (seed 003): linear circle in a plane or rotary-axis circle.
 #include <string>
 #include <vector>
 
 #include "cnccomp/ballbar.hpp"
+#include "cnccomp/identification/dbb5_run.hpp"
+#include "cnccomp/identification/rtest_run.hpp"
 
 namespace cnccomp {
 
 struct MeasurementPlan {
     std::string machine;      ///< machine name the plan was made for (may be empty)
     std::string description;
-    std::vector<BallbarRun> runs;
+    std::vector<BallbarRun> runs;          ///< <run>
+    std::vector<BallbarRun> absoluteRuns;  ///< <absolute-run>
+    std::vector<RtestRun> rtestRuns;       ///< <rtest>
+    std::vector<Dbb5Run> dbb5Runs;         ///< <dbb5>
+    /// Total number of runs of every kind.
+    size_t runCount() const { return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size(); }
 };
 
-/// Attributes of <run>: name, test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
-/// tool-ball-offset / work-ball-offset ("x y z" mm),
-/// estimate-mounting (none|tool|work|both: mounting offsets as nuisance parameters), head-axis / table-axis (default B / C).
+/// Attributes of <run> and <absolute-run>: name, test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
+/// tool-ball-offset / work-ball-offset ("x y z" mm), estimate-mounting (none|tool|work|both: mounting offsets as
+/// nuisance parameters; an absolute run takes none|work), head-axis / table-axis (default B / C).
+/// <rtest name ball="x y z" [nest-length=100] [steps=36] [ball-offset="x y z"] [estimate-ball=false]> with children
+/// <sweep axis start end/> (deg, linear in the pose index) and <hold axis deg/>.
+/// <dbb5 name kind="linear|rotary" LB [tool-length=100] ball="x y z" [start=0 end=360 step=5] (linear: plane="XY|YZ|ZX";
+/// rotary: axis direction="x y z" [setup=0]) > with children <hold axis deg/>.
 MeasurementPlan readPlanXml(const std::string& path);
 void writePlanXml(const std::string& path, const MeasurementPlan& plan);
 std::string formatPlanXml(const MeasurementPlan& plan);

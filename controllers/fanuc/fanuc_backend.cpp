@@ -1,0 +1,135 @@
+// Backend "fanuc-30i": one parameter file (CNCCOMP.PRM) with the 5-axis TCP machine configuration and
+// offsets (tcp_parameters.hpp) and the stored pitch error compensation (pitch_error.hpp). Apply model: the
+// 30i tool centre point control (G43.4) on the kinematics the parameters describe — the programmed commands'
+// nominal tool pose is reached on it — then the pitch error correction interpolated at each axis position.
+#include "controllers/fanuc/fanuc_backend.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "controllers/common/axis_table.hpp"
+#include "controllers/common/header.hpp"
+#include "controllers/fanuc/tcp_parameters.hpp"
+
+namespace cnccomp::controllers::fanuc {
+
+EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
+    const MachineModel& m = request.machine;
+    const DeviationSet& d = request.deviations;
+    if (&d.machine() != &m && d.machine().name != m.name)
+        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", d.machine().name, m.name));
+    if (!d.values.allFinite()) throw ModelError("the deviation set holds a value that is not a finite number");
+    const TcpParameters tcp = tcpFromMachine(m, d.values);
+    const PitchPlan pitch = pitchFromDeviations(m, d, o);
+    EmitResult r;
+    for (size_t di = 0; di < m.deviations.size(); ++di) {
+        if (!d.present[di]) continue;
+        const DeviationDef& def = m.deviations[di];
+        if (def.kind != DeviationKind::Location) continue;
+        const Link& l = m.chain(def.side).links[def.link];
+        if (def.isAngle()) {
+            r.notCompensated.push_back(
+                {def.name, l.kind == AxisKind::Linear
+                               ? "squareness: the 30i TCP takes orthogonal linear axes (straightness/3-D compensation "
+                                 "parameters not public [G])"
+                               : "orientation / zero position of an axis: the 30i TCP parameters hold no tilt of a "
+                                 "rotary axis or of the spindle"});
+            continue;
+        }
+        std::string where;
+        if (l.kind == AxisKind::Rotary) where = m.axisSide(l.axisIndex) == Side::Tool ? "tool rotary axis position (19709-19714)" : "rotary table position (19700-19705)";
+        else if (l.kind == AxisKind::Fixed) where = def.side == Side::Tool ? "tool axis offset (19709-19711)" : "workpiece zero (1220)";
+        else where = "controlled point / workpiece zero (1220)";
+        r.compensated.push_back({def.name, fmt::format("5-axis TCP: {}", where)});
+    }
+    r.compensated.insert(r.compensated.end(), pitch.compensated.begin(), pitch.compensated.end());
+    r.notCompensated.insert(r.notCompensated.end(), pitch.notCompensated.begin(), pitch.notCompensated.end());
+
+    std::string axes;
+    for (int a : controllerAxisOrder(m)) axes += fmt::format("{}A{} = {}", axes.empty() ? "" : ", ", controllerAxisNumber(m, a), m.axisNames[a]);
+    const std::vector<std::string> notes = {
+        "controlled axes: " + axes + "; path 1; increment system IS-C (0.0001 mm / 0.0001 deg) [G]",
+        fmt::format("machine type 19680 = {}; 1220 moves the workpiece datum onto the measured axis lines (leave it out if "
+                    "the datum is probed again)",
+                    tcp.type),
+        "pitch data: correction added to the command (= -error) per interval, reference position at machine 0 [G]",
+        "line format N<number>Q1L1P (path), N<number>Q1A<n>P (axis), N1<point>Q0P (pitch data) [G: confirm on the control]",
+        "power off/on and a reference return after loading",
+    };
+    const std::string header = formatHeader(makeHeaderInfo(request, "Fanuc Series 30i (5-axis TCP parameters, pitch error compensation)",
+                                                            r, notes),
+                                            "(", ")");
+    std::vector<Parameter> lines = tcpLines(m, tcp);
+    const auto pl = pitchLines(m, pitch.tables);
+    lines.insert(lines.end(), pl.begin(), pl.end());
+    // Parameters by number, then the pitch error data.
+    std::stable_sort(lines.begin(), lines.end(), [](const Parameter& a, const Parameter& b) {
+        return std::make_pair(a.q == 0, a.number) < std::make_pair(b.q == 0, b.number);
+    });
+    r.files.push_back({kParameterFile, formatParameterFile(header, lines)});
+    return r;
+}
+
+FanucCompensation::FanucCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> tcp,
+                                     std::vector<PitchTable> pitch, double unit)
+    : machine_(&m), tcp_(m, std::move(tcp)), pitch_(std::move(pitch)), unit_(unit) {}
+
+AxisVector FanucCompensation::driveCommands(const AxisVector& programmed) const {
+    const AxisVector q = tcp_.solve(programmed);
+    AxisVector out = q;
+    for (const PitchTable& t : pitch_) {
+        const double scale = positionScale(machine_->axisLink(t.axis));
+        out[t.axis] += t.correction(q[t.axis] * scale, unit_) / scale;
+    }
+    return out;
+}
+
+std::unique_ptr<FanucCompensation> readFiles(const MachineModel& m, const std::vector<OutputFile>& files) {
+    const OutputFile* prm = nullptr;
+    for (const OutputFile& f : files) {
+        if (f.name != kParameterFile) throw InputError(f.name, 0, fmt::format("not a fanuc-30i file (expected {})", kParameterFile));
+        prm = &f;
+    }
+    if (!prm) throw InputError(kParameterFile, 0, "missing: the parameter file is needed");
+    const ParameterFile f = parseParameterFile(prm->name, prm->content);
+    for (const Parameter& p : f.parameters) {
+        const bool known = p.q == 0 || p.number == 1220 || (p.number >= 3620 && p.number <= 3625) || p.number == 19666 ||
+                           (p.number >= 19680 && p.number <= 19714);
+        if (!known) throw InputError(f.path, p.line, fmt::format("parameter {} is not one cnccomp writes or models", p.number));
+    }
+    const TcpParameters tcp = tcpFromFile(m, f);
+    std::vector<PitchTable> pitch = pitchFromFile(m, f);
+    std::vector<ChainElement> wp, tool;
+    tcpChains(m, tcp, wp, tool);
+    std::unique_ptr<const ControllerModel> model;
+    try {
+        model = std::make_unique<ControllerModel>(m, wp, tool);
+    } catch (const ModelError& e) {
+        throw InputError(f.path, f.find(19680) ? f.find(19680)->line : 0, e.what());
+    }
+    return std::make_unique<FanucCompensation>(m, std::move(model), std::move(pitch), PitchOptions{}.unit);
+}
+
+namespace {
+
+class FanucBackend final : public Backend {
+public:
+    std::string_view name() const override { return "fanuc-30i"; }
+    std::string_view description() const override {
+        return "Fanuc 30i: parameter file with the 5-axis TCP offsets (19680-19714, 1220) from the pivot errors and "
+               "stored pitch error compensation (3620-3625 + data)";
+    }
+    EmitResult emit(const EmitRequest& request) const override { return emitFiles(request, PitchOptions{}); }
+    std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
+                                               const std::vector<OutputFile>& files) const override {
+        return readFiles(machine, files);
+    }
+};
+
+const RegisterBackend registration(std::make_unique<FanucBackend>());
+
+}  // namespace
+}  // namespace cnccomp::controllers::fanuc

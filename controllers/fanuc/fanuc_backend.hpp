@@ -1,0 +1,34 @@
+#pragma once
+// Backend "fanuc-30i" (see fanuc_backend.cpp): emit with explicit limits, and the apply model.
+#include <memory>
+#include <vector>
+
+#include "controllers/backend.hpp"
+#include "controllers/common/controller_model.hpp"
+#include "controllers/fanuc/pitch_error.hpp"
+
+namespace cnccomp::controllers::fanuc {
+
+inline constexpr const char* kParameterFile = "CNCCOMP.PRM";
+
+EmitResult emitFiles(const EmitRequest& request, const PitchOptions& options);
+
+class FanucCompensation final : public AppliedCompensation {
+public:
+    FanucCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> tcp, std::vector<PitchTable> pitch,
+                      double unit);
+    AxisVector driveCommands(const AxisVector& programmed) const override;
+    TcpTransform& tcp() { return tcp_; }
+    const std::vector<PitchTable>& pitch() const { return pitch_; }
+
+private:
+    const MachineModel* machine_;
+    TcpTransform tcp_;
+    std::vector<PitchTable> pitch_;
+    double unit_;
+};
+
+/// Reads CNCCOMP.PRM (InputError file:line).
+std::unique_ptr<FanucCompensation> readFiles(const MachineModel& m, const std::vector<OutputFile>& files);
+
+}  // namespace cnccomp::controllers::fanuc

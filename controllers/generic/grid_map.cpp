@@ -1,0 +1,246 @@
+#include "controllers/generic/grid_map.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "controllers/common/controller_model.hpp"
+#include "controllers/common/files.hpp"
+#include "controllers/generic/json.hpp"
+
+namespace cnccomp::controllers::generic {
+namespace {
+
+constexpr const char* kValueColumns[] = {"dx_um", "dy_um", "dz_um", "dkx_urad", "dky_urad", "dkz_urad"};
+
+std::string axisColumn(const MachineModel& m, int a) {
+    return m.axisNames[a] + (m.axisLink(a).kind == AxisKind::Rotary ? "_deg" : "_mm");
+}
+
+double unitOf(bool rotary) { return rotary ? kDeg : 1.0; }
+
+std::vector<std::string> splitComma(std::string_view line) {
+    std::vector<std::string> out;
+    size_t start = 0;
+    for (;;) {
+        const size_t c = line.find(',', start);
+        out.emplace_back(trim(line.substr(start, c == std::string_view::npos ? std::string_view::npos : c - start)));
+        if (c == std::string_view::npos) break;
+        start = c + 1;
+    }
+    return out;
+}
+
+}  // namespace
+
+void GridMap::at(const AxisVector& q, Vec3& tipError, Vec3& axisError) const {
+    const int n = static_cast<int>(axes.size());
+    std::array<long, kMaxAxes> base{}, stride{};
+    std::array<double, kMaxAxes> frac{};
+    std::array<int, kMaxAxes> varying{};
+    int nv = 0;
+    long s = 1;
+    for (int a = n - 1; a >= 0; --a) {
+        stride[a] = s;
+        s *= static_cast<long>(axes[a].nodes.size());
+    }
+    for (int a = 0; a < n; ++a) {
+        const std::vector<double>& x = axes[a].nodes;
+        double v = q[axes[a].axis];
+        if (axes[a].wraps) {
+            v = std::fmod(v - x.front(), 2 * kPi);
+            if (v < 0) v += 2 * kPi;
+            v += x.front();
+        }
+        if (x.size() == 1 || v <= x.front()) {
+            base[a] = 0;
+            frac[a] = 0;
+        } else if (v >= x.back()) {
+            base[a] = static_cast<long>(x.size()) - 2;
+            frac[a] = 1;
+        } else {
+            const long i = static_cast<long>(std::upper_bound(x.begin(), x.end(), v) - x.begin()) - 1;
+            base[a] = i;
+            frac[a] = (v - x[i]) / (x[i + 1] - x[i]);
+        }
+        if (x.size() > 1) varying[nv++] = a;
+    }
+    tipError.setZero();
+    axisError.setZero();
+    for (long corner = 0; corner < (1L << nv); ++corner) {
+        double w = 1;
+        long index = 0;
+        for (int a = 0; a < n; ++a) index += base[a] * stride[a];
+        for (int k = 0; k < nv; ++k) {
+            const int a = varying[k];
+            const bool hi = (corner >> k) & 1;
+            w *= hi ? frac[a] : 1 - frac[a];
+            index += hi ? stride[a] : 0;
+        }
+        if (w == 0) continue;
+        tipError += w * tip[index];
+        axisError += w * toolAxis[index];
+    }
+}
+
+GridMap buildGridMap(const MachineModel& m, const DeviationSet& d) {
+    GridMap g;
+    for (int a = 0; a < m.axisCount(); ++a) {
+        const Link& l = m.axisLink(a);
+        GridMapAxis ax;
+        ax.axis = a;
+        ax.rotary = l.kind == AxisKind::Rotary;
+        bool components = false;
+        for (size_t k = 0; k < m.deviations.size(); ++k) {
+            const DeviationDef& def = m.deviations[k];
+            if (d.present[k] && def.kind == DeviationKind::Component && m.chain(def.side).links[def.link].axisIndex == a) components = true;
+        }
+        double lo = l.min, hi = l.max;
+        int count;
+        if (ax.rotary) {
+            lo = std::max(lo, -kPi);
+            hi = std::min(hi, kPi);
+            count = static_cast<int>(std::ceil((hi - lo) / (30 * kDeg) - 1e-9)) + 1;
+            ax.wraps = l.modulo && std::abs(hi - lo - 2 * kPi) < 1e-12;
+        } else {
+            count = components ? 5 : 2;
+        }
+        if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
+            throw ModelError(fmt::format("axis {} has no finite travel: the grid map needs one", l.name));
+        for (int i = 0; i < count; ++i) ax.nodes.push_back(i + 1 == count ? hi : lo + (hi - lo) * i / (count - 1));
+        g.axes.push_back(std::move(ax));
+    }
+    long total = 1;
+    for (const GridMapAxis& ax : g.axes) total *= static_cast<long>(ax.nodes.size());
+    if (total > 2'000'000) throw ModelError(fmt::format("the grid map would have {} nodes (limit 2 000 000)", total));
+    const Kinematics nominal(m), actual(m, d);
+    const Vec3 tip0 = nominal.toolPoint(0.0);
+    g.tip.resize(static_cast<size_t>(total));
+    g.toolAxis.resize(static_cast<size_t>(total));
+    AxisVector q(m.axisCount());
+    for (long i = 0; i < total; ++i) {
+        long r = i;
+        for (int a = m.axisCount() - 1; a >= 0; --a) {
+            const auto& x = g.axes[a].nodes;
+            q[a] = x[static_cast<size_t>(r % static_cast<long>(x.size()))];
+            r /= static_cast<long>(x.size());
+        }
+        const ToolPose n = toolPose(nominal, q, tip0), e = toolPose(actual, q, tip0);
+        g.tip[i] = e.tip - n.tip;
+        g.toolAxis[i] = e.axis - n.axis;
+    }
+    return g;
+}
+
+std::string formatGridMapCsv(const GridMap& g, const MachineModel& m, const std::string& header) {
+    std::string s = header;
+    s += "# tool-tip error at tool length 0 (dx dy dz, um) and tool-axis unit-vector error (dkx dky dkz, urad), workpiece frame;\n"
+         "# error at tool length L = (dx dy dz) + L * (dkx dky dkz); rows: last axis fastest; interpolate multilinearly\n";
+    for (int a = 0; a < m.axisCount(); ++a) s += axisColumn(m, a) + ",";
+    for (size_t i = 0; i < std::size(kValueColumns); ++i) s += std::string(kValueColumns[i]) + (i + 1 < std::size(kValueColumns) ? "," : "\n");
+    std::vector<size_t> idx(g.axes.size(), 0);
+    for (size_t i = 0; i < g.tip.size(); ++i) {
+        for (size_t a = 0; a < g.axes.size(); ++a) s += fixed(g.axes[a].nodes[idx[a]] / unitOf(g.axes[a].rotary), 6) + ",";
+        const Vec3 &t = g.tip[i], &k = g.toolAxis[i];
+        s += fmt::format("{},{},{},{},{},{}\n", fixed(t.x() / kUm, 6), fixed(t.y() / kUm, 6), fixed(t.z() / kUm, 6),
+                         fixed(k.x() * 1e6, 6), fixed(k.y() * 1e6, 6), fixed(k.z() * 1e6, 6));
+        for (int a = static_cast<int>(g.axes.size()) - 1; a >= 0; --a) {
+            if (++idx[a] < g.axes[a].nodes.size()) break;
+            idx[a] = 0;
+        }
+    }
+    return s;
+}
+
+std::string formatGridMapJson(const GridMap& g, const MachineModel& m, const std::vector<std::string>& header) {
+    std::string s = "{\n  \"format\": \"cnccomp-grid-map\",\n  \"version\": 1,\n  \"header\": [\n";
+    for (size_t i = 0; i < header.size(); ++i) s += "    " + jsonString(header[i]) + (i + 1 < header.size() ? ",\n" : "\n");
+    s += fmt::format("  ],\n  \"machine\": {},\n  \"toolLength_mm\": 0,\n", jsonString(m.name));
+    s += "  \"order\": \"row-major over grid, last axis fastest; error at tool length L = tip + L * toolAxis\",\n  \"grid\": [\n";
+    for (size_t a = 0; a < g.axes.size(); ++a) {
+        std::vector<double> nodes;
+        for (double v : g.axes[a].nodes) nodes.push_back(std::stod(fixed(v / unitOf(g.axes[a].rotary), 6)));
+        s += fmt::format("    {{\"axis\": {}, \"unit\": \"{}\", \"wraps\": {}, \"nodes\": {}}}{}\n", jsonString(m.axisNames[g.axes[a].axis]),
+                         g.axes[a].rotary ? "deg" : "mm", g.axes[a].wraps ? "true" : "false", jsonNumbers(nodes),
+                         a + 1 < g.axes.size() ? "," : "");
+    }
+    s += "  ],\n";
+    const auto column = [&](const char* name, bool tipColumn, int k, bool last) {
+        std::vector<double> v;
+        for (size_t i = 0; i < g.tip.size(); ++i)
+            v.push_back(std::stod(fixed(tipColumn ? g.tip[i][k] / kUm : g.toolAxis[i][k] * 1e6, 6)));
+        s += fmt::format("  \"{}\": {}{}\n", name, jsonNumbers(v), last ? "" : ",");
+    };
+    for (int k = 0; k < 3; ++k) column(kValueColumns[k], true, k, false);
+    for (int k = 0; k < 3; ++k) column(kValueColumns[3 + k], false, k, k == 2);
+    s += "}\n";
+    return s;
+}
+
+GridMap parseGridMapCsv(const std::string& text, const std::string& file, const MachineModel& m) {
+    std::vector<std::string> header;
+    int headerLine = 0;
+    std::vector<std::vector<double>> rows;
+    std::vector<int> lines;
+    for (const TextLine& l : splitLines(text)) {
+        const std::string_view s = trim(l.text);
+        if (s.empty() || s.front() == '#') continue;
+        const auto cells = splitComma(s);
+        if (header.empty()) {
+            header = cells;
+            headerLine = l.number;
+            continue;
+        }
+        if (cells.size() != header.size())
+            throw InputError(file, l.number, fmt::format("{} cells for {} columns", cells.size(), header.size()));
+        std::vector<double> v;
+        for (size_t i = 0; i < cells.size(); ++i) v.push_back(requireNumber(cells[i], file, l.number, "a value of " + header[i]));
+        rows.push_back(std::move(v));
+        lines.push_back(l.number);
+    }
+    const int n = m.axisCount();
+    if (static_cast<int>(header.size()) != n + 6) throw InputError(file, headerLine, fmt::format("expected {} axis columns and 6 error columns", n));
+    for (int a = 0; a < n; ++a)
+        if (header[a] != axisColumn(m, a)) throw InputError(file, headerLine, fmt::format("column {} must be {}", a + 1, axisColumn(m, a)));
+    for (int k = 0; k < 6; ++k)
+        if (header[n + k] != kValueColumns[k]) throw InputError(file, headerLine, fmt::format("column {} must be {}", n + k + 1, kValueColumns[k]));
+    if (rows.empty()) throw InputError(file, headerLine, "no data rows");
+    GridMap g;
+    long total = 1;
+    std::vector<std::vector<double>> fileNodes(n);
+    for (int a = 0; a < n; ++a) {
+        const Link& l = m.axisLink(a);
+        GridMapAxis ax;
+        ax.axis = a;
+        ax.rotary = l.kind == AxisKind::Rotary;
+        std::set<double> values;
+        for (const auto& r : rows) values.insert(r[a]);
+        fileNodes[a].assign(values.begin(), values.end());
+        for (double v : values) ax.nodes.push_back(v * unitOf(ax.rotary));
+        ax.wraps = l.modulo && ax.nodes.size() > 1 && std::abs(ax.nodes.back() - ax.nodes.front() - 2 * kPi) < 1e-9;
+        total *= static_cast<long>(ax.nodes.size());
+        g.axes.push_back(std::move(ax));
+    }
+    if (total != static_cast<long>(rows.size()))
+        throw InputError(file, headerLine, fmt::format("{} rows do not form a full grid ({} nodes)", rows.size(), total));
+    for (size_t i = 0; i < rows.size(); ++i) {
+        long r = static_cast<long>(i);
+        for (int a = n - 1; a >= 0; --a) {
+            const auto& x = fileNodes[a];
+            const double want = x[static_cast<size_t>(r % static_cast<long>(x.size()))];
+            r /= static_cast<long>(x.size());
+            if (rows[i][a] != want) throw InputError(file, lines[i], "rows are not in grid order (last axis fastest)");
+        }
+        g.tip.emplace_back(rows[i][n] * kUm, rows[i][n + 1] * kUm, rows[i][n + 2] * kUm);
+        g.toolAxis.emplace_back(rows[i][n + 3] * 1e-6, rows[i][n + 4] * 1e-6, rows[i][n + 5] * 1e-6);
+    }
+    return g;
+}
+
+}  // namespace cnccomp::controllers::generic

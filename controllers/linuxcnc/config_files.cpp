@@ -1,0 +1,82 @@
+#include "controllers/linuxcnc/config_files.hpp"
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "controllers/common/files.hpp"
+
+namespace cnccomp::controllers::linuxcnc {
+
+IniFragment parseIni(const std::string& text, const std::string& name) {
+    IniFragment ini;
+    std::string section;
+    for (const TextLine& l : splitLines(text)) {
+        const std::string_view s = trim(l.text);
+        if (s.empty() || s.front() == '#' || s.front() == ';') continue;
+        if (s.front() == '[') {
+            if (s.back() != ']') throw InputError(name, l.number, "expected [SECTION]");
+            section = std::string(s.substr(1, s.size() - 2));
+            continue;
+        }
+        const size_t eq = s.find('=');
+        if (eq == std::string_view::npos || section.empty())
+            throw InputError(name, l.number, "expected KEY = value inside a [SECTION]");
+        const std::string key(trim(s.substr(0, eq)));
+        const std::string value(trim(s.substr(eq + 1)));
+        if (section == "KINS" && key == "KINEMATICS") {
+            const auto tok = tokens(value);
+            if (tok.empty()) throw InputError(name, l.number, "KINEMATICS needs a module name");
+            ini.kinematics = std::string(tok[0]);
+            for (size_t i = 1; i < tok.size(); ++i)
+                if (tok[i].starts_with("coordinates=")) ini.coordinates = std::string(tok[i].substr(12));
+            if (ini.coordinates.empty()) throw InputError(name, l.number, "KINEMATICS needs coordinates=LETTERS");
+        } else if (section.starts_with("JOINT_")) {
+            const auto n = parseNumber(std::string_view(section).substr(6));
+            if (!n || *n < 0 || *n != static_cast<int>(*n)) throw InputError(name, l.number, fmt::format("bad section [{}]", section));
+            if (key == "COMP_FILE") {
+                if (value.empty()) throw InputError(name, l.number, "COMP_FILE needs a file name");
+                ini.compFile[static_cast<int>(*n)] = value;
+            } else if (key == "COMP_FILE_TYPE") {
+                if (value != "1") throw InputError(name, l.number, "this backend writes trims: COMP_FILE_TYPE must be 1");
+            }
+        } else if (section.starts_with("AXIS_") && section.size() == 6 && key == "WRAPPED_ROTARY") {
+            if (value != "0" && value != "1") throw InputError(name, l.number, "WRAPPED_ROTARY must be 0 or 1");
+            ini.wrapped[section[5]] = value == "1";
+        }
+    }
+    if (ini.kinematics.empty()) throw InputError(name, 0, "no [KINS] KINEMATICS line");
+    return ini;
+}
+
+std::optional<TrtPins> parseHal(const std::string& text, const std::string& name, const std::string& module) {
+    TrtPins p;
+    bool any = false;
+    for (const TextLine& l : splitLines(text)) {
+        const std::string_view s = trim(l.text);
+        if (s.empty() || s.front() == '#') continue;
+        const auto tok = tokens(s);
+        if (tok[0] == "net" || tok[0] == "loadrt" || tok[0] == "addf") continue;
+        if (tok[0] != "setp" || tok.size() != 3) throw InputError(name, l.number, "expected 'setp <pin> <value>'");
+        const std::string pin(tok[1]);
+        if (!pin.starts_with(module + "."))
+            throw InputError(name, l.number, fmt::format("pin '{}' is not a pin of {}", pin, module));
+        const std::string short_ = pin.substr(module.size() + 1);
+        const double v = requireNumber(tok[2], name, l.number, "the pin value");
+        double* target = short_ == "x-rot-point" ? &p.xRotPoint
+                         : short_ == "y-rot-point" ? &p.yRotPoint
+                         : short_ == "z-rot-point" ? &p.zRotPoint
+                         : short_ == "x-offset"    ? &p.xOffset
+                         : short_ == "y-offset"    ? &p.yOffset
+                         : short_ == "z-offset"    ? &p.zOffset
+                         : short_ == "tool-offset" ? &p.toolOffset
+                                                   : nullptr;
+        if (!target) throw InputError(name, l.number, fmt::format("unknown pin '{}' of {}", short_, module));
+        *target = v;
+        any = true;
+    }
+    if (!any) return std::nullopt;
+    return p;
+}
+
+}  // namespace cnccomp::controllers::linuxcnc

@@ -1,0 +1,243 @@
+#include "controllers/linuxcnc/linuxcnc_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+
+namespace cnccomp::controllers::linuxcnc {
+namespace {
+
+constexpr double kAligned = 1.0 - 1e-12;
+
+/// k (0..2) when the unit vector is ±e_k, else -1.
+int alignedComponent(const Vec3& d) {
+    for (int k = 0; k < 3; ++k)
+        if (std::abs(d[k]) >= kAligned) return k;
+    return -1;
+}
+
+bool isIdentityRotation(const Pose& p) { return (p.linear() - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-12; }
+
+/// Index of the first rotary link of a chain, or the chain length.
+int firstRotary(const Chain& c) {
+    for (int i = 0; i < static_cast<int>(c.links.size()); ++i)
+        if (c.links[i].kind == AxisKind::Rotary) return i;
+    return static_cast<int>(c.links.size());
+}
+
+/// Rotation of the frame in which link i's location error is expressed (nominal placements only).
+Mat3 errorFrame(const Chain& c, int i) {
+    Mat3 r = Mat3::Identity();
+    for (int k = 0; k <= i; ++k) r = r * c.links[k].placement.linear();
+    return r;
+}
+
+/// Workpiece-chain indices of the tilt and C links of a trt machine.
+std::pair<int, int> trtLinks(const MachineModel& m) {
+    int tilt = -1, c = -1;
+    const auto& l = m.workpiece.links;
+    for (int i = 0; i < static_cast<int>(l.size()); ++i) {
+        if (l[i].kind != AxisKind::Rotary) continue;
+        (tilt < 0 ? tilt : c) = i;
+    }
+    return {tilt, c};
+}
+
+std::string describeUnit(bool rotary) { return rotary ? "deg" : "mm"; }
+
+}  // namespace
+
+std::vector<int> linuxcncJointOrder(const MachineModel& m) {
+    std::vector<int> out;
+    for (char letter : std::string("XYZABCUVW"))
+        if (const int a = m.axisIndex(std::string(1, letter)); a >= 0) out.push_back(a);
+    for (int a = 0; a < m.axisCount(); ++a)
+        if (std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
+    return out;
+}
+
+std::optional<TrtType> matchTrt(const MachineModel& m) {
+    // Workpiece chain: exactly two rotary links (A about +X or B about +Y, then C about +Z), no linear ones.
+    // Tool chain: exactly the three linear slides along ±X ±Y ±Z, tool along −Z. No rotated placements.
+    int rot = 0;
+    for (const Link& l : m.workpiece.links) {
+        if (l.kind == AxisKind::Linear || !isIdentityRotation(l.placement)) return std::nullopt;
+        if (l.kind == AxisKind::Rotary) ++rot;
+    }
+    if (rot != 2) return std::nullopt;
+    int lin = 0, dirs = 0;
+    for (const Link& l : m.tool.links) {
+        if (l.kind == AxisKind::Rotary || !isIdentityRotation(l.placement)) return std::nullopt;
+        if (l.kind == AxisKind::Linear) {
+            const int k = alignedComponent(l.direction);
+            if (k < 0 || l.direction[k] < 0) return std::nullopt;
+            dirs |= 1 << k;
+            ++lin;
+        }
+    }
+    if (lin != 3 || dirs != 7 || (m.toolDirection - Vec3(0, 0, -1)).norm() > 1e-12) return std::nullopt;
+    const auto [tilt, c] = trtLinks(m);
+    const Link &lt = m.workpiece.links[tilt], &lc = m.workpiece.links[c];
+    if ((lc.direction - Vec3::UnitZ()).norm() > 1e-12 || lc.name != "C") return std::nullopt;
+    if ((lt.direction - Vec3::UnitX()).norm() < 1e-12 && lt.name == "A") return TrtType::AC;
+    if ((lt.direction - Vec3::UnitY()).norm() < 1e-12 && lt.name == "B") return TrtType::BC;
+    return std::nullopt;
+}
+
+TrtPins trtPins(const MachineModel& m, TrtType type, const DeviationSet* d) {
+    const auto [tilt, c] = trtLinks(m);
+    Vec3 a = Vec3::Zero(), cc = Vec3::Zero();
+    for (int i = 0; i <= c; ++i) {
+        Vec3 t = m.workpiece.links[i].placement.translation();
+        if (d)
+            for (size_t k = 0; k < m.deviations.size(); ++k) {
+                const DeviationDef& def = m.deviations[k];
+                if (def.side == Side::Workpiece && def.link == i && def.kind == DeviationKind::Location && def.component < 3)
+                    t[def.component] += d->values[def.offset];
+            }
+        (i <= tilt ? a : cc) += t;
+    }
+    // J = a + R1·(c + R2·p) equals trtfuncs' J = r + d − R1·d + R1·R2·(p − r) in world coordinates p + r when
+    // r = a + c and d = −c (the component of d along the tilt axis cancels).
+    TrtPins p;
+    const Vec3 r = a + cc;
+    p.xRotPoint = r.x();
+    p.yRotPoint = r.y();
+    p.zRotPoint = r.z();
+    if (type == TrtType::AC) p.yOffset = -cc.y();
+    else p.xOffset = -cc.x();
+    p.zOffset = -cc.z();
+    return p;
+}
+
+LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
+    LinuxcncPlan plan;
+    for (int a : linuxcncJointOrder(m)) {
+        const Link& l = m.axisLink(a);
+        JointPlan j;
+        j.axis = a;
+        j.name = l.name;
+        j.rotary = l.kind == AxisKind::Rotary;
+        j.modulo = l.modulo;
+        plan.coordinates += l.name;
+        plan.joints.push_back(j);
+    }
+    const auto joint = [&](int axis) -> JointPlan& {
+        for (JointPlan& j : plan.joints)
+            if (j.axis == axis) return j;
+        throw ModelError("internal: joint not found");
+    };
+    plan.trt = matchTrt(m);
+    int trtLast = -1;
+    if (plan.trt) {
+        plan.nominalPins = trtPins(m, *plan.trt, nullptr);
+        plan.pins = trtPins(m, *plan.trt, &d);
+        plan.workOffsetShift = {plan.pins.xRotPoint - plan.nominalPins.xRotPoint, plan.pins.yRotPoint - plan.nominalPins.yRotPoint,
+                                plan.pins.zRotPoint - plan.nominalPins.zRotPoint};
+        trtLast = trtLinks(m).second;
+    }
+    const std::string module = plan.trt ? trtModule(*plan.trt) : "trivkins";
+
+    // Linear joints usable for constant shifts: linear links before any rotary link of their chain.
+    std::vector<std::pair<int, Vec3>> shiftAxes;  // axis, effect on the tool relative to the workpiece per mm
+    for (const Chain* c : {&m.workpiece, &m.tool}) {
+        const int fr = firstRotary(*c);
+        for (int i = 0; i < fr; ++i) {
+            const Link& l = c->links[i];
+            if (l.kind != AxisKind::Linear) continue;
+            const Vec3 u = (errorFrame(*c, i) * l.direction).normalized();
+            shiftAxes.emplace_back(l.axisIndex, c->side == Side::Tool ? u : Vec3(-u));
+        }
+    }
+    Eigen::Matrix<double, 3, Eigen::Dynamic> A(3, static_cast<int>(shiftAxes.size()));
+    for (size_t k = 0; k < shiftAxes.size(); ++k) A.col(static_cast<int>(k)) = shiftAxes[k].second;
+    const bool canShift = shiftAxes.size() >= 3 && Eigen::FullPivLU<Eigen::MatrixXd>(A).rank() == 3;
+    std::string shiftNames;
+    for (const auto& [axis, u] : shiftAxes) shiftNames += m.axisNames[axis];
+
+    Vec3 shift = Vec3::Zero();  // wanted correction of the tool relative to the workpiece, bed frame
+    std::vector<std::string> shifted;
+    for (size_t k = 0; k < m.deviations.size(); ++k) {
+        if (!d.present[k]) continue;
+        const DeviationDef& def = m.deviations[k];
+        const Chain& c = m.chain(def.side);
+        const Link& l = c.links[def.link];
+        const auto yes = [&](std::string note) { plan.compensated.push_back({def.name, std::move(note)}); };
+        const auto no = [&](std::string note) { plan.notCompensated.push_back({def.name, std::move(note)}); };
+        if (def.kind == DeviationKind::Component) {
+            const int k3 = alignedComponent(l.direction);
+            const bool own = k3 >= 0 && def.component == (l.kind == AxisKind::Rotary ? 3 + k3 : k3);
+            if (own) {
+                joint(l.axisIndex).components.push_back({static_cast<int>(k), l.direction[k3]});
+                yes(fmt::format("positioning error of {}: joint table {}.comp", l.name, l.name));
+            } else {
+                no(fmt::format("cross-axis component error of {}: a LinuxCNC joint table corrects a joint along itself only", l.name));
+            }
+            continue;
+        }
+        const double v = d.values[def.offset];
+        if (def.isAngle()) {
+            const int k3 = alignedComponent(l.direction);
+            if (l.kind == AxisKind::Rotary && k3 >= 0 && def.component == 3 + k3) {
+                joint(l.axisIndex).constantTrim -= l.direction[k3] * v;
+                yes(fmt::format("zero position of {}: constant trim in {}.comp", l.name, l.name));
+            } else if (l.kind == AxisKind::Fixed) {
+                no(fmt::format("tilt of the fixed link {}: no LinuxCNC kinematics pin ({}) or table takes it", l.name, module));
+            } else if (l.kind == AxisKind::Rotary) {
+                no(fmt::format("orientation of the {} axis line: no LinuxCNC kinematics pin ({}) or table takes it", l.name, module));
+            } else {
+                no(fmt::format("squareness / angular error at {}: LinuxCNC has no cross-axis compensation", l.name));
+            }
+            continue;
+        }
+        // Translation location error.
+        if (plan.trt && def.side == Side::Workpiece && def.link <= trtLast) {
+            yes(fmt::format("position of the {} axis line: {} HAL pins (rot-point / offset)", l.name, module));
+            continue;
+        }
+        if (def.link <= firstRotary(c)) {
+            if (!canShift) {
+                no(fmt::format("offset at {}: needs three linear joints before the rotary axes to shift", l.name));
+                continue;
+            }
+            Vec3 e = Vec3::Zero();
+            e[def.component] = v;
+            const Vec3 vb = errorFrame(c, def.link) * e;
+            shift += def.side == Side::Tool ? Vec3(-vb) : vb;
+            yes(fmt::format("offset at {} (before any rotary axis): constant trims of joints {}", l.name, shiftNames));
+            continue;
+        }
+        no(fmt::format("offset behind a rotary axis at {}: no pin of the LinuxCNC kinematics ({}) takes it", l.name, module));
+    }
+    if (shift.norm() > 0) {
+        const Eigen::VectorXd t = A.colPivHouseholderQr().solve(shift);
+        for (size_t k = 0; k < shiftAxes.size(); ++k) joint(shiftAxes[k].first).constantTrim += t[static_cast<int>(k)];
+    }
+    for (const JointPlan& j : plan.joints) {
+        const double limit = j.rotary ? 5.0 * kDeg : 5.0;
+        if (std::abs(j.constantTrim) > limit)
+            throw ModelError(fmt::format("joint {}: constant trim {:.4f} {} exceeds the ±5 {} sanity limit (check the deviation units)",
+                                         j.name, j.constantTrim / (j.rotary ? kDeg : 1.0), describeUnit(j.rotary),
+                                         describeUnit(j.rotary)));
+    }
+    return plan;
+}
+
+double jointTrim(const MachineModel& m, const DeviationSet& d, const JointPlan& j, double p) {
+    double q = p + j.constantTrim;
+    for (int it = 0; it < 8; ++it) {
+        double e = 0;
+        for (const OwnComponent& c : j.components) {
+            const DeviationDef& def = m.deviations[c.deviation];
+            e += c.sign * def.basis.evaluate(q, d.values.data() + def.offset, j.modulo);
+        }
+        q = p + j.constantTrim - e;
+    }
+    return q - p;
+}
+
+}  // namespace cnccomp::controllers::linuxcnc

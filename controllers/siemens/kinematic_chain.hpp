@@ -1,0 +1,37 @@
+#pragma once
+// Sinumerik kinematic chain data (840D sl 4.7+, K12 "transformation definitions with kinematic chains"):
+// elements $NK_NAME[e], $NK_NEXT[e], $NK_PARALLEL[e], $NK_TYPE[e] ("OFFSET", "ROT_CONST", "AXIS_LIN",
+// "AXIS_ROT"), $NK_AXIS[e], $NK_OFF_DIR[e,0..2], $NK_A_OFF[e], and the transformation record $NT_...[1]
+// naming the ends of the tool and part chains. Element 0 starts the tool chain at the machine zero (ROOT);
+// $NK_PARALLEL[0] starts the part (workpiece) chain beside it.
+//
+// Meaning used here (and by the apply model) [G: confirm with the K12 manual of the NCK version]:
+//   OFFSET     translation by $NK_OFF_DIR (mm)
+//   ROT_CONST  rotation about the unit vector $NK_OFF_DIR by $NK_A_OFF (deg)
+//   AXIS_LIN   motion along $NK_OFF_DIR by the axis position
+//   AXIS_ROT   rotation about $NK_OFF_DIR by (axis position + $NK_A_OFF) (deg)
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "controllers/common/controller_model.hpp"
+#include "controllers/siemens/siemens_plan.hpp"
+
+namespace cnccomp::controllers::siemens {
+
+/// The chain data file (subprogram %_N_CNCCOMP_KINCHAIN_SPF) for the plan; `header` is inserted after the
+/// identifier line. Throws ModelError when the chain has more elements than Options::chainMaxElements.
+std::string formatKinematicChain(const MachineModel& m, const Plan& plan, const Options& o, const std::string& header);
+
+struct ParsedChain {
+    std::vector<ChainElement> workpiece, tool;
+};
+
+/// Reads a chain data file back. InputError (file:line) on syntax errors, unknown variables or element
+/// names, missing fields, a broken chain, or axes the machine does not have.
+ParsedChain parseKinematicChain(const MachineModel& m, const std::string& path, std::string_view text);
+
+inline constexpr const char* kChainIdentifier = "_N_CNCCOMP_KINCHAIN_SPF";
+inline constexpr const char* kChainFile = "CNCCOMP_KINCHAIN.SPF";
+
+}  // namespace cnccomp::controllers::siemens

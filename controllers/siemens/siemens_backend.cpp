@@ -1,0 +1,98 @@
+#include "controllers/siemens/siemens_backend.hpp"
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "controllers/common/header.hpp"
+#include "controllers/siemens/compensation_tables.hpp"
+#include "controllers/siemens/kinematic_chain.hpp"
+
+namespace cnccomp::controllers::siemens {
+
+EmitResult emitFiles(const EmitRequest& request, const Options& o) {
+    const MachineModel& m = request.machine;
+    const Plan plan = makePlan(m, request.deviations, o);
+    EmitResult r;
+    r.compensated = plan.compensated;
+    r.notCompensated = plan.notCompensated;
+    std::string axes;
+    for (int a : controllerAxisOrder(m)) axes += fmt::format("{}{} = {}", axes.empty() ? "" : ", ", axisName(m, a), m.axisNames[a]);
+    std::vector<std::string> notes = {
+        "machine axes: " + axes + " (MD10000 names as written; rename if yours differ)",
+        "units: mm and degrees",
+        "CEC: the table value is added to the output axis (correction = -error) [G: sign not confirmed]",
+        "CEC: enable with MD18342 MM_CEC_MAX_POINTS[t] >= points, SD41300 CEC_TABLE_ENABLE[t]=1, "
+        "MD32710 CEC_ENABLE=1 [G]",
+        "EEC: the value is the positioning error; a positive value moves the axis negative (K3); MD32700 ENC_COMP_ENABLE=1",
+        "kinematic chain: element meaning (OFFSET, ROT_CONST, AXIS_* with $NK_A_OFF) and branching with "
+        "$NK_PARALLEL at ROOT as read by cnccomp [G: confirm with K12 for your NCK version]",
+        "linear axes are written orthogonal in the chain; their squareness is in the CEC tables",
+    };
+    const std::string header =
+        formatHeader(makeHeaderInfo(request, "Siemens Sinumerik 840D sl (CEC, EEC, kinematic chain for TRAORI)", r, notes),
+                     "; ");
+    r.files.push_back({kChainFile, formatKinematicChain(m, plan, o, header)});
+    if (!plan.cec.empty()) r.files.push_back({kCecFile, formatCec(m, plan.cec, header)});
+    if (!plan.eec.empty()) r.files.push_back({kEecFile, formatEec(m, plan.eec, header)});
+    return r;
+}
+
+SiemensCompensation::SiemensCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> chain,
+                                         std::vector<CecTable> cec, std::vector<EecTable> eec)
+    : machine_(&m), tcp_(m, std::move(chain)), cec_(std::move(cec)), eec_(std::move(eec)) {}
+
+AxisVector SiemensCompensation::driveCommands(const AxisVector& programmed) const {
+    const AxisVector q = tcp_.solve(programmed);
+    AxisVector out = q;
+    for (const CecTable& c : cec_) {
+        const double in = q[c.input] * positionScale(machine_->axisLink(c.input));
+        out[c.output] += c.table.at(in) / positionScale(machine_->axisLink(c.output));
+    }
+    for (const EecTable& e : eec_) {
+        const double scale = positionScale(machine_->axisLink(e.axis));
+        out[e.axis] -= e.table.at(q[e.axis] * scale) / scale;
+    }
+    return out;
+}
+
+std::unique_ptr<SiemensCompensation> readFiles(const MachineModel& m, const std::vector<OutputFile>& files) {
+    const OutputFile* chain = nullptr;
+    std::vector<CecTable> cec;
+    std::vector<EecTable> eec;
+    for (const OutputFile& f : files) {
+        if (f.name == kChainFile) chain = &f;
+        else if (f.name == kCecFile) cec = parseCec(m, f.name, f.content);
+        else if (f.name == kEecFile) eec = parseEec(m, f.name, f.content);
+        else throw InputError(f.name, 0, fmt::format("not a siemens-840d file (expected {}, {} or {})", kChainFile, kCecFile, kEecFile));
+    }
+    if (!chain) throw InputError(kChainFile, 0, "missing: the kinematic chain file is needed for TRAORI");
+    const ParsedChain pc = parseKinematicChain(m, chain->name, chain->content);
+    std::unique_ptr<const ControllerModel> model;
+    try {
+        model = std::make_unique<ControllerModel>(m, pc.workpiece, pc.tool);
+    } catch (const ModelError& e) {
+        throw InputError(chain->name, 0, e.what());
+    }
+    return std::make_unique<SiemensCompensation>(m, std::move(model), std::move(cec), std::move(eec));
+}
+
+namespace {
+
+class SiemensBackend final : public Backend {
+public:
+    std::string_view name() const override { return "siemens-840d"; }
+    std::string_view description() const override {
+        return "Sinumerik 840D sl: CEC tables (squareness, cross-axis), EEC tables (positioning), kinematic chain "
+               "($NK_) with the rotary-axis locations for TRAORI";
+    }
+    EmitResult emit(const EmitRequest& request) const override { return emitFiles(request, Options{}); }
+    std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
+                                               const std::vector<OutputFile>& files) const override {
+        return readFiles(machine, files);
+    }
+};
+
+const RegisterBackend registration(std::make_unique<SiemensBackend>());
+
+}  // namespace
+}  // namespace cnccomp::controllers::siemens

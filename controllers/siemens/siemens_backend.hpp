@@ -1,0 +1,37 @@
+#pragma once
+// Backend "siemens-840d": Sinumerik 840D sl files from a deviation set (see siemens_plan.hpp for what goes
+// where) and the apply model: TRAORI on the kinematic chain read back from the file (the programmed commands'
+// nominal tool pose is reached on the corrected chain), then the CEC trims added to the output axes and the
+// EEC errors taken off each axis, interpolated at the commanded positions as the NCK does.
+#include <memory>
+#include <vector>
+
+#include "controllers/backend.hpp"
+#include "controllers/common/controller_model.hpp"
+#include "controllers/siemens/siemens_plan.hpp"
+
+namespace cnccomp::controllers::siemens {
+
+/// emit with explicit controller limits (the registered backend uses the defaults).
+EmitResult emitFiles(const EmitRequest& request, const Options& options);
+
+class SiemensCompensation final : public AppliedCompensation {
+public:
+    SiemensCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> chain, std::vector<CecTable> cec,
+                        std::vector<EecTable> eec);
+    AxisVector driveCommands(const AxisVector& programmed) const override;
+    TcpTransform& tcp() { return tcp_; }
+    const std::vector<CecTable>& cec() const { return cec_; }
+    const std::vector<EecTable>& eec() const { return eec_; }
+
+private:
+    const MachineModel* machine_;
+    TcpTransform tcp_;
+    std::vector<CecTable> cec_;
+    std::vector<EecTable> eec_;
+};
+
+/// Reads the files (InputError file:line) into the apply model.
+std::unique_ptr<SiemensCompensation> readFiles(const MachineModel& m, const std::vector<OutputFile>& files);
+
+}  // namespace cnccomp::controllers::siemens

@@ -1,0 +1,74 @@
+#include "postproc/block_writer.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace cnccomp::pp {
+
+OutputBuffer::OutputBuffer(std::ostream& out, size_t capacity) : out_(out), buf_(capacity < 64 ? 64 : capacity) {}
+
+OutputBuffer::~OutputBuffer() {
+    // flush() is explicit: a destructor must not throw, and a failed run must not look complete.
+}
+
+void OutputBuffer::flushSome(size_t) { flush(); }
+
+void OutputBuffer::flush() {
+    if (used_) out_.write(buf_.data(), static_cast<std::streamsize>(used_));
+    written_ += used_;
+    used_ = 0;
+}
+
+bool BlockEdits::add(uint32_t begin, uint32_t end, std::string_view text) {
+    if (count_ >= kMaxEdits) {
+        overflow_ = true;
+        return false;
+    }
+    size_t at;
+    if (text.data() >= arena_.data() && text.data() < arena_.data() + kArena) {
+        at = static_cast<size_t>(text.data() - arena_.data());  // composed in scratch()
+        used_ = std::max(used_, at + text.size());
+    } else {
+        if (text.size() > kArena - used_) {
+            overflow_ = true;
+            return false;
+        }
+        at = used_;
+        std::memcpy(arena_.data() + used_, text.data(), text.size());
+        used_ += text.size();
+    }
+    edits_[count_] = {begin, end, static_cast<uint32_t>(at), static_cast<uint32_t>(text.size()),
+                      static_cast<uint32_t>(count_)};
+    ++count_;
+    return true;
+}
+
+char* BlockEdits::scratch(size_t need) {
+    if (need > kArena - used_) {
+        overflow_ = true;
+        return nullptr;
+    }
+    return arena_.data() + used_;
+}
+
+void BlockEdits::apply(std::string_view line, OutputBuffer& out) {
+    std::sort(edits_.begin(), edits_.begin() + count_, [](const Edit& a, const Edit& b) {
+        if (a.begin != b.begin) return a.begin < b.begin;
+        // At the same position: a replacement that ends there first? No: replacements start there; insertions
+        // (empty spans) go before replacements of the word that starts at the same byte.
+        const bool ai = a.begin == a.end, bi = b.begin == b.end;
+        if (ai != bi) return ai;
+        return a.order < b.order;
+    });
+    uint32_t pos = 0;
+    for (int i = 0; i < count_; ++i) {
+        const Edit& e = edits_[i];
+        if (e.begin < pos) continue;  // overlapping edit: cannot happen with word spans; ignore defensively
+        out.write(line.substr(pos, e.begin - pos));
+        out.write(std::string_view(arena_.data() + e.textBegin, e.textLen));
+        pos = e.end;
+    }
+    out.write(line.substr(pos));
+}
+
+}  // namespace cnccomp::pp

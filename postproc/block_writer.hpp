@@ -1,0 +1,70 @@
+#pragma once
+// Writing blocks: a fixed-size output buffer over a stream, and the edits of one block (replace a byte span,
+// insert text) applied to the original line so that every byte outside the edits is kept.
+#include <array>
+#include <cstdint>
+#include <ostream>
+#include <string_view>
+#include <vector>
+
+namespace cnccomp::pp {
+
+class OutputBuffer {
+public:
+    explicit OutputBuffer(std::ostream& out, size_t capacity = size_t{1} << 20);
+    ~OutputBuffer();
+    void write(std::string_view s) {
+        if (s.size() > buf_.size() - used_) flushSome(s.size());
+        if (s.size() > buf_.size()) {
+            out_.write(s.data(), static_cast<std::streamsize>(s.size()));
+            written_ += s.size();
+            return;
+        }
+        std::copy(s.begin(), s.end(), buf_.begin() + static_cast<std::ptrdiff_t>(used_));
+        used_ += s.size();
+    }
+    void flush();
+    uint64_t bytesWritten() const { return written_ + used_; }
+
+private:
+    void flushSome(size_t need);
+    std::ostream& out_;
+    std::vector<char> buf_;
+    size_t used_ = 0;
+    uint64_t written_ = 0;
+};
+
+/// Edits of one block: replacements of byte spans of the original line and insertions (begin == end).
+/// Replacement text lives in a fixed arena; no allocation per block.
+class BlockEdits {
+public:
+    static constexpr int kMaxEdits = 96;
+    static constexpr size_t kArena = 16384;
+
+    void clear() {
+        count_ = 0;
+        used_ = 0;
+        overflow_ = false;
+    }
+    /// Replace [begin, end) by `text` (insert when begin == end). Returns false when full (the caller then
+    /// writes the block unchanged and reports it).
+    bool add(uint32_t begin, uint32_t end, std::string_view text);
+    /// A writable tail of the arena for composing text; commit with add(begin, end, view) on the returned span.
+    char* scratch(size_t need);
+    bool empty() const { return count_ == 0; }
+    bool overflow() const { return overflow_; }
+    /// Original line with the edits applied (edits sorted by position; insertions keep their order).
+    void apply(std::string_view line, OutputBuffer& out);
+
+private:
+    struct Edit {
+        uint32_t begin, end, textBegin, textLen, order;
+    };
+    std::array<Edit, kMaxEdits> edits_{};
+    std::array<char, kArena> arena_{};
+    int count_ = 0;
+    size_t used_ = 0;
+    bool overflow_ = false;
+};
+
+}  // namespace cnccomp::pp

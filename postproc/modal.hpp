@@ -1,0 +1,172 @@
+#pragma once
+// Modal state of a controller and the interpretation of one lexed block: which motion it commands, from
+// where to where in machine coordinates (mm, rad), or why it cannot be evaluated. Follows the RS274NGC
+// order of execution (feed mode, feed, tool, plane, units, tool length, work offset, distance modes,
+// non-modal codes, motion) and the dialect differences listed in README (Fanuc increments, Sinumerik
+// keywords, printer G0 = feed move).
+#include <array>
+#include <string_view>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "cnccomp/machine.hpp"
+#include "postproc/lexer.hpp"
+#include "postproc/setup.hpp"
+
+namespace cnccomp::pp {
+
+using AxisMask = uint32_t;
+
+/// Which program letter drives which machine axis, and how.
+struct AxisLayout {
+    int count = 0;
+    std::array<char, kMaxAxes> letter{};
+    std::array<bool, kMaxAxes> rotary{};
+    std::array<bool, kMaxAxes> modulo{};
+    std::array<int8_t, 26> ofLetter{};  ///< machine axis of a letter, -1 if none
+    int zAxis = -1;                     ///< axis that G43 tool length offsets shift
+
+    /// Axes of a machine; each axis name must be one letter. Throws ModelError otherwise.
+    static AxisLayout fromMachine(const MachineModel& m);
+    /// X Y Z (linear) A B C (rotary): for reading a program without a machine.
+    static AxisLayout generic();
+    int axis(char upperLetter) const {
+        return upperLetter >= 'A' && upperLetter <= 'Z' ? ofLetter[upperLetter - 'A'] : -1;
+    }
+    AxisMask all() const { return count >= 32 ? ~0u : ((1u << count) - 1u); }
+};
+
+enum class Motion : uint8_t { Unknown, Rapid, Linear, ArcCw, ArcCcw, Cycle, Other };
+enum class FeedMode : uint8_t { PerMinute, InverseTime, PerRevolution };
+
+struct ArcGeometry {
+    int axis0 = -1, axis1 = -1;  ///< machine axes of the plane: (X,Y) G17, (Z,X) G18, (Y,Z) G19
+    int normal = -1;             ///< machine axis along the plane normal (helix), -1 when the machine has none
+    double c0 = 0, c1 = 0;       ///< centre, machine coordinates (mm)
+    double sweep = 0;            ///< signed swept angle (rad), negative for G2 (clockwise seen from +normal)
+    int turns = 1;               ///< RS274NGC P word
+    bool radiusForm = false;     ///< R word (else I J K)
+};
+
+enum class BlockKind : uint8_t {
+    Empty,        ///< blank, comment-only, % line
+    NoMotion,     ///< evaluated, no axis motion (modal codes, M/S/T words, offsets …)
+    Move,         ///< evaluated G0/G1/G2/G3 move with every machine axis known
+    PassThrough,  ///< cannot be evaluated (or deliberately not corrected): written unchanged
+};
+
+enum class Warning : uint8_t {
+    OffsetNotGiven,      ///< code = offset code: a work offset used that the setup does not give (taken as zero)
+    ToolLengthNotGiven,  ///< code = H number: G43 with a register the setup does not give (default length used)
+    UnitsAssumed,        ///< program sets neither G20 nor G21 before its first move
+    RotaryAssumed,       ///< code = axis: an axis never commanded, taken at its assumed position (rotary: 0)
+    CutterCompensation,  ///< G41/G42: corrections are computed on the programmed contour
+    NoToolLengthAxis,    ///< G43 on a machine without a Z axis
+};
+
+struct BlockResult {
+    BlockKind kind = BlockKind::Empty;
+    Motion motion = Motion::Unknown;  ///< Move: Rapid / Linear / ArcCw / ArcCcw; PassThrough: the modal motion
+    int motionWord = -1;              ///< index of the block's motion G word, -1 when modal
+    bool motionCode = false;          ///< the block holds a motion G word (a motion code, even if not evaluated)
+    AxisVector start, end;            ///< nominal machine positions before / after (mm, rad)
+    AxisMask startKnown = 0;          ///< axes whose start position is known
+    AxisMask endKnown = 0;            ///< axes whose end position is known
+    AxisMask words = 0;               ///< machine axes with a word in this block
+    std::array<int8_t, kMaxAxes> axisWord{};  ///< word index per machine axis, -1 none
+    ArcGeometry arc;
+    FeedMode feedMode = FeedMode::PerMinute;
+    double feed = 0.0;                ///< F in effect (program units)
+    int feedWord = -1;                ///< index of the block's F word
+    double tipLength = 0.0;           ///< mm: active tool length (tool point along the tool direction)
+    bool stop = false;                ///< M0 M1 M2 M30 M60: the block's motion is not split
+    bool rapidIsFeed = false;         ///< printers: G0 is a straight feed move
+    bool absolute = true;
+    bool arcAbsolute = false;
+    bool inch = false;
+    AxisVector scale;                 ///< machine units per program unit, per axis (25.4, kDeg, ½ for diameters …)
+    AxisVector offset;                ///< machine = word · scale + offset (absolute words)
+    AxisMask wrap = 0;                ///< modulo axes read as shortest-path positions in [0, 360)
+    double increment = 0.001;         ///< Fanuc: value of one unit of an integer dimension word (program units)
+    bool integerIncrements = false;   ///< Fanuc: dimension words without a point are in increments
+    // PassThrough:
+    const char* reason = nullptr;     ///< why (static string)
+    int reasonCode = 0;               ///< detail: G code × 10, or 0
+    char reasonLetter = 0;            ///< detail: the axis letter concerned, or 0
+    bool machineCoordinates = false;  ///< G53 / SUPA move: words are machine coordinates
+    bool report = true;               ///< list it in the pass-through report (false: ordinary uncorrected moves)
+    // Warnings raised by this block (once per program and kind/code).
+    std::array<std::pair<Warning, int>, 4> warnings{};
+    int warningCount = 0;
+};
+
+struct InterpreterOptions {
+    Dialect dialect = Dialect::Rs274ngc;
+    Setup setup;
+    bool rotaryShortest = false;  ///< modulo rotary axes: absolute positions in [0, 360) reached the shortest way
+};
+
+class Interpreter {
+public:
+    Interpreter(const AxisLayout& layout, const InterpreterOptions& options);
+
+    /// Interprets one block (`line` is the text the block was lexed from) and advances the modal state and
+    /// the nominal position.
+    void interpret(std::string_view line, const LexedBlock& block, BlockResult& result);
+    /// A line the caller could not lex (overlong): everything becomes unknown.
+    void forgetAll(BlockResult& result, const char* reason);
+
+    const AxisLayout& layout() const { return layout_; }
+    const AxisVector& position() const { return pos_; }
+    AxisMask known() const { return known_; }
+    /// Rotary axes known only because they are taken at 0 until the program commands them.
+    AxisMask assumed() const { return assumed_; }
+    Motion motion() const { return motion_; }
+    /// Value of a word in program units (Fanuc integer increments applied to dimension words).
+    double wordValue(const Word& w) const;
+
+private:
+    void resetPositions();
+    void warn(BlockResult& r, Warning w, int code);
+    void passThrough(BlockResult& r, const char* reason, int code, bool report = true);
+    void unknownAll(BlockResult& r);
+    bool isDimensionLetter(char c) const;
+    const AxisVector* offsetValues(int code) const;
+    AxisMask offsetUnknown(int code) const;
+    void fillConversions(BlockResult& r) const;
+    /// Targets of the block's axis words (absolute or incremental) into r.end / r.endKnown; returns the
+    /// first reason a target is unknown, or nullptr.
+    const char* computeTargets(const LexedBlock& b, BlockResult& r, bool machineCoordinates) const;
+    void commit(const BlockResult& r);
+    bool arcGeometry(const LexedBlock& b, BlockResult& r, const char*& why);
+
+    AxisLayout layout_;
+    InterpreterOptions options_;
+    // Modal state.
+    Motion motion_ = Motion::Unknown;
+    bool cycleActive_ = false;       ///< Fanuc canned cycle (separate modal group from G0/G1)
+    int plane_ = 17;
+    bool absolute_ = true, arcAbsolute_ = false, inch_ = false, unitsSet_ = false;
+    bool diameter_ = false;
+    FeedMode feedMode_ = FeedMode::PerMinute;
+    double feed_ = 0.0;
+    int offsetCode_ = 540;
+    int tool_ = 0;
+    int tloSign_ = 0;                ///< 0 none, +1 G43, -1 G44
+    double tloLength_ = 0.0;         ///< mm
+    bool tloKnown_ = true;
+    bool tcp_ = false, transform_ = false, modalMacro_ = false, cutterComp_ = false;
+    AxisVector local_;               ///< G52 local offset (machine units)
+    AxisMask g92Unknown_ = 0;        ///< axes under a position-dependent G92 / G50 offset
+    std::vector<std::pair<int, AxisVector>> offsets_;  ///< work offsets from the setup and G10 L2
+    std::vector<std::pair<int, AxisMask>> offsetsUnknown_;  ///< set by G10 L20
+    // Position.
+    AxisVector pos_;
+    AxisMask known_ = 0;
+    AxisMask assumed_ = 0;           ///< axes taken at an assumed position (rotary 0, Setup::assumed) until commanded
+    // Warnings already given.
+    std::vector<std::pair<Warning, int>> warned_;
+};
+
+}  // namespace cnccomp::pp

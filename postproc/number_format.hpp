@@ -1,0 +1,25 @@
+#pragma once
+// Writing G-code numbers in a program's own style: fixed decimals or trimmed trailing zeros, with or without
+// the leading zero (".5"), an explicit '+', or Fanuc-style integers in least input increments.
+#include <cstddef>
+
+namespace cnccomp::pp {
+
+struct NumberStyle {
+    int decimals = 4;           ///< digits after the point
+    bool fixed = true;          ///< keep trailing zeros ("1.500"); false trims them ("1.5", "1.")
+    bool bareFraction = false;  ///< ".5" instead of "0.5"
+    bool plus = false;          ///< "+1.5" for positive values
+    bool point = true;          ///< false: an integer without a point (Fanuc increments; decimals ignored)
+};
+
+inline constexpr size_t kMaxNumberChars = 48;
+
+/// Writes `value` into `out` (at least kMaxNumberChars bytes) and returns the length. Never writes "-0".
+/// Values too large for the style (|value| · 10^decimals ≥ 9e18) are written with as many digits as needed.
+size_t formatNumber(double value, const NumberStyle& style, char* out);
+
+/// `value` rounded to the style's resolution (what a controller reads back from formatNumber's text).
+double roundToStyle(double value, const NumberStyle& style);
+
+}  // namespace cnccomp::pp

@@ -1,0 +1,76 @@
+#pragma once
+// `cnccomp correct`: stream a G-code program block by block, correct every evaluable motion endpoint for the
+// machine's deviations (postproc/correction.hpp), subdivide where needed, and write every byte that is not
+// changed exactly as read. Constant memory: a fixed read buffer, a fixed write buffer, capped notice lists.
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cnccomp/deviations.hpp"
+#include "postproc/correction.hpp"
+#include "postproc/dialect.hpp"
+#include "postproc/setup.hpp"
+
+namespace cnccomp::pp {
+
+struct CorrectOptions {
+    std::optional<Dialect> dialect;  ///< nullopt: detected from the head of the program
+    Setup setup;
+    bool rotaryShortest = false;     ///< modulo rotary axes: absolute words in [0, 360) reached the shortest way
+    CorrectorOptions corrector;
+    int decimals = -1;               ///< decimals of changed numbers; -1: the program's own (see README)
+    std::string inputName = "<input>";
+    std::function<void(uint64_t bytesRead)> progress;  ///< called every few thousand lines
+    std::ostream* report = nullptr;  ///< optional CSV "line,kind,message" of every notice (unbounded, streamed)
+    size_t bufferSize = size_t{1} << 20;  ///< read buffer: longest line parsed; longer lines pass through
+};
+
+struct Notice {
+    uint64_t line = 0;
+    std::string message;
+};
+
+struct CorrectSummary {
+    Dialect dialect = Dialect::Rs274ngc;
+    bool dialectDetected = false;   ///< auto-detected (not given)
+    bool dialectCertain = false;
+    std::string dialectReason;
+    uint64_t lines = 0;             ///< lines read
+    uint64_t blocks = 0;            ///< lines with code (not blank / comment-only)
+    uint64_t moves = 0;             ///< evaluated G0–G3 moves
+    uint64_t corrected = 0;         ///< blocks whose text changed
+    uint64_t split = 0;             ///< moves subdivided (or arcs turned into lines)
+    uint64_t addedLines = 0;        ///< lines inserted by subdivision
+    uint64_t arcsToLines = 0;
+    uint64_t passedThrough = 0;     ///< blocks written unchanged because they could not be evaluated
+    uint64_t notCorrected = 0;      ///< of which ordinary moves deliberately left alone (G53, reference returns)
+    double maxLinearCorrection = 0; ///< mm
+    uint64_t maxLinearLine = 0;
+    double maxRotaryCorrection = 0; ///< rad
+    uint64_t maxRotaryLine = 0;
+    double maxTipResidual = 0;      ///< mm: solver residual at endpoints
+    double maxAxisResidual = 0;     ///< rad: tool-axis residual at endpoints (non-zero only near singular poses)
+    double maxPathDeviation = 0;    ///< mm: at the checked midpoints / arc samples
+    uint64_t unconverged = 0;
+    std::vector<Notice> passThrough;  ///< first kMaxNotices
+    std::vector<Notice> warnings;     ///< first kMaxNotices
+    uint64_t warningCount = 0;
+    uint64_t bytesIn = 0, bytesOut = 0;
+    static constexpr size_t kMaxNotices = 100;
+};
+
+/// Corrects the program read from `in` into `out`. Throws InputError (naming options.inputName) for an empty or
+/// binary input; everything else it cannot evaluate is passed through and reported in the summary.
+CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& deviations, std::istream& in,
+                              std::ostream& out, const CorrectOptions& options);
+
+/// The summary as text for the terminal (several lines).
+std::string formatSummary(const CorrectSummary& s, size_t maxListed = 20);
+
+/// Refuses files that are empty or binary (NUL bytes, mostly control bytes) in their first bytes.
+void checkTextHead(std::string_view head, const std::string& name);
+
+}  // namespace cnccomp::pp

@@ -1,0 +1,137 @@
+// cnccomp correct: rewrite a G-code program so that the erroneous machine cuts the nominal path.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "cli/command.hpp"
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "postproc/processor.hpp"
+
+namespace cnccomp::cli {
+namespace {
+
+struct Options {
+    std::string machine, deviations, in, out, dialect = "auto", setup, report;
+    double tolUm = 1.0;
+    int decimals = -1;
+    std::vector<std::string> workOffsets, toolLengths, assume;
+    bool tipOnly = false, rotaryShortest = false;
+    std::string units;
+};
+
+/// Builds the setup from --setup, --work-offset, --tool-length, --units (shared with `poses`).
+pp::Setup setupOf(const std::string& file, const std::vector<std::string>& offsets,
+                  const std::vector<std::string>& lengths, const std::vector<std::string>& assume,
+                  const std::string& units) {
+    pp::Setup s;
+    if (!file.empty()) s.readFile(file);
+    for (const auto& a : assume) s.addAssumed(a);
+    for (const auto& w : offsets) s.addWorkOffset(w);
+    for (const auto& l : lengths) s.addToolLength(l);
+    if (units == "inch") s.inchDefault = true;
+    else if (units == "mm") s.inchDefault = false;
+    else if (!units.empty()) throw InputError("--units", 0, fmt::format("expected mm or inch, got '{}'", units));
+    return s;
+}
+
+std::optional<pp::Dialect> dialectOf(const std::string& name) {
+    if (name == "auto") return std::nullopt;
+    const auto d = pp::parseDialect(name);
+    if (!d) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, rs274ngc, fanuc, sinumerik, printer)", name));
+    return d;
+}
+
+void run(const Options& o) {
+    const MachineModel m = readMachineXml(o.machine);
+    const DeviationSet d = readDeviationCsv(o.deviations, m);
+    refuseToOverwrite(o.out, {o.in, o.machine, o.deviations, o.setup});
+    if (!o.report.empty()) refuseToOverwrite(o.report, {o.in, o.machine, o.deviations, o.setup, o.out});
+    if (std::filesystem::absolute(o.out).lexically_normal() == std::filesystem::absolute(o.in).lexically_normal())
+        throw InputError(o.out, 0, "refusing to overwrite the input program");
+    if (!(o.tolUm > 0) || !std::isfinite(o.tolUm) || o.tolUm > 1e4)
+        throw InputError("--tol-um", 0, "the tolerance must be a positive number of um");
+    if (o.decimals < -1 || o.decimals > 12) throw InputError("--decimals", 0, "decimals must be 0..12");
+    pp::CorrectOptions co;
+    co.dialect = dialectOf(o.dialect);
+    co.setup = setupOf(o.setup, o.workOffsets, o.toolLengths, o.assume, o.units);
+    co.rotaryShortest = o.rotaryShortest;
+    co.corrector.toleranceMm = o.tolUm * kUm;
+    co.corrector.tipOnly = o.tipOnly;
+    co.decimals = o.decimals;
+    co.inputName = o.in;
+    std::ifstream in(o.in, std::ios::binary);
+    if (!in) throw InputError(o.in, 0, "cannot open the program");
+    std::error_code ec;
+    const auto total = std::filesystem::file_size(o.in, ec);
+    const bool bar = ::isatty(STDERR_FILENO) && !ec && total > 0;
+    if (bar)
+        co.progress = [total](uint64_t done) {
+            const int width = 40, filled = static_cast<int>(width * std::min<double>(1.0, double(done) / double(total)));
+            std::fprintf(stderr, "\r[%.*s%.*s] %3d%%", filled, "########################################",
+                         width - filled, "                                        ",
+                         static_cast<int>(100.0 * std::min<double>(1.0, double(done) / double(total))));
+            std::fflush(stderr);
+        };
+    // The report streams to a temporary file, renamed only when the correction succeeded.
+    std::ofstream report;
+    std::string reportTmp;
+    if (!o.report.empty()) {
+        reportTmp = o.report + ".tmp" + std::to_string(::getpid());
+        report.open(reportTmp, std::ios::binary | std::ios::trunc);
+        if (!report) throw InputError(o.report, 0, "cannot create the report file");
+        report << "line,kind,message\n";
+        co.report = &report;
+    }
+    pp::CorrectSummary summary;
+    try {
+        writeFileAtomically(o.out, [&](std::ostream& out) { summary = pp::correctProgram(m, d, in, out, co); });
+        if (!o.report.empty()) {
+            report.close();
+            std::filesystem::rename(reportTmp, o.report);
+        }
+    } catch (...) {
+        if (bar) std::fprintf(stderr, "\n");
+        if (!reportTmp.empty()) std::filesystem::remove(reportTmp, ec);
+        throw;
+    }
+    if (bar) std::fprintf(stderr, "\r%60s\r", "");
+    fmt::print("corrected {} for '{}' ({} deviations{}) -> {}\n", o.in, m.name,
+               std::count(d.present.begin(), d.present.end(), 1), d.values.cwiseAbs().maxCoeff() == 0 ? ", all zero" : "",
+               o.out);
+    fmt::print("{}", pp::formatSummary(summary));
+}
+
+const RegisterCommand reg([](CLI::App& app) {
+    auto o = std::make_shared<Options>();
+    auto* c = app.add_subcommand("correct", "Rewrite a G-code program so that the erroneous machine cuts the nominal path");
+    c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
+    c->add_option("--deviations", o->deviations, "deviation set CSV (identified or known)")->required()->check(CLI::ExistingFile);
+    c->add_option("--in", o->in, "G-code program to correct")->required()->check(CLI::ExistingFile);
+    c->add_option("--out", o->out, "corrected program to write (never the input)")->required();
+    c->add_option("--dialect", o->dialect, "auto, rs274ngc (linuxcnc), fanuc, sinumerik, printer")->capture_default_str();
+    c->add_option("--tol-um", o->tolUm, "largest tool-tip deviation from the nominal path before a move is split, um")
+        ->capture_default_str();
+    c->add_option("--decimals", o->decimals, "decimals of changed numbers (default: the program's own, at least 4 in mm and deg, 5 in inch)");
+    c->add_option("--work-offset", o->workOffsets, "work offset CODE=x,y,z[,a,b,c] in mm and deg, e.g. G54=100,0,-300 (repeatable)");
+    c->add_option("--tool-length", o->toolLengths, "tool length in mm: L (default tool point) or Hn=L for G43 Hn (repeatable)");
+    c->add_option("--setup", o->setup, "setup file: lines 'work-offset G54=…', 'tool-length H3=…', 'units mm|inch'")
+        ->check(CLI::ExistingFile);
+    c->add_option("--assume", o->assume, "positions of axes until the program commands them, e.g. Y=0 (mm, deg; rotary default 0)");
+    c->add_option("--units", o->units, "units when the program sets neither G20 nor G21: mm (default) or inch");
+    c->add_option("--report", o->report, "write every pass-through and warning as CSV line,kind,message");
+    c->add_flag("--tip-only", o->tipOnly, "correct the tool tip with the linear axes only; rotary commands stay");
+    c->add_flag("--rotary-shortest", o->rotaryShortest,
+                "modulo rotary axes: absolute positions in [0,360) reached the shortest way (rollover)");
+    c->callback([o] { run(*o); });
+});
+
+}  // namespace
+}  // namespace cnccomp::cli

@@ -1,0 +1,63 @@
+// cnccomp emit: controller compensation files from a deviation set, through one of the registered backends.
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <ostream>
+
+#include <fmt/format.h>
+
+#include "cli/command.hpp"
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "controllers/backend.hpp"
+#include "controllers/common/header.hpp"
+
+namespace cnccomp::cli {
+namespace {
+
+struct Options {
+    std::string controller, machine, deviations, out, date;
+};
+
+std::string today() {
+    const std::time_t t = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    return fmt::format("{:04}-{:02}-{:02}", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday);
+}
+
+void run(const Options& o) {
+    const controllers::Backend& b = controllers::backend(o.controller);
+    const MachineModel m = readMachineXml(o.machine);
+    const DeviationSet d = readDeviationCsv(o.deviations, m);
+    const std::string date = o.date.empty() ? today() : o.date;
+    const controllers::EmitRequest req{m, d, std::filesystem::path(o.deviations).filename().string(), date};
+    const controllers::EmitResult r = b.emit(req);
+    namespace fs = std::filesystem;
+    fs::create_directories(o.out);
+    for (const controllers::OutputFile& f : r.files) refuseToOverwrite((fs::path(o.out) / f.name).string(), {o.machine, o.deviations});
+    for (const controllers::OutputFile& f : r.files)
+        writeFileAtomically((fs::path(o.out) / f.name).string(), [&](std::ostream& s) { s << f.content; });
+    fmt::print("{} compensation for '{}' from {} ({} files in {})\n", b.name(), m.name, o.deviations, r.files.size(), o.out);
+    for (const controllers::OutputFile& f : r.files) fmt::print("  {}\n", f.name);
+    fmt::print("{}", controllers::formatCoverage(r));
+}
+
+const RegisterCommand reg([](CLI::App& app) {
+    auto o = std::make_shared<Options>();
+    std::string known;
+    for (const controllers::Backend* b : controllers::backends()) known += fmt::format("\n  {:<16} {}", b->name(), b->description());
+    auto* c = app.add_subcommand("emit", "Write compensation files for a controller; lists what is and is NOT compensated."
+                                         "\nControllers:" + known);
+    c->add_option("--controller", o->controller, "controller backend (see the list above)")->required();
+    c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
+    c->add_option("--deviations", o->deviations, "deviation set CSV")->required()->check(CLI::ExistingFile);
+    c->add_option("--out", o->out, "output folder (created if missing)")->required();
+    c->add_option("--date", o->date, "date for the header comments (default: today, UTC)");
+    c->callback([o] { run(*o); });
+});
+
+}  // namespace
+}  // namespace cnccomp::cli

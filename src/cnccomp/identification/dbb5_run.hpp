@@ -1,0 +1,50 @@
+#pragma once
+// DBB5 runs (seed 003): a double ball bar whose balls are held from 45° to the spindle axis, so that circles in
+// the XY, YZ and ZX planes and rotary-axis circles can all be measured from one setup.
+//  - linear circle: the rotary axes hold still, the linear axes move the spindle ball on a circle of radius LB
+//    around the table ball (ISO 230-4 circular test) in the plane XY, YZ or ZX (angle 0 along the first letter,
+//    90° towards the second);
+//  - rotary circle: one rotary axis turns (full turn or arc), the table ball turns with it, and the linear axes
+//    keep the spindle ball at LB along a fixed bed-frame direction from the table ball (seed 003 "C-X (−Z)" etc.).
+// The table ball is set where the spindle ball stands at the setup pose (sweep angle `setupDeg`, spindle ball on
+// the table ball), as for the seed-000 ball bar; ΔL = L − LB.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cnccomp/ballbar.hpp"
+
+namespace cnccomp {
+
+struct Dbb5Run {
+    enum class Kind { LinearCircle, RotaryCircle };
+    std::string name;
+    Kind kind = Kind::LinearCircle;
+    double LB = 100.0;                 ///< bar length, mm
+    double toolLength = 100.0;         ///< spindle ball: distance along the tool direction from the last tool frame, mm
+    Vec3 ball = Vec3::Zero();          ///< nominal table-ball centre in the workpiece frame, mm
+    double startDeg = 0.0, endDeg = 360.0, stepDeg = 5.0;
+    double setupDeg = 0.0;             ///< sweep angle of the setup pose (rotary circles)
+    std::vector<std::pair<std::string, double>> hold;  ///< rotary axes held at a position (deg); others stay at 0
+    std::string plane = "XY";          ///< linear circle: XY, YZ or ZX
+    std::string axis = "C";            ///< rotary circle: the turning axis
+    Vec3 barDirection = -Vec3::UnitX();  ///< rotary circle: table ball → spindle ball, bed frame (unit)
+
+    /// Throws ModelError for impossible geometry (non-positive LB, zero step, unknown plane, zero direction …).
+    void validate() const;
+    /// Sweep angles in degrees; a whole turn does not repeat its first angle (as BallbarRun::anglesDeg()).
+    std::vector<double> anglesDeg() const;
+    /// Unit vectors (first, second) of a linear circle's plane.
+    std::pair<Vec3, Vec3> planeAxes() const;
+};
+
+/// Axis commands at sweep angle `angleDeg` (nominal machine): spindle ball on its target.
+AxisVector dbb5Commands(const MachineModel& m, const Dbb5Run& run, double angleDeg);
+/// Setup commands: spindle ball on the nominal table ball (at the sweep angle setupDeg for rotary circles).
+AxisVector dbb5SetupCommands(const MachineModel& m, const Dbb5Run& run);
+
+/// Simulates ΔL along the sweep on machine `k` (angle_deg, ΔL as for a ball-bar trace). Throws ModelError naming
+/// the run when a command leaves an axis' travel.
+BallbarTrace simulateDbb5(const Kinematics& k, const Dbb5Run& run);
+
+}  // namespace cnccomp

@@ -1,0 +1,45 @@
+#pragma once
+// General least-squares identification (issue 3): any subset of a machine's deviations (location errors,
+// squareness, spindle offsets, component-error coefficients) from any observations (ball-bar ΔL samples,
+// R-test displacements, …) on the exact kinematic model, with the runs' nuisance parameters.
+// Levenberg–Marquardt by default, NLopt as an alternative for bounded problems; the result carries a report
+// with identifiability (named confounded combinations), covariance, 95 % intervals and optional Monte Carlo.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cnccomp/identification/observation.hpp"
+#include "cnccomp/identification/report.hpp"
+
+namespace cnccomp {
+
+/// Bounds of one unknown for bounded solvers, internal units.
+struct ParameterBound {
+    std::string name;  ///< ISO name, alias, "NAME[k]" or nuisance name
+    double lower = -kNaN, upper = kNaN;
+};
+
+struct IdentifyOptions {
+    std::vector<int> deviations;        ///< indices into machine.deviations; empty = every deviation
+    std::string solver = "lm";          ///< "lm" (Levenberg–Marquardt) or "nlopt:<ALGORITHM>" (e.g. nlopt:LD_LBFGS)
+    int maxIterations = 50;             ///< LM iterations (NLopt: ×200 evaluations)
+    double rankTolerance = 1e-7;        ///< relative singular value below which a direction is unobservable
+    std::vector<ParameterBound> bounds; ///< NLopt only
+    double defaultBoundDisplay = 1000;  ///< NLopt: ± this many µm / arcsec for unknowns without a bound
+    int monteCarlo = 0;                 ///< number of resampled solutions (0 = none)
+    std::uint64_t seed = 1;             ///< Monte Carlo random seed
+    std::optional<DeviationSet> start;  ///< starting values; deviations not estimated keep these values
+};
+
+struct IdentificationResult {
+    DeviationSet deviations;       ///< identified values; `present` marks the identified estimated deviations
+    Eigen::VectorXd nuisance;      ///< nuisance parameters, internal units, in report order
+    IdentificationReport report;
+};
+
+/// Throws ModelError for an empty observation list, an unknown solver or bound name, or bad options.
+IdentificationResult identify(const MachineModel& machine, const Observations& observations,
+                              const IdentifyOptions& options = {});
+
+}  // namespace cnccomp

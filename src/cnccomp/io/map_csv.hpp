@@ -1,0 +1,33 @@
+#pragma once
+// Volumetric map CSV: '#' header lines (machine, deviation set, grid, tool, statistics), then one row per grid
+// point: every machine axis command (mm / deg), the nominal tip in the workpiece frame (mm), the tip error
+// (um), the tool-orientation error as a rotation vector and tilt angle (arcsec), and ok (1/0).
+#include <string>
+#include <vector>
+
+#include "cnccomp/volumetric_map.hpp"
+
+namespace cnccomp {
+
+struct MapCsvInfo {
+    std::string machine;         ///< machine name
+    std::string deviationSource; ///< deviation file
+};
+
+/// Text of the map file.
+std::string formatMapCsv(const VolumetricMap& map, const MachineModel& machine, const MapCsvInfo& info);
+/// Writes the map atomically.
+void writeMapCsv(const std::string& path, const VolumetricMap& map, const MachineModel& machine, const MapCsvInfo& info);
+
+/// A map file read back: the axis names of its columns and its points (internal units: mm, rad).
+struct MapCsvTable {
+    std::vector<std::string> axisNames;
+    std::vector<MapPoint> points;
+};
+/// Reads a map CSV; throws InputError with file:line on missing columns or bad numbers.
+MapCsvTable readMapCsv(const std::string& path);
+
+/// Statistics lines shared by the CSV header and the `cnccomp map` output (no comment prefix).
+std::vector<std::string> formatMapStatistics(const VolumetricMap& map, const MachineModel& machine);
+
+}  // namespace cnccomp

@@ -1,0 +1,371 @@
+#include "cnccomp/io/report_json.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/geometry.hpp"
+#include "cnccomp/io/text_util.hpp"
+
+namespace cnccomp {
+
+namespace {
+
+std::string quote(const std::string& s) {
+    std::string o = "\"";
+    for (unsigned char c : s) {
+        switch (c) {
+            case '"': o += "\\\""; break;
+            case '\\': o += "\\\\"; break;
+            case '\n': o += "\\n"; break;
+            case '\t': o += "\\t"; break;
+            case '\r': o += "\\r"; break;
+            default:
+                if (c < 0x20) o += fmt::format("\\u{:04x}", c);
+                else o += static_cast<char>(c);
+        }
+    }
+    return o + "\"";
+}
+
+std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : "null"; }
+
+class Writer {
+public:
+    std::ostringstream o;
+    int depth = 0;
+    bool first = true;
+
+    void newline() { o << '\n' << std::string(2 * depth, ' '); }
+    void key(const std::string& k) {
+        if (!first) o << ',';
+        first = false;
+        newline();
+        o << quote(k) << ": ";
+    }
+    void open(char c) {
+        o << c;
+        ++depth;
+        first = true;
+    }
+    void close(char c) {
+        --depth;
+        if (!first) newline();
+        o << c;
+        first = false;
+    }
+    void element() {
+        if (!first) o << ',';
+        first = false;
+        newline();
+    }
+    template <class T>
+    void field(const std::string& k, const T& v) {
+        key(k);
+        value(v);
+    }
+    void value(const std::string& s) { o << quote(s); }
+    void value(const char* s) { o << quote(s); }
+    void value(double v) { o << num(v); }
+    void value(int v) { o << v; }
+    void value(bool v) { o << (v ? "true" : "false"); }
+    void numbers(const std::string& k, const std::vector<double>& v) {
+        key(k);
+        o << '[';
+        for (size_t i = 0; i < v.size(); ++i) o << (i ? ", " : "") << num(v[i]);
+        o << ']';
+    }
+    void strings(const std::string& k, const std::vector<std::string>& v) {
+        key(k);
+        o << '[';
+        for (size_t i = 0; i < v.size(); ++i) o << (i ? ", " : "") << quote(v[i]);
+        o << ']';
+    }
+};
+
+void combinations(Writer& w, const std::string& k, const std::vector<Combination>& list, bool values) {
+    w.key(k);
+    w.open('[');
+    for (const Combination& c : list) {
+        w.element();
+        w.open('{');
+        w.field("text", c.text);
+        w.strings("names", c.names);
+        w.numbers("coefficients", c.coefficients);
+        if (values) {
+            const double s = c.angle ? kArcsec : kUm;
+            w.field("unit", c.angle ? "arcsec" : "um");
+            w.field("value", c.value / s);
+            w.field("stddev", c.stddev / s);
+        }
+        w.close('}');
+    }
+    w.close(']');
+}
+
+}  // namespace
+
+std::string formatReportJson(const IdentificationReport& r) {
+    Writer w;
+    w.open('{');
+    w.field("schema", "cnccomp-identification-report/1");
+    w.field("machine", r.machine);
+    w.field("method", r.method);
+    w.field("solver", r.solver);
+    w.field("termination", r.termination);
+    w.field("converged", r.converged);
+    w.field("iterations", r.iterations);
+    w.field("evaluations", r.evaluations);
+    w.field("cost_before_um2", r.costBefore);
+    w.field("cost_after_um2", r.costAfter);
+    w.field("observations", r.observations);
+    w.field("unknowns", r.unknowns);
+    w.field("rank", r.rank);
+    w.field("dof", r.dof);
+    w.field("rank_tolerance", r.rankTolerance);
+    w.field("sigma_um", r.sigma / kUm);
+    w.field("condition_number", r.conditionNumber);
+    w.numbers("singular_values", r.singularValues);
+    w.key("runs");
+    w.open('[');
+    for (const RunResidual& rr : r.runs) {
+        w.element();
+        w.open('{');
+        w.field("run", rr.run);
+        w.field("kind", rr.kind);
+        w.field("samples", rr.samples);
+        w.field("rms_before_um", rr.rmsBefore / kUm);
+        w.field("rms_after_um", rr.rmsAfter / kUm);
+        w.field("max_after_um", rr.maxAfter / kUm);
+        w.close('}');
+    }
+    w.close(']');
+    w.key("parameters");
+    w.open('[');
+    for (const ParameterEstimate& p : r.parameters) {
+        const double s = p.displayScale();
+        w.element();
+        w.open('{');
+        w.field("name", p.name);
+        w.field("alias", p.alias);
+        w.field("nuisance", p.nuisance);
+        w.field("unit", p.unit());
+        w.field("identified", p.identified);
+        w.field("start", p.start / s);
+        w.field("value", p.identified ? p.value / s : kNaN);
+        w.field("stddev", p.stddev / s);
+        w.field("lower95", p.lower95 / s);
+        w.field("upper95", p.upper95 / s);
+        if (r.monteCarloSamples > 0) {
+            w.field("mc_stddev", p.mcStddev / s);
+            w.field("mc_lower95", p.mcLower95 / s);
+            w.field("mc_upper95", p.mcUpper95 / s);
+        }
+        w.close('}');
+    }
+    w.close(']');
+    w.strings("unidentified", r.unidentified);
+    combinations(w, "identifiable_combinations", r.identifiable, true);
+    combinations(w, "unobservable_directions", r.unobservable, false);
+    w.field("monte_carlo_samples", r.monteCarloSamples);
+    w.key("covariance");
+    w.open('[');
+    for (Eigen::Index i = 0; i < r.covariance.rows(); ++i) {
+        w.element();
+        std::vector<double> row(r.covariance.cols());
+        for (Eigen::Index j = 0; j < r.covariance.cols(); ++j) row[j] = r.covariance(i, j);
+        w.o << '[';
+        for (size_t j = 0; j < row.size(); ++j) w.o << (j ? ", " : "") << num(row[j]);
+        w.o << ']';
+    }
+    w.close(']');
+    w.strings("warnings", r.warnings);
+    w.close('}');
+    w.o << '\n';
+    return w.o.str();
+}
+
+void writeReportJson(const std::string& path, const IdentificationReport& report) {
+    const std::string text = formatReportJson(report);
+    writeFileAtomically(path, [&](std::ostream& o) { o << text; });
+}
+
+// ----------------------------------------------------------------------------------------------- reader
+
+const JsonValue& JsonValue::operator[](const std::string& key) const {
+    if (type != Type::Object) throw ModelError(fmt::format("JSON: '{}' looked up in a value that is not an object", key));
+    for (const auto& [k, v] : object)
+        if (k == key) return v;
+    throw ModelError(fmt::format("JSON: no member '{}'", key));
+}
+
+const JsonValue& JsonValue::operator[](size_t i) const {
+    if (type != Type::Array || i >= array.size()) throw ModelError(fmt::format("JSON: no array element {}", i));
+    return array[i];
+}
+
+bool JsonValue::has(const std::string& key) const {
+    if (type != Type::Object) return false;
+    for (const auto& kv : object)
+        if (kv.first == key) return true;
+    return false;
+}
+
+double JsonValue::num() const {
+    if (type == Type::Null) return kNaN;
+    if (type != Type::Number) throw ModelError("JSON: expected a number");
+    return number;
+}
+
+namespace {
+
+class Parser {
+public:
+    Parser(const std::string& t, const std::string& src) : s(t), source(src) {}
+
+    JsonValue document() {
+        JsonValue v = value(0);
+        skip();
+        if (i != s.size()) fail("end of input after the top-level value");
+        return v;
+    }
+
+private:
+    const std::string& s;
+    std::string source;
+    size_t i = 0;
+
+    int line() const { return 1 + static_cast<int>(std::count(s.begin(), s.begin() + std::min(i, s.size()), '\n')); }
+    [[noreturn]] void fail(const std::string& expected) const {
+        throw InputError(source, line(), fmt::format("malformed JSON: expected {}", expected));
+    }
+    void skip() {
+        while (i < s.size() && (s[i] == ' ' || s[i] == '\n' || s[i] == '\t' || s[i] == '\r')) ++i;
+    }
+    bool literal(const char* w) {
+        const size_t n = std::char_traits<char>::length(w);
+        if (s.compare(i, n, w) == 0) {
+            i += n;
+            return true;
+        }
+        return false;
+    }
+    JsonValue value(int depth) {
+        if (depth > 200) fail("less deeply nested values");
+        skip();
+        if (i >= s.size()) fail("a value");
+        JsonValue v;
+        const char c = s[i];
+        if (c == '{') {
+            v.type = JsonValue::Type::Object;
+            ++i;
+            skip();
+            if (i < s.size() && s[i] == '}') { ++i; return v; }
+            while (true) {
+                skip();
+                if (i >= s.size() || s[i] != '"') fail("a quoted member name");
+                std::string k = string();
+                skip();
+                if (i >= s.size() || s[i] != ':') fail("':' after a member name");
+                ++i;
+                v.object.emplace_back(std::move(k), value(depth + 1));
+                skip();
+                if (i < s.size() && s[i] == ',') { ++i; continue; }
+                if (i < s.size() && s[i] == '}') { ++i; return v; }
+                fail("',' or '}' in an object");
+            }
+        }
+        if (c == '[') {
+            v.type = JsonValue::Type::Array;
+            ++i;
+            skip();
+            if (i < s.size() && s[i] == ']') { ++i; return v; }
+            while (true) {
+                v.array.push_back(value(depth + 1));
+                skip();
+                if (i < s.size() && s[i] == ',') { ++i; continue; }
+                if (i < s.size() && s[i] == ']') { ++i; return v; }
+                fail("',' or ']' in an array");
+            }
+        }
+        if (c == '"') {
+            v.type = JsonValue::Type::String;
+            v.string = string();
+            return v;
+        }
+        if (literal("true")) { v.type = JsonValue::Type::Bool; v.boolean = true; return v; }
+        if (literal("false")) { v.type = JsonValue::Type::Bool; return v; }
+        if (literal("null")) return v;
+        const size_t start = i;
+        while (i < s.size() && (std::isdigit(static_cast<unsigned char>(s[i])) || s[i] == '-' || s[i] == '+' ||
+                                s[i] == '.' || s[i] == 'e' || s[i] == 'E'))
+            ++i;
+        const auto n = parseNumber(std::string_view(s).substr(start, i - start));
+        if (start == i || !n) fail("a value (object, array, string, number, true, false or null)");
+        v.type = JsonValue::Type::Number;
+        v.number = *n;
+        return v;
+    }
+    std::string string() {
+        ++i;  // opening quote
+        std::string o;
+        while (true) {
+            if (i >= s.size()) fail("a closing '\"'");
+            const char c = s[i++];
+            if (c == '"') return o;
+            if (c != '\\') { o += c; continue; }
+            if (i >= s.size()) fail("an escape character");
+            const char e = s[i++];
+            switch (e) {
+                case '"': o += '"'; break;
+                case '\\': o += '\\'; break;
+                case '/': o += '/'; break;
+                case 'n': o += '\n'; break;
+                case 't': o += '\t'; break;
+                case 'r': o += '\r'; break;
+                case 'b': o += '\b'; break;
+                case 'f': o += '\f'; break;
+                case 'u': {
+                    if (i + 4 > s.size()) fail("four hex digits after \\u");
+                    unsigned cp = 0;
+                    for (int k = 0; k < 4; ++k) {
+                        const char h = s[i++];
+                        cp <<= 4;
+                        if (h >= '0' && h <= '9') cp |= h - '0';
+                        else if (h >= 'a' && h <= 'f') cp |= h - 'a' + 10;
+                        else if (h >= 'A' && h <= 'F') cp |= h - 'A' + 10;
+                        else fail("four hex digits after \\u");
+                    }
+                    if (cp < 0x80) o += static_cast<char>(cp);
+                    else if (cp < 0x800) { o += static_cast<char>(0xC0 | (cp >> 6)); o += static_cast<char>(0x80 | (cp & 0x3F)); }
+                    else {
+                        o += static_cast<char>(0xE0 | (cp >> 12));
+                        o += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+                        o += static_cast<char>(0x80 | (cp & 0x3F));
+                    }
+                    break;
+                }
+                default: fail("a valid escape (\\\" \\\\ \\/ \\n \\t \\r \\b \\f \\uXXXX)");
+            }
+        }
+    }
+};
+
+}  // namespace
+
+JsonValue parseJson(const std::string& text, const std::string& source) { return Parser(text, source).document(); }
+
+JsonValue readJsonFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return parseJson(ss.str(), path);
+}
+
+}  // namespace cnccomp

@@ -1,0 +1,21 @@
+#pragma once
+// R-test traces: CSV `pose,<axis>_mm|<axis>_deg …,dx_um,dy_um,dz_um`, one file per run: the axis commands of every
+// pose (linear axes in mm, rotary axes in degrees, machine axis order) and the displacement of the ball centre from
+// the nest centre in the tool (sensor) frame, µm.
+#include <string>
+#include <vector>
+
+#include "cnccomp/identification/rtest_run.hpp"
+
+namespace cnccomp {
+
+/// Throws InputError (file:line) for a missing column or file, a non-finite value, or fewer than three poses.
+RtestTrace readRtestCsv(const std::string& path, const MachineModel& machine);
+void writeRtestCsv(const std::string& path, const MachineModel& machine, const RtestTrace& trace);
+
+/// Reads DIR/<run>.csv for every run and checks each file against the plan: the same number of poses and the
+/// same commands (to 1e-5 mm / deg; the plan's exact commands are kept). Errors name the file and line.
+std::vector<RtestTrace> readRtestTraces(const std::string& dir, const MachineModel& machine,
+                                        const std::vector<RtestRun>& runs);
+
+}  // namespace cnccomp

@@ -1,0 +1,250 @@
+#include "cnccomp/volumetric_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
+
+namespace cnccomp {
+namespace {
+
+constexpr int kMaxGridAxes = 16;
+
+/// Everything a worker needs, prepared once (the per-point kernel only reads it).
+struct Plan {
+    const MapRequest* request = nullptr;
+    Kinematics nominal, actual;
+    Vec3 tipInTool = Vec3::Zero();
+    AxisVector base;
+    std::array<int, kMaxGridAxes> target{};  ///< axes mode: machine axis index; orientation mode: 0..2 = x y z
+    std::array<double, kMaxGridAxes> scale{};
+    AxisVector start;  ///< orientation mode: IK start (solved once at the grid centre)
+
+    Plan(const MapRequest& r) : request(&r), nominal(r.machine), actual(r.machine, r.deviations) {}
+};
+
+void prepare(Plan& p) {
+    const MapRequest& r = *p.request;
+    const MachineModel& m = r.machine;
+    if (!std::isfinite(r.toolLength)) throw ModelError("tool length must be a finite number");
+    if (static_cast<int>(r.grid.axes.size()) > kMaxGridAxes) throw InputError("--grid", 0, "too many grid axes");
+    p.tipInTool = p.nominal.toolPoint(r.toolLength);
+    p.base = AxisVector::Zero(m.axisCount());
+    if (!r.toolOrientation) {
+        for (size_t i = 0; i < r.grid.axes.size(); ++i) {
+            const GridAxis& g = r.grid.axes[i];
+            const int a = m.axisIndex(g.name);
+            if (a < 0)
+                throw InputError("--grid", 0,
+                                 fmt::format("machine '{}' has no axis '{}' (axes: {})", m.name, g.name,
+                                             fmt::join(m.axisNames, " ")));
+            const Link& l = m.axisLink(a);
+            p.target[i] = a;
+            p.scale[i] = l.kind == AxisKind::Rotary ? kDeg : 1.0;
+            for (double v : {g.from, g.to})
+                if (v * p.scale[i] < l.min - 1e-9 || v * p.scale[i] > l.max + 1e-9)
+                    throw ModelError(fmt::format("grid axis {} value {:g} is outside its travel [{:g}, {:g}] {}", g.name, v,
+                                                 l.min / p.scale[i], l.max / p.scale[i],
+                                                 l.kind == AxisKind::Rotary ? "deg" : "mm"));
+        }
+        for (int a = 0; a < m.axisCount(); ++a) {
+            if (r.grid.find(m.axisNames[a]) >= 0) continue;
+            const Link& l = m.axisLink(a);
+            if (0.0 < l.min || 0.0 > l.max)
+                throw ModelError(fmt::format("axis {} is held at 0, outside its travel; give {}=value in the grid",
+                                             l.name, l.name));
+        }
+        return;
+    }
+    // Orientation mode: grid names the tool-tip coordinates.
+    const Vec3 k = *r.toolOrientation;
+    if (!k.allFinite() || k.norm() < 1e-12) throw InputError("--orientation", 0, "tool orientation must be a non-zero vector");
+    for (size_t i = 0; i < r.grid.axes.size(); ++i) {
+        const std::string& n = r.grid.axes[i].name;
+        if (n != "X" && n != "Y" && n != "Z")
+            throw InputError("--grid", 0,
+                             fmt::format("with a fixed tool orientation the grid names the tip coordinates X, Y, Z, not '{}'", n));
+        p.target[i] = n[0] - 'X';
+        p.scale[i] = 1.0;
+    }
+    // A start for Newton: the nominal IK at the grid's centre from a few rotary starts; keep the converged solution
+    // with the smallest rotary angles (the one a post-processor would normally pick).
+    ToolPose centre;
+    centre.axis = k.normalized();
+    for (size_t i = 0; i < r.grid.axes.size(); ++i) {
+        const GridAxis& g = r.grid.axes[i];
+        centre.tip[p.target[i]] = 0.5 * (g.from + g.to);
+    }
+    std::vector<int> rotary;
+    for (int a = 0; a < m.axisCount(); ++a)
+        if (m.axisLink(a).kind == AxisKind::Rotary) rotary.push_back(a);
+    const int starts = 8;
+    long combos = 1;
+    for (size_t i = 0; i < rotary.size(); ++i) combos *= starts;
+    double best = HUGE_VAL;
+    for (long c = 0; c < combos; ++c) {
+        AxisVector q0 = AxisVector::Zero(m.axisCount());
+        long cc = c;
+        for (int a : rotary) {
+            q0[a] = (cc % starts) * (2 * kPi / starts) - (cc % starts >= starts / 2 ? 2 * kPi : 0.0);
+            cc /= starts;
+        }
+        const IkResult s = solveToolPose(p.nominal, centre, p.tipInTool, q0);
+        if (!s.converged) continue;
+        bool inside = true;
+        for (int a = 0; a < m.axisCount(); ++a) {
+            const Link& l = m.axisLink(a);
+            if (s.q[a] < l.min - 1e-9 || s.q[a] > l.max + 1e-9) inside = false;
+        }
+        if (!inside) continue;
+        double size = 0;
+        for (int a : rotary) size += std::abs(s.q[a]);
+        if (size < best - 1e-9) {
+            best = size;
+            p.start = s.q;
+        }
+    }
+    if (!std::isfinite(best))
+        throw ModelError(fmt::format("machine '{}' cannot reach tool orientation ({:g}, {:g}, {:g}) at the grid centre",
+                                     m.name, centre.axis.x(), centre.axis.y(), centre.axis.z()));
+}
+
+/// The per-point kernel: no allocation.
+void evaluate(const Plan& p, long index, MapPoint& out) {
+    const MapRequest& r = *p.request;
+    std::array<long, kMaxGridAxes> idx;
+    r.grid.unflatten(index, idx.data());
+    AxisVector q = p.base;
+    out.ok = true;
+    if (!r.toolOrientation) {
+        for (size_t i = 0; i < r.grid.axes.size(); ++i) q[p.target[i]] = r.grid.axes[i].value(idx[i]) * p.scale[i];
+    } else {
+        ToolPose t;
+        t.axis = r.toolOrientation->normalized();
+        for (size_t i = 0; i < r.grid.axes.size(); ++i) t.tip[p.target[i]] = r.grid.axes[i].value(idx[i]);
+        const IkResult s = solveToolPose(p.nominal, t, p.tipInTool, p.start);
+        q = s.q;
+        if (!s.converged) out.ok = false;
+        for (int a = 0; a < q.size() && out.ok; ++a) {
+            const Link& l = r.machine.axisLink(a);
+            if (q[a] < l.min - 1e-9 || q[a] > l.max + 1e-9) out.ok = false;
+        }
+    }
+    out.q.fill(0.0);
+    for (int a = 0; a < q.size(); ++a) out.q[a] = q[a];
+    const ToolPose n = toolPose(p.nominal, q, p.tipInTool);
+    const ToolPose a = toolPose(p.actual, q, p.tipInTool);
+    out.tip = n.tip;
+    out.error = a.tip - n.tip;
+    const Vec3 cr = n.axis.cross(a.axis);
+    const double s = cr.norm();
+    out.tilt = std::atan2(s, n.axis.dot(a.axis));
+    out.rotation = s > 0 ? Vec3(cr * (out.tilt / s)) : Vec3::Zero();
+}
+
+/// Running statistics of one worker.
+struct Accumulator {
+    long points = 0, failed = 0;
+    std::array<double, 5> sumSq{}, maxAbs{};
+    long worstIndex = -1, worstTiltIndex = -1;
+    MapPoint worst, worstTilt;
+
+    void add(long index, const MapPoint& pt) {
+        if (!pt.ok) {
+            ++failed;
+            return;
+        }
+        ++points;
+        const std::array<double, 5> v{pt.error.x(), pt.error.y(), pt.error.z(), pt.error.norm(), pt.tilt};
+        for (int i = 0; i < 5; ++i) {
+            sumSq[i] += v[i] * v[i];
+            maxAbs[i] = std::max(maxAbs[i], std::abs(v[i]));
+        }
+        if (worstIndex < 0 || v[3] > worst.error.norm()) worstIndex = index, worst = pt;
+        if (worstTiltIndex < 0 || v[4] > worstTilt.tilt) worstTiltIndex = index, worstTilt = pt;
+    }
+    /// Merge a later chunk (higher indices): ties keep the earlier index, as a serial run would.
+    void merge(const Accumulator& o) {
+        points += o.points;
+        failed += o.failed;
+        for (int i = 0; i < 5; ++i) sumSq[i] += o.sumSq[i], maxAbs[i] = std::max(maxAbs[i], o.maxAbs[i]);
+        if (o.worstIndex >= 0 && (worstIndex < 0 || o.worst.error.norm() > worst.error.norm()))
+            worstIndex = o.worstIndex, worst = o.worst;
+        if (o.worstTiltIndex >= 0 && (worstTiltIndex < 0 || o.worstTilt.tilt > worstTilt.tilt))
+            worstTiltIndex = o.worstTiltIndex, worstTilt = o.worstTilt;
+    }
+    MapStatistics finish() const {
+        MapStatistics s;
+        s.points = points;
+        s.failed = failed;
+        ComponentStats* c[5] = {&s.dx, &s.dy, &s.dz, &s.norm, &s.tilt};
+        for (int i = 0; i < 5; ++i) {
+            c[i]->maxAbs = maxAbs[i];
+            c[i]->rms = points > 0 ? std::sqrt(sumSq[i] / points) : 0.0;
+        }
+        s.worstIndex = worstIndex;
+        s.worstTiltIndex = worstTiltIndex;
+        s.worst = worst;
+        s.worstTilt = worstTilt;
+        return s;
+    }
+};
+
+MapStatistics run(const Plan& plan, MapPoint* store) {
+    const MapRequest& r = *plan.request;
+    const long n = r.grid.size();
+    int threads = r.threads > 0 ? r.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    threads = static_cast<int>(std::clamp<long>(n / 256, 1, threads));
+    std::vector<Accumulator> acc(threads);
+    std::vector<std::exception_ptr> errors(threads);
+    const auto work = [&](int t) {
+        try {
+            const long lo = n * t / threads, hi = n * (t + 1) / threads;
+            MapPoint local;
+            for (long i = lo; i < hi; ++i) {
+                MapPoint& pt = store ? store[i] : local;
+                evaluate(plan, i, pt);
+                acc[t].add(i, pt);
+            }
+        } catch (...) {
+            errors[t] = std::current_exception();
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
+    work(0);
+    for (auto& th : pool) th.join();
+    for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
+    for (int t = 1; t < threads; ++t) acc[0].merge(acc[t]);
+    return acc[0].finish();
+}
+
+}  // namespace
+
+VolumetricMap computeMap(const MapRequest& request) {
+    Plan plan(request);
+    prepare(plan);
+    VolumetricMap map;
+    map.grid = request.grid;
+    map.axisNames = request.machine.axisNames;
+    map.toolLength = request.toolLength;
+    map.toolOrientation = request.toolOrientation;
+    if (map.toolOrientation) *map.toolOrientation = map.toolOrientation->normalized();
+    map.points.resize(static_cast<size_t>(request.grid.size()));
+    map.stats = run(plan, map.points.data());
+    return map;
+}
+
+MapStatistics mapStatistics(const MapRequest& request) {
+    Plan plan(request);
+    prepare(plan);
+    return run(plan, nullptr);
+}
+
+}  // namespace cnccomp

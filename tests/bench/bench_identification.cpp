@@ -1,0 +1,80 @@
+// Least-squares identification of the 12 seed-000 deviations from the six ball-bar runs of section 5.3, each a
+// 3600-sample trace (0.1° steps), on the exact model (issue 3 benchmark).
+#include <benchmark/benchmark.h>
+
+#include "cnccomp/identification/lsq.hpp"
+#include "cnccomp/identification/parameters.hpp"
+#include "cnccomp/identification/problem.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/plan_xml.hpp"
+
+namespace cnccomp {
+namespace {
+
+struct Fixture {
+    MachineModel machine = readMachineXml(std::string(CNCCOMP_SOURCE_DIR) + "/samples/machines/multitasking.xml");
+    DeviationSet truth = readDeviationCsv(std::string(CNCCOMP_SOURCE_DIR) + "/samples/deviations/multitasking-truth.csv", machine);
+    std::vector<BallbarRun> runs = readPlanXml(std::string(CNCCOMP_SOURCE_DIR) + "/samples/plans/multitasking-six-circles.xml").runs;
+    std::vector<BallbarTrace> traces;
+    IdentifyOptions options;
+    Fixture() {
+        const Kinematics k(machine, truth);
+        for (BallbarRun& r : runs) {
+            r.stepDeg = 0.1;
+            traces.push_back(simulateRun(k, r));
+        }
+        options.deviations = parseDeviationList(machine, "dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ");
+        DeviationSet start = truth;  // γXY known, the twelve start from zero
+        for (int i : options.deviations) start.values[machine.deviations[i].offset] = 0.0;
+        options.start = start;
+    }
+};
+
+Fixture& fixture() {
+    static Fixture f;
+    return f;
+}
+
+void BM_IdentifyTwelveFromSixTraces(benchmark::State& state) {
+    Fixture& f = fixture();
+    const Observations obs = ballbarObservations(f.machine, f.runs, f.traces);
+    int iterations = 0;
+    for (auto _ : state) {
+        const IdentificationResult r = identify(f.machine, obs, f.options);
+        iterations = r.report.iterations;
+        benchmark::DoNotOptimize(r.deviations.values.data());
+    }
+    state.counters["samples"] = static_cast<double>(obs.size() * f.traces[0].dL.size());
+    state.counters["lm_iterations"] = iterations;
+}
+BENCHMARK(BM_IdentifyTwelveFromSixTraces)->Unit(benchmark::kMillisecond);
+
+void BM_JacobianSixTraces(benchmark::State& state) {
+    Fixture& f = fixture();
+    const Observations obs = ballbarObservations(f.machine, f.runs, f.traces);
+    const UnknownLayout layout(f.machine, f.options.deviations, obs);
+    const LsqProblem p(f.machine, obs, layout, *f.options.start);
+    Eigen::MatrixXd J;
+    for (auto _ : state) {
+        p.jacobian(p.start(), J);
+        benchmark::DoNotOptimize(J.data());
+    }
+}
+BENCHMARK(BM_JacobianSixTraces)->Unit(benchmark::kMillisecond);
+
+void BM_ResidualsSixTraces(benchmark::State& state) {
+    Fixture& f = fixture();
+    const Observations obs = ballbarObservations(f.machine, f.runs, f.traces);
+    const UnknownLayout layout(f.machine, f.options.deviations, obs);
+    const LsqProblem p(f.machine, obs, layout, *f.options.start);
+    Eigen::VectorXd r;
+    for (auto _ : state) {
+        p.residuals(p.start(), r);
+        benchmark::DoNotOptimize(r.data());
+    }
+}
+BENCHMARK(BM_ResidualsSixTraces)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace cnccomp

@@ -1,0 +1,297 @@
+// fanuc-30i backend: golden files parsed back, emit → apply → residual volumetric error for the claimed errors,
+// parameter-file grammar, rotary pitch tables summing to zero, limits, malformed files rejected with file:line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <regex>
+#include <sstream>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "controller_test_util.hpp"
+#include "controllers/common/evaluate.hpp"
+#include "controllers/fanuc/fanuc_backend.hpp"
+#include "controllers/fanuc/parameter_file.hpp"
+#include "controllers/fanuc/tcp_parameters.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp::controllers {
+namespace {
+
+using test::sourcePath;
+
+const Backend& fanuc30i() { return backend("fanuc-30i"); }
+
+const MachineModel& pitchMachine() {
+    static const MachineModel m = readMachineXml(sourcePath("samples/machines/controllers-fanuc-pitch.xml"));
+    return m;
+}
+
+DeviationSet pitchTruth() {
+    return readDeviationCsv(sourcePath("samples/deviations/controllers-fanuc-pitch.csv"), pitchMachine());
+}
+
+/// The deviations the backend lists as compensated, the others removed.
+DeviationSet claimedOnly(const DeviationSet& d, const EmitResult& r) {
+    DeviationSet c = d;
+    for (const auto& nc : r.notCompensated) {
+        const int i = c.machine().deviationIndex(nc.deviation);
+        if (i < 0) continue;  // e.g. "EXX (constant part)"
+        const auto& def = c.machine().deviations[i];
+        for (int k = 0; k < def.size(); ++k) c.values[def.offset + k] = 0.0;
+        c.present[i] = 0;
+    }
+    return c;
+}
+
+std::string messageOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no InputError";
+}
+
+TEST(ControllerFanuc, RegisteredUnderItsName) { EXPECT_EQ(fanuc30i().name(), "fanuc-30i"); }
+
+TEST(ControllerFanuc, GoldenFilesMultitaskingParseBack) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/multitasking-truth.csv"), m);
+    test::checkGolden(fanuc30i(), m, d, "multitasking-truth.csv", "fanuc/multitasking");
+}
+
+TEST(ControllerFanuc, GoldenFilesPitchParseBack) {
+    test::checkGolden(fanuc30i(), pitchMachine(), pitchTruth(), "controllers-fanuc-pitch.csv", "fanuc/pitch");
+}
+
+TEST(ControllerFanuc, GoldenFilesOtherSampleMachinesParseBack) {
+    for (const char* name : {"tilting-head-b", "table-table-ac"}) {
+        const MachineModel m = readMachineXml(sourcePath(std::string("samples/machines/") + name + ".xml"));
+        test::checkGolden(fanuc30i(), m, test::patternedLocationErrors(m), "patterned", std::string("fanuc/") + name);
+    }
+}
+
+// Seed 000's machine: the four pivot/offset errors are claimed; the nine angles are listed NOT compensated.
+TEST(ControllerFanuc, MultitaskingPivotErrors) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/multitasking-truth.csv"), m);
+    const EmitResult r = fanuc30i().emit({m, d, "multitasking-truth.csv", "2024-01-01"});
+    EXPECT_EQ(r.compensated.size(), 4u);
+    EXPECT_EQ(r.notCompensated.size(), 9u);
+    const auto samples = test::nonSingularSamples(m, 4);
+    const CompensationFigures f = test::evaluateBackend(fanuc30i(), m, claimedOnly(d, r), samples, 100.0);
+    test::report("fanuc-30i multitasking (claimed: pivots)", f);
+    EXPECT_GT(f.maxBefore, 0.015);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    const CompensationFigures all = test::evaluateBackend(fanuc30i(), m, d, samples, 100.0);
+    test::report("fanuc-30i multitasking (all 13, angles left)", all);
+    EXPECT_LT(all.maxAfter, all.maxBefore);
+}
+
+TEST(ControllerFanuc, SampleMachinesRandomTranslationErrors) {
+    for (const char* name : {"tilting-head-b", "table-table-ac"}) {
+        const MachineModel m = readMachineXml(sourcePath(std::string("samples/machines/") + name + ".xml"));
+        const DeviationSet d = test::randomLocationErrors(m, 31);
+        const EmitResult r = fanuc30i().emit({m, d, "random", "2024-01-01"});
+        const CompensationFigures f =
+            test::evaluateBackend(fanuc30i(), m, claimedOnly(d, r), test::nonSingularSamples(m, 4), 100.0);
+        test::report(std::string("fanuc-30i ") + name + " (claimed)", f);
+        EXPECT_GT(f.maxBefore, 0.01) << name;
+        EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore) << name;
+    }
+}
+
+TEST(ControllerFanuc, PivotAndPitchErrorsClaimedAreCompensated) {
+    const MachineModel& m = pitchMachine();
+    const DeviationSet d = pitchTruth();
+    const EmitResult r = fanuc30i().emit({m, d, "controllers-fanuc-pitch.csv", "2024-01-01"});
+    std::set<std::string> refused;
+    for (const auto& c : r.notCompensated) refused.insert(c.deviation);
+    EXPECT_EQ(refused, (std::set<std::string>{"EA0B", "EC0Y", "EYX"}));
+    const auto samples = test::nonSingularSamples(m, 4, 300.0);
+    const CompensationFigures f = test::evaluateBackend(fanuc30i(), m, claimedOnly(d, r), samples, 100.0);
+    test::report("fanuc-30i pivots + pitch (claimed)", f);
+    EXPECT_GT(f.maxBefore, 0.03);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    const CompensationFigures all = test::evaluateBackend(fanuc30i(), m, d, samples, 100.0);
+    test::report("fanuc-30i pivots + pitch (all, 3 left)", all);
+}
+
+// The TCP offsets read back are the pivot positions of the deviation set (seed 000: C axis line, spindle).
+TEST(ControllerFanuc, TcpOffsetsAreThePivotPositions) {
+    const MachineModel& m = pitchMachine();
+    DeviationSet d(m);
+    d.set("EX0C", -0.015);
+    d.set("EY0C", 0.010);
+    d.set("EX0S", 0.012);
+    d.set("EZ0S", 0.015);
+    d.set("EX0B", 0.007);
+    const EmitResult r = fanuc30i().emit({m, d, "x", "2024-01-01"});
+    const fanuc::ParameterFile f = fanuc::parseParameterFile(r.files[0].name, r.files[0].content);
+    const fanuc::TcpParameters p = fanuc::tcpFromFile(m, f);
+    EXPECT_EQ(p.type, 21);
+    EXPECT_EQ(m.axisNames[p.rotary[0].axis], "B");
+    EXPECT_EQ(m.axisNames[p.rotary[1].axis], "C");
+    EXPECT_EQ(p.rotary[0].direction, 2);
+    EXPECT_EQ(p.rotary[1].direction, 3);
+    // Controlled point on the B axis (at X = 0.007): D -> E is from the tool reference point up to it.
+    EXPECT_NEAR(p.toolOffset.x(), -0.012, 1e-12);
+    EXPECT_NEAR(p.toolOffset.z(), 150.0 - 0.015, 1e-12);
+    // The C axis line, seen from the controlled point; the workpiece datum on it.
+    EXPECT_NEAR(p.tablePosition.x(), -0.015 - 0.007, 1e-12);
+    EXPECT_NEAR(p.tablePosition.y(), 0.010, 1e-12);
+    EXPECT_NEAR((p.workZero - p.tablePosition).norm(), 0.0, 1e-12);
+}
+
+TEST(ControllerFanuc, EveryLineMatchesTheParameterGrammar) {
+    const EmitResult r = fanuc30i().emit({pitchMachine(), pitchTruth(), "x", "2024-01-01"});
+    const std::string& text = r.files.at(0).content;
+    const std::regex grammar(R"(^N\d{5}Q[01](P[+-]?\d+(\.\d+)?|L\d+P[+-]?\d+(\.\d+)?|(A\d+P[+-]?\d+(\.\d+)?)+)$)");
+    std::istringstream in(text);
+    std::string line;
+    int state = 0, body = 0;
+    while (std::getline(in, line)) {
+        if (state == 0) {
+            if (line == "%") state = 1;
+            else EXPECT_TRUE(line.empty() || (line.front() == '(' && line.back() == ')')) << line;
+            continue;
+        }
+        if (state == 2) {
+            ADD_FAILURE() << "text after the closing %: " << line;
+            continue;
+        }
+        if (line == "%") {
+            state = 2;
+            continue;
+        }
+        ++body;
+        EXPECT_TRUE(std::regex_match(line, grammar)) << line;
+    }
+    EXPECT_EQ(state, 2);
+    EXPECT_GT(body, 100);
+    EXPECT_EQ(text.find('\r'), std::string::npos);
+}
+
+TEST(ControllerFanuc, RotaryPitchTableSumsToZeroOverARevolution) {
+    const MachineModel& m = pitchMachine();
+    const EmitResult r = fanuc30i().emit({m, pitchTruth(), "x", "2024-01-01"});
+    const fanuc::ParameterFile f = fanuc::parseParameterFile(r.files[0].name, r.files[0].content);
+    const auto tables = fanuc::pitchFromFile(m, f);
+    ASSERT_EQ(tables.size(), 5u);  // X Y Z B C
+    const int c = m.requireAxis("C");
+    for (const auto& t : tables) {
+        if (t.axis != c) {
+            EXPECT_FALSE(t.rotaryType);
+            EXPECT_DOUBLE_EQ(t.correction(0.0, 1e-4), 0.0);  // zero at the reference position
+            continue;
+        }
+        EXPECT_TRUE(t.rotaryType);
+        EXPECT_EQ(t.reference, t.negative);
+        EXPECT_DOUBLE_EQ((t.positive - t.negative) * t.interval, 360.0);
+        long sum = 0;
+        for (size_t k = 1; k < t.data.size(); ++k) sum += t.data[k];
+        EXPECT_EQ(sum, 0);
+        // ECC = 8" sin c - 3" sin 2c; the correction is -ECC (within half a detection unit per point).
+        for (double deg : {17.0, 95.0, 250.0, 250.0 - 720.0}) {
+            const double q = deg * kDeg;
+            const double ecc = (8 * std::sin(q) - 3 * std::sin(2 * q)) / 3600.0;
+            EXPECT_NEAR(t.correction(deg, 1e-4), -ecc, 1.5e-4) << deg;
+        }
+    }
+}
+
+TEST(ControllerFanuc, ConstantPartOfAPositioningErrorIsReported) {
+    const MachineModel& m = pitchMachine();
+    DeviationSet d(m);
+    const auto& ecc = m.deviations[m.deviationIndex("ECC")];
+    d.values[ecc.offset] = 5 * kArcsec;  // cos c: 5" at the reference position
+    d.present[m.deviationIndex("ECC")] = 1;
+    const EmitResult r = fanuc30i().emit({m, d, "x", "2024-01-01"});
+    ASSERT_EQ(r.notCompensated.size(), 1u);
+    EXPECT_EQ(r.notCompensated[0].deviation, "ECC (constant part)");
+    EXPECT_NE(r.notCompensated[0].note.find("5.000 arcsec"), std::string::npos) << r.notCompensated[0].note;
+    EXPECT_NE(r.files[0].content.find("(  ECC [constant part]"), std::string::npos);
+}
+
+TEST(ControllerFanuc, LimitsAreReportedAsModelErrors) {
+    const EmitRequest req{pitchMachine(), pitchTruth(), "x", "2024-01-01"};
+    fanuc::PitchOptions few;
+    few.maxPoints = 200;
+    try {
+        fanuc::emitFiles(req, few);
+        FAIL() << "expected ModelError";
+    } catch (const ModelError& e) {
+        EXPECT_NE(std::string(e.what()).find("the control holds 200"), std::string::npos) << e.what();
+    }
+    fanuc::PitchOptions narrow;
+    narrow.maxData = 1;
+    narrow.maxMagnification = 1;
+    EXPECT_THROW(fanuc::emitFiles(req, narrow), ModelError);
+    fanuc::PitchOptions coarse;
+    coarse.maxIntervals = 16;
+    const EmitResult r = fanuc::emitFiles(req, coarse);
+    for (const auto& t : fanuc::pitchFromFile(pitchMachine(), fanuc::parseParameterFile("p", r.files[0].content)))
+        EXPECT_LE(t.positive - t.negative, 16);
+    // Three rotary axes: no 30i machine type.
+    MachineModel three;
+    three.name = "three-rotary";
+    Link a, b, c, s;
+    a.name = "A", a.kind = AxisKind::Rotary, a.direction = Vec3::UnitX();
+    b.name = "B", b.kind = AxisKind::Rotary, b.direction = Vec3::UnitY();
+    c.name = "C", c.kind = AxisKind::Rotary, c.direction = Vec3::UnitZ();
+    s.name = "S";
+    three.workpiece.links = {a, c};
+    three.tool.links = {b, s};
+    three.finalize();
+    EXPECT_THROW(fanuc30i().emit({three, DeviationSet(three), "x", "2024-01-01"}), ModelError);
+}
+
+TEST(ControllerFanuc, MalformedFilesAreRejectedWithFileAndLine) {
+    const MachineModel& m = pitchMachine();
+    const EmitResult r = fanuc30i().emit({m, pitchTruth(), "x", "2024-01-01"});
+    const std::string text = r.files[0].content;
+    const auto apply = [&](const std::string& content) {
+        return messageOf([&] { fanuc30i().apply(m, {{fanuc::kParameterFile, content}}); });
+    };
+    const int typeLine = test::lineOf(text, "N19680Q1L1P");
+    EXPECT_EQ(apply(test::replaceLine(text, typeLine, "N19680Q1L1P5")),
+              fmt::format("CNCCOMP.PRM:{}: parameter 19680: machine type 5 is not 0, 2, 12 or 21", typeLine));
+    EXPECT_EQ(apply(test::replaceLine(text, typeLine, "N1968Q1L1P21")),
+              fmt::format("CNCCOMP.PRM:{}: 'N1968Q1L1P21' does not match N<5 digits>Q<0|1>(P<v>|L<n>P<v>|(A<n>P<v>)+): the "
+                          "parameter number has 5 digits",
+                          typeLine));
+    EXPECT_NE(apply(test::replaceLine(text, typeLine, "N19680Q1L1P2.1e1")).find("does not match"), std::string::npos);
+    EXPECT_NE(apply(test::replaceLine(text, typeLine, "G01 X10")).find(fmt::format("CNCCOMP.PRM:{}:", typeLine)), std::string::npos);
+    // A parameter twice.
+    const int pos = test::lineOf(text, "N19700Q1L1P");
+    std::string twice = test::replaceLine(text, pos, text.substr(text.find("N19700"), text.find('\n', text.find("N19700")) - text.find("N19700")) +
+                                                         "\n" + text.substr(text.find("N19700"), text.find('\n', text.find("N19700")) - text.find("N19700")));
+    EXPECT_EQ(apply(twice), fmt::format("CNCCOMP.PRM:{}: parameter 19700 given twice", pos + 1));
+    // Missing closing %, comment between the % lines, text before the opening %.
+    EXPECT_NE(apply(text.substr(0, text.rfind("%"))).find("missing the closing %"), std::string::npos);
+    EXPECT_NE(apply("hello\n" + text).find("CNCCOMP.PRM:1: before the opening % only (comment) lines are allowed"), std::string::npos);
+    // The rotary table's data no longer summing to zero.
+    const fanuc::ParameterFile pf = fanuc::parseParameterFile("p", text);
+    int cFirst = -1;
+    for (const auto& t : fanuc::pitchFromFile(m, pf))
+        if (t.rotaryType) cFirst = t.negative;
+    ASSERT_GE(cFirst, 0);
+    const int dataLine = test::lineOf(text, fmt::format("N{}Q0P", 10000 + cFirst + 5));
+    const std::string broken = test::replaceLine(text, dataLine, fmt::format("N{}Q0P77", 10000 + cFirst + 5));
+    const std::string msg = apply(broken);
+    EXPECT_NE(msg.find("not 0"), std::string::npos) << msg;
+    EXPECT_EQ(msg.rfind("CNCCOMP.PRM:", 0), 0u) << msg;
+    // A missing data point, an unknown parameter, the wrong file.
+    std::string gap = text;
+    const size_t at = gap.find(fmt::format("\nN{}Q0P", 10000 + cFirst + 5));
+    gap.erase(at, gap.find('\n', at + 1) - at);
+    EXPECT_NE(apply(gap).find(fmt::format("parameter {} is missing", 10000 + cFirst + 5)), std::string::npos) << apply(gap);
+    EXPECT_EQ(apply(test::replaceLine(text, typeLine, "N01005Q1A1P1")),
+              fmt::format("CNCCOMP.PRM:{}: parameter 1005 is not one cnccomp writes or models", typeLine));
+    EXPECT_EQ(messageOf([&] { fanuc30i().apply(m, {{"OTHER.TXT", text}}); }), "OTHER.TXT: not a fanuc-30i file (expected CNCCOMP.PRM)");
+}
+
+}  // namespace
+}  // namespace cnccomp::controllers

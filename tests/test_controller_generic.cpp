@@ -1,0 +1,140 @@
+// Generic backend: the deviation set read back from CSV and JSON, the grid map against the exact model and its
+// JSON twin, emit → apply (map lookup) ≥ 90 % less tip error, goldens, readers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
+#include "controllers/common/evaluate.hpp"
+#include "controllers/generic/deviation_json.hpp"
+#include "controllers/generic/grid_map.hpp"
+#include "controllers/generic/json.hpp"
+#include "test_controller_common_support.hpp"
+
+namespace cnccomp::controllers {
+namespace {
+
+using namespace testing;
+
+const std::vector<Sample> kGolden = {{"multitasking", "multitasking-truth"},
+                                     {"table-table-ac", "map-table-table-ac"},
+                                     {"tilting-head-b", "map-tilting-head-b"}};
+const std::vector<Sample> kAll = {{"multitasking", "multitasking-truth"},
+                                  {"table-table-ac", "map-table-table-ac"},
+                                  {"tilting-head-b", "map-tilting-head-b"},
+                                  {"controllers-table-table-ac", "controllers-table-table-ac"},
+                                  {"controllers-tilting-head-b", "controllers-tilting-head-b"}};
+
+EmitResult emitSample(const Sample& s, const DeviationSet& d) { return testing::emitSample("generic", s, d); }
+
+TEST(ControllerGeneric, MapLookupRemovesAtLeastNinetyPercentOfTheTipError) {
+    const Backend& b = backend("generic");
+    for (const Sample& s : kAll) {
+        const MachineModel& m = machine(s.machine);
+        const DeviationSet d = deviations(s);
+        const EmitResult r = emitSample(s, d);
+        EXPECT_TRUE(r.notCompensated.empty()) << s.machine;
+        for (double L : {0.0, 150.0}) {
+            // Six samples per axis fall between the 30° rotary nodes (and off the linear nodes).
+            const CompensationFigures f = emitApplyEvaluate(b, m, d, workspaceSamples(m, 6), L);
+            std::cout << fmt::format("[generic] {:<28} L={:5.1f}: max {:8.3f} -> {:7.3f} um, rms {:7.3f} -> {:6.3f} um ({} points)\n",
+                                     s.machine, L, f.maxBefore / kUm, f.maxAfter / kUm, f.rmsBefore / kUm, f.rmsAfter / kUm,
+                                     f.points);
+            EXPECT_GT(f.maxBefore, 5 * kUm);
+            EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore) << s.machine << " L=" << L;
+        }
+    }
+}
+
+TEST(ControllerGeneric, MapNodesHoldTheExactErrorAndInterpolateExactlyAlongLinearAxes) {
+    const Sample& s = kGolden[0];
+    const MachineModel& m = machine(s.machine);
+    const DeviationSet d = deviations(s);
+    const generic::GridMap g = generic::buildGridMap(m, d);
+    const Kinematics nominal(m), actual(m, d);
+    // Location errors only: at fixed rotary nodes the tip error is affine in each linear axis, so the two-node
+    // interpolation is exact anywhere along X, Y, Z (an independent check of both the map and the lookup).
+    for (double x : {-433.0, 17.0, 650.0})
+        for (double y : {-250.0, 99.0})
+            for (int bi : {0, 3, 7}) {
+                AxisVector q = AxisVector::Zero(m.axisCount());
+                q[m.requireAxis("X")] = x;
+                q[m.requireAxis("Y")] = y;
+                q[m.requireAxis("Z")] = 321.0;
+                q[m.requireAxis("B")] = (-180.0 + 30.0 * bi) * kDeg;
+                q[m.requireAxis("C")] = 60 * kDeg;
+                Vec3 e0, dk;
+                g.at(q, e0, dk);
+                const Vec3 tip = nominal.toolPoint(80.0);
+                const Vec3 exact = toolPose(actual, q, tip).tip - toolPose(nominal, q, tip).tip;
+                EXPECT_NEAR((e0 + 80.0 * dk - exact).norm(), 0.0, 1e-9);
+            }
+}
+
+TEST(ControllerGeneric, DeviationFilesAndMapJsonReadBack) {
+    for (const Sample& s : kAll) {
+        const MachineModel& m = machine(s.machine);
+        const DeviationSet d = deviations(s);
+        const EmitResult r = emitSample(s, d);
+        const DeviationSet j = generic::readDeviationJson(requireFile(r.files, "deviations.json", "t").content, "deviations.json", m);
+        EXPECT_EQ(j.present, d.present);
+        EXPECT_EQ((j.values - d.values).cwiseAbs().maxCoeff(), 0.0) << s.machine;  // shortest round-trip numbers
+        test::ScratchDir dir("generic_dev");
+        test::writeText(dir.file("d.csv"), requireFile(r.files, "deviations.csv", "t").content);
+        const DeviationSet c = readDeviationCsv(dir.file("d.csv"), m);
+        EXPECT_LT((c.values - d.values).cwiseAbs().maxCoeff(), 1e-9);
+        // map.json carries the numbers of map.csv.
+        const generic::GridMap g = generic::parseGridMapCsv(requireFile(r.files, "map.csv", "t").content, "map.csv", m);
+        const generic::Json mj = generic::parseJson(requireFile(r.files, "map.json", "t").content, "map.json");
+        const auto dx = mj.require("dx_um", generic::Json::Type::Array, "map.json").numbers("map.json");
+        const auto dkz = mj.require("dkz_urad", generic::Json::Type::Array, "map.json").numbers("map.json");
+        ASSERT_EQ(dx.size(), g.tip.size());
+        for (size_t i = 0; i < dx.size(); ++i) {
+            EXPECT_NEAR(dx[i] * kUm, g.tip[i].x(), 1e-15);
+            EXPECT_NEAR(dkz[i] * 1e-6, g.toolAxis[i].z(), 1e-15);
+        }
+        const auto& grid = mj.require("grid", generic::Json::Type::Array, "map.json").array;
+        ASSERT_EQ(grid.size(), g.axes.size());
+        for (size_t a = 0; a < grid.size(); ++a)
+            EXPECT_EQ(grid[a].require("nodes", generic::Json::Type::Array, "map.json").array.size(), g.axes[a].nodes.size());
+    }
+}
+
+TEST(ControllerGeneric, GoldenFilesAreReproducedAndReadBack) {
+    for (const Sample& s : kGolden) {
+        const EmitResult r = emitSample(s, deviations(s));
+        const std::vector<OutputFile> golden = compareWithGolden("generic", s.machine, r);
+        const auto comp = backend("generic").apply(machine(s.machine), golden);
+        EXPECT_TRUE(comp->driveCommands(AxisVector::Zero(machine(s.machine).axisCount())).allFinite());
+    }
+}
+
+TEST(ControllerGeneric, ReadersNameFileAndLine) {
+    using namespace generic;
+    EXPECT_EQ(inputErrorLine([] { parseJson("{\n \"a\": [1,\n 2,,\n 3]}", "x.json"); }), 3);
+    EXPECT_EQ(inputErrorLine([] { parseJson("{\"a\": 1, \"a\": 2}", "x.json"); }), 1);
+    EXPECT_EQ(inputErrorLine([] { parseJson("{\"a\": nan}", "x.json"); }), 1);
+    EXPECT_EQ(inputErrorLine([] { parseJson("[1] 2", "x.json"); }), 1);
+    const MachineModel& m = machine("multitasking");
+    EXPECT_EQ(inputErrorLine([&] {
+                  readDeviationJson("{\"format\": \"cnccomp-deviations\", \"deviations\": [\n{\"name\": \"EQ0Q\"}]}", "d.json", m);
+              }),
+              2);
+    const EmitResult r = emitSample(kGolden[0], deviations(kGolden[0]));
+    std::string csv = requireFile(r.files, "map.csv", "t").content;
+    const size_t last = csv.rfind('\n', csv.size() - 2);
+    const std::string cut = csv.substr(0, last + 1);  // one row missing: not a full grid
+    EXPECT_THROW(parseGridMapCsv(cut, "map.csv", m), InputError);
+    std::string bad = csv;
+    bad.replace(bad.rfind(','), 1, ",x");
+    const int lines = static_cast<int>(std::count(csv.begin(), csv.end(), '\n'));
+    EXPECT_EQ(inputErrorLine([&] { parseGridMapCsv(bad, "map.csv", m); }), lines);
+    EXPECT_THROW(parseGridMapCsv(csv, "map.csv", machine("table-table-ac")), InputError);
+}
+
+}  // namespace
+}  // namespace cnccomp::controllers

@@ -1,0 +1,339 @@
+// siemens-840d backend: golden files parsed back, emit → apply → residual volumetric error, CEC/EEC format
+// rules (MIN/MAX/STEP vs point count, modulo tables closing), limits, malformed files rejected with file:line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <functional>
+#include <regex>
+#include <sstream>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "controllers/common/evaluate.hpp"
+#include "controllers/siemens/compensation_tables.hpp"
+#include "controllers/siemens/kinematic_chain.hpp"
+#include "controllers/siemens/siemens_backend.hpp"
+#include "controller_test_util.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp::controllers {
+namespace {
+
+using test::sourcePath;
+
+const Backend& siemens() { return backend("siemens-840d"); }
+
+const MachineModel& componentsMachine() {
+    static const MachineModel m = readMachineXml(sourcePath("samples/machines/controllers-siemens-components.xml"));
+    return m;
+}
+
+TEST(ControllerSiemens, RegisteredUnderItsName) {
+    EXPECT_EQ(siemens().name(), "siemens-840d");
+    EXPECT_FALSE(siemens().description().empty());
+}
+
+TEST(ControllerSiemens, GoldenFilesMultitaskingParseBack) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/multitasking-truth.csv"), m);
+    test::checkGolden(siemens(), m, d, "multitasking-truth.csv", "siemens/multitasking");
+}
+
+TEST(ControllerSiemens, GoldenFilesComponentsParseBack) {
+    const MachineModel& m = componentsMachine();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/controllers-siemens-components.csv"), m);
+    test::checkGolden(siemens(), m, d, "controllers-siemens-components.csv", "siemens/components");
+}
+
+TEST(ControllerSiemens, GoldenFilesOtherSampleMachinesParseBack) {
+    for (const char* name : {"tilting-head-b", "table-table-ac"}) {
+        const MachineModel m = readMachineXml(sourcePath(std::string("samples/machines/") + name + ".xml"));
+        test::checkGolden(siemens(), m, test::patternedLocationErrors(m), "patterned", std::string("siemens/") + name);
+    }
+}
+
+// All 13 location errors of seed 000's machine are claimed: squareness by CEC lines (+ the head orientation
+// folded into the chain), everything else by the kinematic chain.
+TEST(ControllerSiemens, MultitaskingTruthResidualBelowTenPercent) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/multitasking-truth.csv"), m);
+    const EmitResult r = siemens().emit({m, d, "multitasking-truth.csv", "2024-01-01"});
+    EXPECT_EQ(r.compensated.size(), 13u);
+    EXPECT_TRUE(r.notCompensated.empty());
+    const CompensationFigures f = test::evaluateBackend(siemens(), m, d, test::nonSingularSamples(m, 4), 100.0);
+    test::report("siemens-840d multitasking truth", f);
+    EXPECT_GT(f.maxBefore, 0.02);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    EXPECT_LT(f.maxAfter, 2e-4);  // second-order terms of the CEC straight lines only
+}
+
+TEST(ControllerSiemens, SampleMachinesRandomLocationErrors) {
+    for (const char* name : {"tilting-head-b", "table-table-ac"}) {
+        const MachineModel m = readMachineXml(sourcePath(std::string("samples/machines/") + name + ".xml"));
+        const DeviationSet d = test::randomLocationErrors(m, 11);
+        const CompensationFigures f = test::evaluateBackend(siemens(), m, d, test::nonSingularSamples(m, 4), 100.0);
+        test::report(std::string("siemens-840d ") + name, f);
+        EXPECT_GT(f.maxBefore, 0.01) << name;
+        EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore) << name;
+    }
+}
+
+}  // namespace
+}  // namespace cnccomp::controllers
+
+namespace cnccomp::controllers {
+namespace {
+
+DeviationSet withoutDeviation(DeviationSet d, const std::string& name) {
+    const int i = d.require(name);
+    const auto& def = d.machine().deviations[i];
+    for (int k = 0; k < def.size(); ++k) d.values[def.offset + k] = 0.0;
+    d.present[i] = 0;
+    return d;
+}
+
+// Component errors: positioning (EEC), straightness and radial motion (CEC) are claimed; the roll EAX is not.
+TEST(ControllerSiemens, ComponentErrorsClaimedAreCompensated) {
+    const MachineModel& m = componentsMachine();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/controllers-siemens-components.csv"), m);
+    const EmitResult r = siemens().emit({m, d, "controllers-siemens-components.csv", "2024-01-01"});
+    ASSERT_EQ(r.notCompensated.size(), 1u);
+    EXPECT_EQ(r.notCompensated[0].deviation, "EAX");
+    const DeviationSet claimed = withoutDeviation(d, "EAX");
+    const auto samples = test::nonSingularSamples(m, 4, 300.0);
+    const CompensationFigures f = test::evaluateBackend(siemens(), m, claimed, samples, 100.0);
+    test::report("siemens-840d components (claimed)", f);
+    EXPECT_GT(f.maxBefore, 0.02);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    const CompensationFigures all = test::evaluateBackend(siemens(), m, d, samples, 100.0);
+    test::report("siemens-840d components (all, EAX left)", all);
+}
+
+}  // namespace
+}  // namespace cnccomp::controllers
+
+namespace cnccomp::controllers {
+namespace {
+
+const OutputFile& file(const EmitResult& r, const std::string& name) {
+    for (const auto& f : r.files)
+        if (f.name == name) return f;
+    throw std::runtime_error("no file " + name);
+}
+
+EmitResult componentsEmit() {
+    const MachineModel& m = componentsMachine();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/controllers-siemens-components.csv"), m);
+    return siemens().emit({m, d, "controllers-siemens-components.csv", "2024-01-01"});
+}
+
+// Every table's points are numbered 0..N-1 with N = (MAX-MIN)/STEP + 1, counted from the text itself.
+TEST(ControllerSiemens, CecMinMaxStepMatchThePointCount) {
+    const EmitResult r = componentsEmit();
+    const std::string& text = file(r, siemens::kCecFile).content;
+    std::map<int, int> count;
+    std::map<int, double> step, mn, mx;
+    const std::regex point(R"(^\$AN_CEC\[(\d+),(\d+)\]=(-?\d+\.\d+)$)");
+    const std::regex field(R"(^\$AN_CEC_(STEP|MIN|MAX)\[(\d+)\]=(-?\d+\.\d+)$)");
+    std::istringstream in(text);
+    std::string line;
+    std::map<int, int> lastIndex;
+    while (std::getline(in, line)) {
+        std::smatch mt;
+        if (std::regex_match(line, mt, point)) {
+            const int t = std::stoi(mt[1]), n = std::stoi(mt[2]);
+            EXPECT_EQ(n, count[t]) << "points of table " << t << " are numbered in order";
+            ++count[t];
+        } else if (std::regex_match(line, mt, field)) {
+            const int t = std::stoi(mt[2]);
+            (mt[1] == "STEP" ? step : mt[1] == "MIN" ? mn : mx)[t] = std::stod(mt[3]);
+        }
+    }
+    ASSERT_GE(count.size(), 5u);  // X->Y, X->Z, Y->X or Y->Z, Y->Z, C->X, C->Y, B->X, B->Z ...
+    for (const auto& [t, n] : count) {
+        ASSERT_TRUE(step.count(t) && mn.count(t) && mx.count(t)) << t;
+        const double intervals = (mx[t] - mn[t]) / step[t];
+        EXPECT_NEAR(intervals, std::round(intervals), 1e-9) << t;
+        EXPECT_EQ(n, static_cast<int>(std::lround(intervals)) + 1) << "table " << t;
+        EXPECT_LE(n, siemens::Options{}.cecMaxPoints);
+    }
+}
+
+// Squareness is a straight line through zero: output = slope x input, slope = the squareness angle.
+TEST(ControllerSiemens, SquarenessIsAStraightLine) {
+    const MachineModel& m = test::multitasking();
+    DeviationSet d(m);
+    d.set("EC0Y", 10 * kArcsec);
+    const EmitResult r = siemens().emit({m, d, "EC0Y only", "2024-01-01"});
+    const auto tables = siemens::parseCec(m, siemens::kCecFile, file(r, siemens::kCecFile).content);
+    ASSERT_EQ(tables.size(), 1u);
+    const auto& t = tables[0];
+    EXPECT_EQ(m.axisNames[t.input], "X");
+    EXPECT_EQ(m.axisNames[t.output], "Y");
+    // X slide rotated by +gamma about Z moves +gamma*x in Y: the trim is -gamma*x (rounded to 1 nm).
+    for (size_t n = 0; n < t.table.values.size(); ++n) {
+        const double x = t.table.min + t.table.step * n;
+        EXPECT_NEAR(t.table.values[n], -std::tan(10 * kArcsec) * x, 6e-7) << x;
+    }
+    EXPECT_NEAR(t.table.at(0.0), 0.0, 1e-12);
+}
+
+// Modulo tables (the C axis) span one revolution and close on themselves.
+TEST(ControllerSiemens, ModuloTablesCloseOnThemselves) {
+    const MachineModel& m = componentsMachine();
+    const EmitResult r = componentsEmit();
+    const auto cec = siemens::parseCec(m, siemens::kCecFile, file(r, siemens::kCecFile).content);
+    const auto eec = siemens::parseEec(m, siemens::kEecFile, file(r, siemens::kEecFile).content);
+    const int c = m.requireAxis("C");
+    int modulo = 0;
+    for (const auto& t : cec)
+        if (t.input == c) {
+            ++modulo;
+            EXPECT_TRUE(t.table.modulo);
+            EXPECT_DOUBLE_EQ(t.table.min, 0.0);
+            EXPECT_DOUBLE_EQ(t.table.max(), 360.0);
+            EXPECT_DOUBLE_EQ(t.table.values.front(), t.table.values.back());
+        }
+    for (const auto& t : eec)
+        if (t.axis == c) {
+            ++modulo;
+            EXPECT_TRUE(t.table.modulo);
+            EXPECT_DOUBLE_EQ(t.table.max() - t.table.min, 360.0);
+            EXPECT_DOUBLE_EQ(t.table.values.front(), t.table.values.back());
+            // ECC = 6" cos c - 4" sin c + 3" cos 2c + 2" sin 2c, in degrees.
+            const double q = 30 * kDeg;
+            const double ecc = (6 * std::cos(q) - 4 * std::sin(q) + 3 * std::cos(2 * q) + 2 * std::sin(2 * q)) / 3600.0;
+            EXPECT_NEAR(t.table.at(30.0), ecc, 1e-8);
+            EXPECT_NEAR(t.table.at(390.0), ecc, 1e-8);   // wraps
+            EXPECT_NEAR(t.table.at(-330.0), ecc, 1e-8);
+        }
+    EXPECT_EQ(modulo, 3);  // C->X, C->Y (radial motion) and the EEC of C
+}
+
+TEST(ControllerSiemens, LimitsAreReportedAsModelErrors) {
+    const MachineModel& m = componentsMachine();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/controllers-siemens-components.csv"), m);
+    const EmitRequest req{m, d, "x", "2024-01-01"};
+    siemens::Options few;
+    few.cecMaxPoints = 50;
+    try {
+        siemens::emitFiles(req, few);
+        FAIL() << "expected ModelError";
+    } catch (const ModelError& e) {
+        EXPECT_NE(std::string(e.what()).find("MM_CEC_MAX_POINTS = 50"), std::string::npos) << e.what();
+    }
+    siemens::Options tables;
+    tables.cecMaxTables = 2;
+    EXPECT_THROW(siemens::emitFiles(req, tables), ModelError);
+    siemens::Options chain;
+    chain.chainMaxElements = 4;
+    EXPECT_THROW(siemens::emitFiles(req, chain), ModelError);
+    siemens::Options coarse;
+    coarse.tablePoints = 11;  // fewer, coarser points still fit and still compensate
+    const EmitResult r = siemens::emitFiles(req, coarse);
+    for (const auto& t : siemens::parseCec(m, siemens::kCecFile, file(r, siemens::kCecFile).content))
+        EXPECT_LE(t.table.values.size(), 11u);
+}
+
+TEST(ControllerSiemens, LinearAxisOnARotaryAxisIsRefused) {
+    MachineModel m;
+    m.name = "rotary-carries-linear";
+    Link c;
+    c.name = "C";
+    c.kind = AxisKind::Rotary;
+    Link x;
+    x.name = "X";
+    x.kind = AxisKind::Linear;
+    x.direction = Vec3::UnitX();
+    x.min = -100;
+    x.max = 100;
+    Link s;
+    s.name = "S";
+    m.tool.links = {c, x, s};
+    m.finalize();
+    const DeviationSet d(m);
+    EXPECT_THROW(siemens().emit({m, d, "x", "2024-01-01"}), ModelError);
+}
+
+std::string messageOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no InputError";
+}
+
+// Broken files are refused with the file name and the line.
+TEST(ControllerSiemens, MalformedFilesAreRejectedWithFileAndLine) {
+    const MachineModel& m = componentsMachine();
+    const EmitResult r = componentsEmit();
+    const auto withFile = [&](const std::string& name, const std::string& content) {
+        std::vector<OutputFile> files = r.files;
+        for (auto& f : files)
+            if (f.name == name) f.content = content;
+        return messageOf([&] { siemens().apply(m, files); });
+    };
+    const std::string cec = file(r, siemens::kCecFile).content;
+    const std::string eec = file(r, siemens::kEecFile).content;
+    const std::string chain = file(r, siemens::kChainFile).content;
+
+    const int stepLine = test::lineOf(cec, "$AN_CEC_STEP[0]=");
+    EXPECT_EQ(withFile(siemens::kCecFile, test::replaceLine(cec, stepLine, "$AN_CEC_STEP[0]=abc")),
+              fmt::format("NC_CEC.INI:{}: 'abc' is not a number", stepLine));
+    EXPECT_EQ(withFile(siemens::kCecFile, test::replaceLine(cec, stepLine, "G01 X10")),
+              fmt::format("NC_CEC.INI:{}: expected $VARIABLE[...]=value, CHANDATA(n), a ';' comment or M17; got 'G01 X10'", stepLine));
+    // One point fewer than (MAX-MIN)/STEP+1.
+    const int p3 = test::lineOf(cec, "$AN_CEC[0,3]=");
+    const std::string missing = withFile(siemens::kCecFile, test::replaceLine(cec, p3, "; removed"));
+    EXPECT_NE(missing.find("NC_CEC.INI:"), std::string::npos);
+    EXPECT_NE(missing.find("points expected"), std::string::npos) << missing;
+    // STEP that does not divide MAX-MIN.
+    const std::string badStep = withFile(siemens::kCecFile, test::replaceLine(cec, stepLine, "$AN_CEC_STEP[0]=3.3"));
+    EXPECT_NE(badStep.find("not a whole number of intervals"), std::string::npos) << badStep;
+    // Unknown axis.
+    const int inLine = test::lineOf(cec, "$AN_CEC_INPUT_AXIS[0]=");
+    EXPECT_EQ(withFile(siemens::kCecFile, test::replaceLine(cec, inLine, "$AN_CEC_INPUT_AXIS[0]=(AX9)")),
+              fmt::format("NC_CEC.INI:{}: machine 'controllers-siemens-components' has no axis AX9", inLine));
+    // No M17.
+    const std::string noEnd = withFile(siemens::kCecFile, cec.substr(0, cec.rfind("M17")));
+    EXPECT_NE(noEnd.find("missing M17"), std::string::npos) << noEnd;
+    // A modulo table whose last point differs from the first.
+    const int c = m.requireAxis("C");
+    const std::string axC = siemens::axisName(m, c);
+    size_t lastIndex = 0;
+    for (const auto& t : siemens::parseEec(m, siemens::kEecFile, eec))
+        if (t.axis == c) lastIndex = t.table.values.size() - 1;
+    ASSERT_GT(lastIndex, 0u);
+    const int last = test::lineOf(eec, fmt::format("$AA_ENC_COMP[0,{},{}]=", lastIndex, axC));
+    ASSERT_GT(last, 0);
+    const std::string open =
+        withFile(siemens::kEecFile, test::replaceLine(eec, last, fmt::format("$AA_ENC_COMP[0,{},{}]=0.5", lastIndex, axC)));
+    EXPECT_EQ(open.rfind(fmt::format("AX_EEC.INI:{}:", last), 0), 0u) << open;
+    EXPECT_NE(open.find("does not close on itself"), std::string::npos) << open;
+    // Chain: a broken link and a wrong identifier.
+    const int next = test::lineOf(chain, "$NK_NEXT[0]=");
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, next, "$NK_NEXT[0]=\"NOWHERE\"")),
+              fmt::format("CNCCOMP_KINCHAIN.SPF:{}: $NK_NEXT of 'T_Z' names no element ('NOWHERE')", test::lineOf(chain, "$NK_NAME[0]=")));
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, 1, "%_N_OTHER_SPF")),
+              "CNCCOMP_KINCHAIN.SPF:1: file identifier is %_N_OTHER_SPF, expected %_N_CNCCOMP_KINCHAIN_SPF");
+    const int type = test::lineOf(chain, "$NK_TYPE[0]=");
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, type, "$NK_TYPE[0]=\"AXIS_ROT\"")),
+              fmt::format("CNCCOMP_KINCHAIN.SPF:{}: AX3 is axis Z of machine 'controllers-siemens-components', which is linear",
+                          test::lineOf(chain, "$NK_NAME[0]=")));
+    // Missing chain file; unknown file.
+    std::vector<OutputFile> noChain;
+    for (const auto& f : r.files)
+        if (f.name != siemens::kChainFile) noChain.push_back(f);
+    EXPECT_EQ(messageOf([&] { siemens().apply(m, noChain); }),
+              "CNCCOMP_KINCHAIN.SPF: missing: the kinematic chain file is needed for TRAORI");
+    std::vector<OutputFile> extra = r.files;
+    extra.push_back({"NOTES.TXT", "hello"});
+    EXPECT_NE(messageOf([&] { siemens().apply(m, extra); }).find("NOTES.TXT: not a siemens-840d file"), std::string::npos);
+    // Binary content.
+    EXPECT_NE(withFile(siemens::kCecFile, std::string("%_N_NC_CEC_INI\n\x01\x02\n")).find("binary content"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cnccomp::controllers

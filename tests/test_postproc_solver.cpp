@@ -1,0 +1,160 @@
+// The endpoint solver of the post-processor against the foundation's solveToolPose (an independent Newton on
+// the unregularised problem), at singular poses (tool axis parallel to a rotary axis), with --tip-only, and
+// for the all-zero deviation set.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "cnccomp/io/machine_xml.hpp"
+#include "postproc/correction.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp::pp {
+namespace {
+
+DeviationSet randomDeviations(const MachineModel& m, int seed) {
+    DeviationSet d(m);
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (const auto& def : m.deviations) d.set(def.name, def.isAngle() ? u(rng) * 20 * kArcsec : u(rng) * 0.02);
+    return d;
+}
+
+AxisVector poseAwayFromSingularities(const MachineModel& m, std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(-1, 1);
+    AxisVector q(m.axisCount());
+    for (int i = 0; i < m.axisCount(); ++i) {
+        const Link& l = m.axisLink(i);
+        if (l.kind == AxisKind::Rotary) {
+            const double v = u(rng);
+            q[i] = (0.35 + 0.5 * std::fabs(v)) * (v < 0 ? -1 : 1);  // 20°..49°, away from 0
+        } else {
+            q[i] = u(rng) * 150.0 + (m.axisNames[i] == "Z" ? 300 : 0);
+        }
+    }
+    return q;
+}
+
+class PostprocSolver : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(PostprocSolver, AgreesWithSolveToolPoseAwayFromSingularities) {
+    const MachineModel m = readMachineXml(test::sourcePath(std::string("samples/machines/") + GetParam() + ".xml"));
+    const DeviationSet d = randomDeviations(m, 7);
+    const Corrector corrector(m, d);
+    const Kinematics nominal(m), actual(m, d);
+    std::mt19937_64 rng(3);
+    for (int trial = 0; trial < 20; ++trial) {
+        const AxisVector q = poseAwayFromSingularities(m, rng);
+        const double L = 120.0;
+        AxisVector qStar;
+        const SolveResult s = corrector.solve(q, L, q, qStar);
+        ASSERT_TRUE(s.converged);
+        const Vec3 tip = nominal.toolPoint(L);
+        const ToolPose target = toolPose(nominal, q, tip);
+        const ToolPose reached = toolPose(actual, qStar, tip);
+        EXPECT_LT((reached.tip - target.tip).norm(), 1e-6) << "tip, trial " << trial;  // mm
+        EXPECT_LT((reached.axis - target.axis).norm(), 2e-8) << "axis, trial " << trial;  // rad
+        const IkResult ref = solveToolPose(actual, target, tip, q);
+        ASSERT_TRUE(ref.converged);
+        for (int i = 0; i < m.axisCount(); ++i)
+            EXPECT_NEAR(qStar[i], ref.q[i], m.axisLink(i).kind == AxisKind::Rotary ? 1e-7 : 2e-5)
+                << GetParam() << " axis " << m.axisNames[i];
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Machines, PostprocSolver, ::testing::Values("multitasking", "tilting-head-b", "table-table-ac"));
+
+TEST(PostprocSolverSingular, ToolAxisParallelToCKeepsCBoundedAndTheTipExact) {
+    // Multitasking machine at B = 0: the tool axis is parallel to C; a tilt of the spindle about X (aBT) cannot be
+    // corrected there. The exact problem would spin C; the regularised one matches the tip and leaves C alone.
+    const MachineModel& m = test::multitasking();
+    DeviationSet d(m);
+    d.set("aBT", 6.5 * kArcsec);
+    d.set("dxBT", 0.012);
+    const Corrector corrector(m, d);
+    const Kinematics nominal(m), actual(m, d);
+    AxisVector q = AxisVector::Zero(m.axisCount());
+    q[m.requireAxis("X")] = 30;
+    q[m.requireAxis("Z")] = 150;
+    for (double bDeg : {0.0, 1e-4, 0.01}) {
+        q[m.requireAxis("B")] = bDeg * kDeg;
+        AxisVector qStar;
+        const SolveResult s = corrector.solve(q, 100.0, q, qStar);
+        ASSERT_TRUE(s.converged) << bDeg;
+        const Vec3 tip = nominal.toolPoint(100.0);
+        EXPECT_LT((toolPose(actual, qStar, tip).tip - toolPose(nominal, q, tip).tip).norm(), 1e-6) << bDeg;
+        EXPECT_LT(std::fabs(qStar[m.requireAxis("C")] - q[m.requireAxis("C")]), 1e-3) << bDeg;  // rad
+        EXPECT_LT(s.axisError, 7 * kArcsec);
+    }
+}
+
+TEST(PostprocSolverSingular, TipOnlyKeepsRotaryCommands) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = randomDeviations(m, 9);
+    CorrectorOptions o;
+    o.tipOnly = true;
+    const Corrector corrector(m, d, o);
+    std::mt19937_64 rng(4);
+    const AxisVector q = poseAwayFromSingularities(m, rng);
+    AxisVector qStar;
+    ASSERT_TRUE(corrector.solve(q, 80.0, q, qStar).converged);
+    for (int i = 0; i < m.axisCount(); ++i)
+        if (m.axisLink(i).kind == AxisKind::Rotary) {
+            EXPECT_EQ(qStar[i], q[i]);
+        }
+    EXPECT_LT(corrector.tipDeviation(q, qStar, 80.0), 1e-6);
+}
+
+TEST(PostprocSolverSingular, ZeroDeviationsAreTheIdentity) {
+    const MachineModel& m = test::multitasking();
+    const Corrector corrector(m, DeviationSet(m));
+    EXPECT_TRUE(corrector.identity());
+    std::mt19937_64 rng(1);
+    const AxisVector q = poseAwayFromSingularities(m, rng);
+    AxisVector qStar;
+    corrector.solve(q, 50.0, q + AxisVector::Constant(m.axisCount(), 0.1), qStar);
+    EXPECT_TRUE(qStar == q);
+}
+
+TEST(PostprocSplit, RotaryMovesAreSplitUntilMidpointsMeetTheTolerance) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = randomDeviations(m, 12);
+    CorrectorOptions o;
+    o.toleranceMm = 0.5e-3;
+    const Corrector corrector(m, d, o);
+    AxisVector a = AxisVector::Zero(m.axisCount()), b = a;
+    a[m.requireAxis("X")] = 40, a[m.requireAxis("Z")] = 150;
+    b[m.requireAxis("X")] = -40, b[m.requireAxis("Z")] = 160, b[m.requireAxis("B")] = 40 * kDeg,
+    b[m.requireAxis("C")] = 300 * kDeg;
+    AxisVector qa, qb;
+    corrector.solve(a, 100, a, qa);
+    corrector.solve(b, 100, b, qb);
+    std::vector<Piece> pieces;
+    SplitStats stats;
+    const MovePath path = MovePath::line(a, b);
+    corrector.split(path, qa, qb, 100, true, pieces, stats);
+    ASSERT_GT(pieces.size(), 2u);
+    EXPECT_FALSE(stats.limited);
+    EXPECT_DOUBLE_EQ(pieces.back().t, 1.0);
+    // Independent re-check of every piece's midpoint (and a quarter point, which the splitter never looked at).
+    AxisVector prev = qa, qn;
+    double prevT = 0, worst = 0;
+    for (const Piece& p : pieces) {
+        for (double f : {0.25, 0.5, 0.75}) {
+            path.at(prevT + f * (p.t - prevT), qn);
+            worst = std::max(worst, corrector.tipDeviation(qn, prev + f * (p.q - prev), 100));
+        }
+        prev = p.q;
+        prevT = p.t;
+    }
+    EXPECT_LT(worst, 0.5e-3 * 1.2);
+    // Without subdivision the same move is far off.
+    std::vector<Piece> one;
+    SplitStats single;
+    corrector.split(path, qa, qb, 100, false, one, single);
+    EXPECT_EQ(one.size(), 1u);
+    EXPECT_GT(single.maxDeviation, 5e-3);
+}
+
+}  // namespace
+}  // namespace cnccomp::pp
