@@ -34,7 +34,7 @@ bool BlockEdits::add(uint32_t begin, uint32_t end, std::string_view text) {
             return false;
         }
         at = used_;
-        std::memcpy(arena_.data() + used_, text.data(), text.size());
+        if (!text.empty()) std::memcpy(arena_.data() + used_, text.data(), text.size());
         used_ += text.size();
     }
     edits_[count_] = {begin, end, static_cast<uint32_t>(at), static_cast<uint32_t>(text.size()),

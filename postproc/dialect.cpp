@@ -91,11 +91,7 @@ DetectedDialect detectDialect(std::string_view head) {
         if (contains(c, "G65") || contains(c, "M98") || contains(c, "G43.4") || contains(c, "G43.5") ||
             contains(c, "G68.2") || contains(c, "G53.1"))
             clue(kFanuc, "Fanuc macro call or TCP code");
-        for (size_t i = 0; i + 1 < c.size(); ++i)
-            if (c[i] == '#' && std::isdigit(static_cast<unsigned char>(c[i + 1]))) {
-                clue(kFanuc, "#number macro variable");
-                break;
-            }
+        // #100 numbered variables exist in Fanuc macros and in RS274NGC alike: no clue.
         if (contains(c, "#<") || (c.front() == 'O' && c.size() > 1 && c[1] == '<') || contains(c, " SUB") ||
             contains(c, "ENDSUB") || contains(c, "G43.1") || contains(c, "G64 P"))
             clue(kNgc, "RS274NGC named parameter or o-word");

@@ -24,7 +24,8 @@ struct DetectedDialect {
 };
 
 /// Looks at the first bytes of a program: ;FLAVOR: / M104 / M109 / E words → printer; %_N_ / TRAORI / CYCLE… →
-/// Sinumerik; O-number program header or G65 / M98 / #100 macro variables → Fanuc; #<name> / o-words → RS274NGC.
+/// Sinumerik; O-number program header or G65 / M98 / G43.4 → Fanuc; #<name> / o-words → RS274NGC. Numbered
+/// variables (#100) exist in both Fanuc and RS274NGC and decide nothing.
 /// Ambiguous (clues of two families) or no clue → RS274NGC with certain = false.
 DetectedDialect detectDialect(std::string_view head);
 

@@ -115,7 +115,6 @@ private:
     AxisMask outKnown_ = 0, all_ = 0;
     Motion outMotion_ = Motion::Unknown;
     std::vector<Piece> pieces_;
-    std::string_view text_;
     bool inLong_ = false;
     bool warnedDecimals_ = false;
     std::string lastEol_ = "\n";
@@ -125,9 +124,10 @@ void ProgramCorrector::notice(bool warning, uint64_t line, std::string message) 
     auto& list = warning ? summary_.warnings : summary_.passThrough;
     if (warning) ++summary_.warningCount;
     if (options_.report) {
+        // Plain CSV without quoting (as every CSV of the project): commas in messages become semicolons.
         std::string m = message;
-        for (size_t p = 0; (p = m.find('"', p)) != std::string::npos; p += 2) m.insert(p, 1, '"');
-        *options_.report << line << ',' << (warning ? "warning" : "pass-through") << ",\"" << m << "\"\n";
+        std::replace(m.begin(), m.end(), ',', ';');
+        *options_.report << line << ',' << (warning ? "warning" : "pass-through") << ',' << m << '\n';
     }
     if (list.size() < CorrectSummary::kMaxNotices) list.push_back({line, std::move(message)});
 }
@@ -241,10 +241,12 @@ bool ProgramCorrector::axisWord(int a, double q, int existing, char* text, size_
             return false;
         }
     } else if (absolute && (outKnown_ & bit)) {
+        // A word the block does not have is added only for a change of at least one output digit: a dead band
+        // that keeps corrections at the rounding level from flickering in and out of every block.
         const double held = (outPos_[a] - off) / scale;
-        if (std::fabs(diff(pv, held)) < 0.5 * res) return false;
+        if (std::fabs(diff(pv, held)) < res * (1.0 - 1e-9)) return false;
     } else if (!absolute) {
-        if (std::fabs(pv) < 0.5 * res) return false;
+        if (std::fabs(pv) < res * (1.0 - 1e-9)) return false;
     }
     if (absolute) outPos_[a] = wrap ? q + diff(readBack, pv) * scale : readBack * scale + off;
     else outPos_[a] += readBack * scale;
@@ -590,7 +592,6 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
 
 void ProgramCorrector::line(const Line& ln, uint64_t no) {
     if (!ln.partial || !inLong_) ++summary_.lines;  // the pieces of an overlong line count as one line
-    text_ = ln.text;
     if (ln.partial) {
         out_.write(ln.text);
         out_.write(ln.eol);

@@ -15,6 +15,7 @@
 
 #include "cnccomp/inverse_kinematics.hpp"
 #include "controllers/common/evaluate.hpp"
+#include "cnccomp/io/machine_xml.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::test {
@@ -42,6 +43,63 @@ inline DeviationSet randomLocationErrors(const MachineModel& m, unsigned seed, d
     std::uniform_real_distribution<double> u(-1, 1);
     for (const auto& def : m.deviations)
         if (def.kind == DeviationKind::Location) d.set(def.name, def.isAngle() ? u(rng) * arcsec * kArcsec : u(rng) * um * kUm);
+    return d;
+}
+
+/// A machine whose table moves (X under a C table) while the column carries Y, Z and a swivel B head: linear
+/// axes on both chains, to check signs of the table-side trims. Location errors incl. squareness of the table X
+/// slide, and component errors of the table X.
+inline MachineModel tableXMachine() {
+    static const char* xml = R"(<?xml version="1.0"?>
+<machine name="table-x" description="test: X moves the table, C on it; Y Z B on the column">
+  <workpiece>
+    <axis name="X" type="linear" direction="1 0 0" min="-400" max="400"/>
+    <axis name="C" type="rotary" direction="0 0 1" min="-3600" max="3600" modulo="true"/>
+  </workpiece>
+  <tool direction="0 0 -1">
+    <axis name="Y" type="linear" direction="0 1 0" min="-300" max="300"/>
+    <axis name="Z" type="linear" direction="0 0 1" min="-200" max="500"/>
+    <axis name="B" type="rotary" direction="0 1 0" min="-110" max="110"/>
+    <fixed name="S" offset="0 0 -120"/>
+  </tool>
+  <deviations>
+    <location name="EC0X" link="X" component="c" description="squareness of the table X to the column Y"/>
+    <location name="EB0X" link="X" component="b" description="squareness of the table X to Z"/>
+    <location name="EA0Z" link="Z" component="a" description="squareness Y to Z"/>
+    <location name="EX0C" link="C" component="x"/>
+    <location name="EY0C" link="C" component="y"/>
+    <location name="EA0C" link="C" component="a"/>
+    <location name="EX0B" link="B" component="x"/>
+    <location name="EZ0B" link="B" component="z"/>
+    <location name="EC0B" link="B" component="c"/>
+    <location name="EX0S" link="S" component="x"/>
+    <component name="EXX" link="X" component="x" basis="polynomial" order="2"/>
+    <component name="EYX" link="X" component="y" basis="polynomial" order="2"/>
+    <component name="EZX" link="X" component="z" basis="polynomial" order="1"/>
+  </deviations>
+</machine>
+)";
+    ScratchDir dir("table-x");
+    writeText(dir.file("table-x.xml"), xml);
+    return readMachineXml(dir.file("table-x.xml"));
+}
+
+/// tableXMachine() with every deviation set: location errors patterned, component coefficients fixed.
+inline DeviationSet tableXErrors(const MachineModel& m) {
+    DeviationSet d(m);
+    int i = 0;
+    for (const auto& def : m.deviations) {
+        const int di = static_cast<int>(&def - m.deviations.data());
+        if (def.kind == DeviationKind::Location) {
+            const double v = (i % 2 ? -1.0 : 1.0) * (6.0 + 2.0 * i);
+            d.set(def.name, def.isAngle() ? v * kArcsec : v * kUm);
+            ++i;
+            continue;
+        }
+        d.values[def.offset] = (def.name == "EXX" ? 25.0 : def.name == "EYX" ? -15.0 : 10.0) * 1e-6;  // 25 um/m ...
+        if (def.size() > 1) d.values[def.offset + 1] = (def.name == "EXX" ? 2e-8 : -3e-8);          // mm per mm^2
+        d.present[di] = 1;
+    }
     return d;
 }
 

@@ -86,6 +86,18 @@ TEST(ControllerHeidenhain, MultitaskingTruthResidualBelowTenPercent) {
     EXPECT_LT(f.maxAfter, 1e-5);  // the rows describe the erroneous chain exactly (rounded to 1e-9 mm / 1e-10 deg)
 }
 
+// Linear axes on both chains: the table X's squareness and straightness trim the column's axes (and back).
+TEST(ControllerHeidenhain, TableSideLinearAxis) {
+    const MachineModel m = test::tableXMachine();
+    const DeviationSet d = test::tableXErrors(m);
+    const EmitResult r = tnc().emit({m, d, "table-x", "2024-01-01"});
+    EXPECT_TRUE(r.notCompensated.empty());
+    const CompensationFigures f = test::evaluateBackend(tnc(), m, d, test::nonSingularSamples(m, 4), 100.0);
+    test::report("heidenhain-tnc table-x (table-side X)", f);
+    EXPECT_GT(f.maxBefore, 0.02);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+}
+
 TEST(ControllerHeidenhain, SampleMachinesRandomLocationErrors) {
     for (const char* name : {"tilting-head-b", "table-table-ac"}) {
         const MachineModel m = readMachineXml(sourcePath(std::string("samples/machines/") + name + ".xml"));

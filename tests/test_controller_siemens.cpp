@@ -5,7 +5,7 @@
 #include <cmath>
 #include <map>
 #include <functional>
-#include <regex>
+#include <cstdio>
 #include <sstream>
 
 #include "cnccomp/error.hpp"
@@ -66,6 +66,18 @@ TEST(ControllerSiemens, MultitaskingTruthResidualBelowTenPercent) {
     EXPECT_GT(f.maxBefore, 0.02);
     EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
     EXPECT_LT(f.maxAfter, 2e-4);  // second-order terms of the CEC straight lines only
+}
+
+// Linear axes on both chains: the table X's squareness and straightness trim the column's axes (and back).
+TEST(ControllerSiemens, TableSideLinearAxis) {
+    const MachineModel m = test::tableXMachine();
+    const DeviationSet d = test::tableXErrors(m);
+    const EmitResult r = siemens().emit({m, d, "table-x", "2024-01-01"});
+    EXPECT_TRUE(r.notCompensated.empty());
+    const CompensationFigures f = test::evaluateBackend(siemens(), m, d, test::nonSingularSamples(m, 4), 100.0);
+    test::report("siemens-840d table-x (table-side X)", f);
+    EXPECT_GT(f.maxBefore, 0.02);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
 }
 
 TEST(ControllerSiemens, SampleMachinesRandomLocationErrors) {
@@ -134,20 +146,20 @@ TEST(ControllerSiemens, CecMinMaxStepMatchThePointCount) {
     const std::string& text = file(r, siemens::kCecFile).content;
     std::map<int, int> count;
     std::map<int, double> step, mn, mx;
-    const std::regex point(R"(^\$AN_CEC\[(\d+),(\d+)\]=(-?\d+\.\d+)$)");
-    const std::regex field(R"(^\$AN_CEC_(STEP|MIN|MAX)\[(\d+)\]=(-?\d+\.\d+)$)");
     std::istringstream in(text);
     std::string line;
-    std::map<int, int> lastIndex;
     while (std::getline(in, line)) {
-        std::smatch mt;
-        if (std::regex_match(line, mt, point)) {
-            const int t = std::stoi(mt[1]), n = std::stoi(mt[2]);
+        int t = -1, n = -1;
+        double v = 0;
+        char field[8] = {};
+        if (std::sscanf(line.c_str(), "$AN_CEC[%d,%d]=%lf", &t, &n, &v) == 3) {
             EXPECT_EQ(n, count[t]) << "points of table " << t << " are numbered in order";
             ++count[t];
-        } else if (std::regex_match(line, mt, field)) {
-            const int t = std::stoi(mt[2]);
-            (mt[1] == "STEP" ? step : mt[1] == "MIN" ? mn : mx)[t] = std::stod(mt[3]);
+        } else if (std::sscanf(line.c_str(), "$AN_CEC_%4[A-Z][%d]=%lf", field, &t, &v) == 3) {
+            const std::string f(field);
+            if (f == "STEP") step[t] = v;
+            if (f == "MIN") mn[t] = v;
+            if (f == "MAX") mx[t] = v;
         }
     }
     ASSERT_GE(count.size(), 5u);  // X->Y, X->Z, Y->X or Y->Z, Y->Z, C->X, C->Y, B->X, B->Z ...

@@ -17,7 +17,7 @@ namespace {
 
 struct Trials {
     int covered = 0, total = 0;
-    double lsqSquared = 0, closedSquared = 0, refinedSquared = 0;  ///< Σ error² over the 12 closed-form deviations
+    double lsqSquared = 0, closedSquared = 0;  ///< Σ error² over the 12 closed-form deviations
     int lsqBetter = 0, trials = 0;
 };
 
@@ -50,35 +50,29 @@ TEST(LsqNoise, IntervalsCoverTruthAndLeastSquaresBeatsClosedForm) {
         }
         const auto rows = eccentricitiesFromTraces(m, runs, traces);
         const DeviationSet formulas = identifyClosedForm(m, rows, ClosedFormOptions{0, 10.0});
-        const DeviationSet refined = identifyClosedForm(m, rows, ClosedFormOptions{3, 10.0});
-        double lsq = 0, cf = 0, rf = 0;
+        double lsq = 0, cf = 0;
         for (const std::string& n : twelve) {
             const double unit = m.deviations[m.deviationIndex(n)].isAngle() ? kArcsec : kUm;
             const auto sq = [&](double v) { return (v - truth.get(n)) / unit * (v - truth.get(n)) / unit; };
             lsq += sq(r.deviations.get(n));
             cf += sq(formulas.get(n));
-            rf += sq(refined.get(n));
         }
         t.lsqSquared += lsq;
         t.closedSquared += cf;
-        t.refinedSquared += rf;
         t.lsqBetter += lsq < cf ? 1 : 0;
         ++t.trials;
     }
     const double coverage = static_cast<double>(t.covered) / t.total;
     const double rmsLsq = std::sqrt(t.lsqSquared / (12.0 * t.trials));
     const double rmsClosed = std::sqrt(t.closedSquared / (12.0 * t.trials));
-    const double rmsRefined = std::sqrt(t.refinedSquared / (12.0 * t.trials));
     RecordProperty("coverage", std::to_string(coverage));
     RecordProperty("rms_error_lsq", std::to_string(rmsLsq));
     RecordProperty("rms_error_closed_form", std::to_string(rmsClosed));
-    RecordProperty("rms_error_closed_form_refined", std::to_string(rmsRefined));
-    std::printf("coverage %.4f  RMS error (um|arcsec): least squares %.4f, closed form %.4f, refined %.4f; "
-                "least squares better in %d/%d trials\n", coverage, rmsLsq, rmsClosed, rmsRefined, t.lsqBetter, t.trials);
+    std::printf("coverage %.4f  RMS error (um|arcsec): least squares %.4f, closed form %.4f; "
+                "least squares better in %d/%d trials\n", coverage, rmsLsq, rmsClosed, t.lsqBetter, t.trials);
     EXPECT_GE(coverage, 0.90);
     EXPECT_LE(coverage, 0.99);  // intervals are not uselessly wide either
     EXPECT_LT(rmsLsq, rmsClosed);
-    EXPECT_LT(rmsLsq, rmsRefined);
 }
 
 TEST(LsqNoise, MonteCarloAgreesWithLinearisedCovariance) {
@@ -95,16 +89,16 @@ TEST(LsqNoise, MonteCarloAgreesWithLinearisedCovariance) {
         for (double& v : traces.back().dL) v += noise(rng);
     }
     IdentifyOptions o;
-    o.monteCarlo = 300;
+    o.monteCarlo = 120;
     o.seed = 11;
     const IdentificationResult r = identify(m, ballbarObservations(m, runs, traces), o);
-    EXPECT_EQ(r.report.monteCarloSamples, 300);
+    EXPECT_EQ(r.report.monteCarloSamples, 120);
     for (const ParameterEstimate& p : r.report.parameters) {
-        // 300 samples: the sampled standard deviation is within ±20 % of the linearised one (4σ of its spread).
-        EXPECT_NEAR(p.mcStddev / p.stddev, 1.0, 0.2) << p.name;
+        // 120 samples: the sampled standard deviation is within ±25 % of the linearised one (≈ 4σ of its spread).
+        EXPECT_NEAR(p.mcStddev / p.stddev, 1.0, 0.25) << p.name;
         EXPECT_LT(p.mcLower95, p.value);
         EXPECT_GT(p.mcUpper95, p.value);
-        EXPECT_NEAR((p.mcUpper95 - p.mcLower95) / (p.upper95 - p.lower95), 1.0, 0.3) << p.name;
+        EXPECT_NEAR((p.mcUpper95 - p.mcLower95) / (p.upper95 - p.lower95), 1.0, 0.35) << p.name;
     }
     // Same seed, same answer.
     const IdentificationResult again = identify(m, ballbarObservations(m, runs, traces), o);

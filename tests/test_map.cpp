@@ -130,6 +130,12 @@ TEST(Map, FixedOrientationSolvesTheNominalInverse) {
     MapRequest r = req(m, d, "X=-100:100:50 Y=-100:100:50 Z=0:60:30", 120.0, k);
     const VolumetricMap map = computeMap(r);
     EXPECT_EQ(map.stats.failed, 0);
+    // One branch of the inverse for the whole grid: the orientation fixes A and C on a table-table machine.
+    for (const MapPoint& p : map.points) {
+        EXPECT_TRUE(p.ok);
+        EXPECT_NEAR(p.q[m.requireAxis("A")], map.points[0].q[m.requireAxis("A")], 1e-9);
+        EXPECT_NEAR(p.q[m.requireAxis("C")], map.points[0].q[m.requireAxis("C")], 1e-9);
+    }
     const Kinematics nominal(m), actual(m, d);
     const Vec3 tip = nominal.toolPoint(120.0);
     for (size_t i = 0; i < map.points.size(); ++i) {

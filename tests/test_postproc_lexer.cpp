@@ -201,6 +201,7 @@ TEST(PostprocDialect, DetectsUnambiguousProgramsOnly) {
     EXPECT_EQ(detectDialect("%_N_PART_MPF\nN10 G0 X1\n").dialect, Dialect::Sinumerik);
     EXPECT_EQ(detectDialect("%\nO1234 (PART)\nG0 X1.\n").dialect, Dialect::Fanuc);
     EXPECT_EQ(detectDialect("#<depth> = 3\nG1 Z#<depth>\n").dialect, Dialect::Rs274ngc);
+    EXPECT_FALSE(detectDialect("#1 = 3\nG1 Z#1\n").certain);  // numbered parameters: both families
     const DetectedDialect plain = detectDialect("G0 X1 Y2\nG1 Z-1 F100\n");
     EXPECT_EQ(plain.dialect, Dialect::Rs274ngc);
     EXPECT_FALSE(plain.certain);

@@ -153,7 +153,7 @@ TEST(PostprocSplit, RotaryMovesAreSplitUntilMidpointsMeetTheTolerance) {
     SplitStats single;
     corrector.split(path, qa, qb, 100, false, one, single);
     EXPECT_EQ(one.size(), 1u);
-    EXPECT_GT(single.maxDeviation, 5e-3);
+    EXPECT_GT(single.maxDeviation, 2 * 0.5e-3);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include "controllers/fanuc/fanuc_backend.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include <fmt/format.h>
@@ -31,12 +32,14 @@ EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
         if (def.kind != DeviationKind::Location) continue;
         const Link& l = m.chain(def.side).links[def.link];
         if (def.isAngle()) {
+            const bool zero = l.kind == AxisKind::Rotary && std::abs(Vec3::Unit(def.component - 3).dot(l.direction)) > 1 - 1e-9;
             r.notCompensated.push_back(
                 {def.name, l.kind == AxisKind::Linear
                                ? "squareness: the 30i TCP takes orthogonal linear axes (straightness/3-D compensation "
                                  "parameters not public [G])"
-                               : "orientation / zero position of an axis: the 30i TCP parameters hold no tilt of a "
-                                 "rotary axis or of the spindle"});
+                           : zero ? "zero position of a rotary axis: no TCP parameter (shift its reference position, "
+                                    "parameter 1850, by hand [G])"
+                                  : "tilt of a rotary axis or of the spindle: the 30i TCP parameters hold none"});
             continue;
         }
         std::string where;

@@ -88,6 +88,7 @@ void run(const Options& o) {
     const PlanProposal p = proposePlan(m, po);
 
     fmt::print("{} of {} candidate runs fit machine '{}'\n", p.candidates - p.rejected.size(), p.candidates, m.name);
+    for (const std::string& s : p.rejected) fmt::print("  rejected {}\n", s);
     for (const std::string& s : p.steps) fmt::print("  {}\n", s);
     if (!p.complete) {
         fmt::print("the candidates cannot identify the whole request (rank {}/{}); the plan below is the best found\n",
@@ -103,7 +104,9 @@ void run(const Options& o) {
             fmt::print("{:<8} {:<6} {:>12}  {:<40} {}\n", n.name, n.alias, fmt::format("{:.4f} {}", n.sigmaPerUm, unit),
                        joined(n.needs), joined(n.seenBy));
         else
-            fmt::print("{:<8} {:<6} {:>12}  confounded with {}\n", n.name, n.alias, "NOT IDENTIFIED", joined(n.confoundedWith));
+            fmt::print("{:<8} {:<6} {:>12}  {}\n", n.name, n.alias, "NOT IDENTIFIED",
+                       n.confoundedWith.empty() ? std::string("unobservable on its own")
+                                                : "confounded with " + joined(n.confoundedWith));
     }
     if (!p.others.empty()) fmt::print("deviations not requested:\n");
     for (const ExtraAdvice& a : p.others) {

@@ -95,7 +95,8 @@ void prepare(Plan& p) {
             cc /= starts;
         }
         const IkResult s = solveToolPose(p.nominal, centre, p.tipInTool, q0);
-        if (!s.converged) continue;
+        const ToolPose got = toolPose(p.nominal, s.q, p.tipInTool);
+        if (!s.converged || (got.tip - centre.tip).norm() > 1e-6 || (got.axis - centre.axis).norm() > 1e-8) continue;
         bool inside = true;
         for (int a = 0; a < m.axisCount(); ++a) {
             const Link& l = m.axisLink(a);
@@ -127,9 +128,22 @@ void evaluate(const Plan& p, long index, MapPoint& out) {
         ToolPose t;
         t.axis = r.toolOrientation->normalized();
         for (size_t i = 0; i < r.grid.axes.size(); ++i) t.tip[p.target[i]] = r.grid.axes[i].value(idx[i]);
-        const IkResult s = solveToolPose(p.nominal, t, p.tipInTool, p.start);
+        // Modulo axes are brought back to the turn of the start (the same pose); one retry from there when Newton
+        // wandered off.
+        const auto unwrap = [&](AxisVector& x) {
+            for (int a = 0; a < x.size(); ++a)
+                if (r.machine.axisLink(a).modulo) x[a] -= 2 * kPi * std::round((x[a] - p.start[a]) / (2 * kPi));
+        };
+        IkResult s = solveToolPose(p.nominal, t, p.tipInTool, p.start);
+        unwrap(s.q);
+        if (!s.converged) {
+            s = solveToolPose(p.nominal, t, p.tipInTool, s.q);
+            unwrap(s.q);
+        }
         q = s.q;
-        if (!s.converged) out.ok = false;
+        // Accept only a pose that is met (the solver's "converged" means the iteration settled).
+        const ToolPose got = toolPose(p.nominal, q, p.tipInTool);
+        if (!s.converged || (got.tip - t.tip).norm() > 1e-6 || (got.axis - t.axis).norm() > 1e-8) out.ok = false;
         for (int a = 0; a < q.size() && out.ok; ++a) {
             const Link& l = r.machine.axisLink(a);
             if (q[a] < l.min - 1e-9 || q[a] > l.max + 1e-9) out.ok = false;

@@ -3,6 +3,7 @@
 // on the multitasking machine. Reports lines/s and bytes/s; memory use does not depend on the program size
 // (fixed read and write buffers; the output goes to a counting sink).
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -23,9 +24,20 @@ constexpr int kLines = 1'000'000;
 
 /// A 5-axis finishing program: small steps along a tilted contour with B and C moving on every block
 /// (4 decimals in mm, 3 in degrees), as CAM output for the multitasking machine looks.
+/// The generated program lives in the system temp folder for the run and is removed at exit.
+struct TempProgram {
+    std::string path;
+    ~TempProgram() {
+        std::error_code ec;
+        if (!path.empty()) std::filesystem::remove(path, ec);
+    }
+};
+
 const std::string& programPath() {
+    static TempProgram program;
     static const std::string path = [] {
-        const std::string p = (std::filesystem::temp_directory_path() / "cnccomp-bench-5axis.ngc").string();
+        const std::string p =
+            (std::filesystem::temp_directory_path() / ("cnccomp-bench-5axis-" + std::to_string(::getpid()) + ".ngc")).string();
         std::FILE* f = std::fopen(p.c_str(), "wb");
         if (!f) return p;
         std::fprintf(f, "(benchmark program: %d lines)\nG21 G90 G17 G94\nG0 X50.0000 Y0.0000 Z40.0000 B0.000 C0.000\nG1 Z12.0000 F800.\n", kLines);
@@ -36,6 +48,7 @@ const std::string& programPath() {
                          10.0 + 2.0 * std::sin(2 * r), 20.0 + 10.0 * std::sin(2 * r), std::fmod(c, 3600.0));
         }
         std::fclose(f);
+        program.path = p;
         return p;
     }();
     return path;

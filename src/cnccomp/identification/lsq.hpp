@@ -5,6 +5,7 @@
 // Levenberg–Marquardt by default, NLopt as an alternative for bounded problems; the result carries a report
 // with identifiability (named confounded combinations), covariance, 95 % intervals and optional Monte Carlo.
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,7 +18,7 @@ namespace cnccomp {
 /// Bounds of one unknown for bounded solvers, internal units.
 struct ParameterBound {
     std::string name;  ///< ISO name, alias, "NAME[k]" or nuisance name
-    double lower = -kNaN, upper = kNaN;
+    double lower = -std::numeric_limits<double>::infinity(), upper = std::numeric_limits<double>::infinity();
 };
 
 struct IdentifyOptions {

@@ -195,7 +195,9 @@ PlanProposal proposePlan(const MachineModel& m, const PlannerOptions& o) {
                         }
                     }
     }
-    if (cands.empty()) throw ModelError(fmt::format("no candidate run fits machine '{}'", m.name));
+    if (cands.empty())
+        throw ModelError(fmt::format("no candidate run fits machine '{}'{}", m.name,
+                                     out.rejected.empty() ? "" : " (e.g. " + out.rejected.front() + ")"));
 
     // ---- Greedy selection over the requested columns.
     const Columns target = columnsOf(m, o.identify);

@@ -103,7 +103,7 @@ EllipseFit fitEllipseAlgebraic(const std::vector<Vec2>& points) {
         const Vec2 q = (points[static_cast<size_t>(i)] - m) / s;
         D.row(i) << q.x() * q.x(), q.x() * q.y(), q.y() * q.y(), q.x(), q.y(), 1.0;
     }
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeThinV);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeFullV);  // full: five points give a 5 × 6 matrix
     const Eigen::VectorXd u = svd.matrixV().col(5);
     const double A = u[0], B = u[1], C = u[2], Dx = u[3], Ey = u[4], F = u[5];
     Eigen::Matrix2d M;

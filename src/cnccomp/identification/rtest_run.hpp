@@ -24,7 +24,7 @@ struct RtestRun {
     Vec3 ballOffset = Vec3::Zero();   ///< actual minus nominal ball centre (mounting error, simulation), mm
     bool estimateBall = false;        ///< identification: the ball offset is a nuisance parameter (3 values)
 
-    /// Throws ModelError for non-finite geometry, fewer than 2 steps, duplicate axes or no moving axis.
+    /// Throws ModelError for non-finite geometry, steps outside 1 .. 10⁶, an axis given twice or no moving axis.
     void validate() const;
     /// Number of poses.
     int sampleCount() const;
