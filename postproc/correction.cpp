@@ -285,9 +285,9 @@ ArcFit Corrector::fitArc(const MovePath& path, const AxisVector& outStart, const
 
 void Corrector::splitArc(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
                          std::vector<Piece>& pieces, SplitStats& stats) const {
-    // Chords whose sagitta stays below a quarter of the tolerance.
+    // Chords whose sagitta stays below half the tolerance; the midpoint checks split further where needed.
     const double r = std::max(path.r0, path.r1);
-    const double tol = options_.toleranceMm * 0.25;
+    const double tol = options_.toleranceMm * 0.5;
     int chords = 1;
     if (r > tol) {
         const double maxAngle = 2.0 * std::acos(1.0 - tol / r);

@@ -390,7 +390,7 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, s.axisError);
         if (!s.converged || !(s.tipError < 1e-5)) {
             ++summary_.unconverged;
-            notice(true, no, fmt::format("the correction did not converge (tip residual {:.3g} um); block written unchanged",
+            notice(true, no, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
                                          s.tipError / kUm));
             qEnd_ = r_.end;
         } else {
@@ -425,6 +425,11 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         const MovePath path = MovePath::arc(r_.start, r_.end, r_.arc);
         const bool closed = std::hypot(r_.end[r_.arc.axis0] - r_.start[r_.arc.axis0],
                                        r_.end[r_.arc.axis1] - r_.start[r_.arc.axis1]) < 1e-12;
+        if (closed && !identity) {
+            // A full circle must end exactly where the controller starts it, digit for digit.
+            qEnd_[r_.arc.axis0] = outStart[r_.arc.axis0];
+            qEnd_[r_.arc.axis1] = outStart[r_.arc.axis1];
+        }
         fit = corrector_.fitArc(path, outStart, qEnd_, L, closed);
         if (fit.ok || r_.stop) {
             if (!fit.ok)
