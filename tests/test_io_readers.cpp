@@ -56,6 +56,27 @@ TEST(MachineXml, MalformedAndInconsistentFilesNameFileAndLine) {
     expectInputError([&] { readMachineXml(dir.file("missing.xml")); }, {"missing.xml", "cannot open"});
 }
 
+TEST(MachineXml, MachineZeroConvertsBetweenCommandsAndControllerCoordinates) {
+    test::ScratchDir dir("machine-zero");
+    const std::string p = dir.file("m.xml");
+    test::writeText(p, "<machine name=\"x\">\n<workpiece>\n<axis name=\"C\" type=\"rotary\" direction=\"0 0 1\" machine-zero=\"90\"/>\n"
+                       "</workpiece>\n<tool>\n<axis name=\"X\" type=\"linear\" direction=\"1 0 0\" machine-zero=\"-250\"/>\n"
+                       "</tool>\n</machine>\n");
+    const MachineModel m = readMachineXml(p);
+    EXPECT_TRUE(m.hasMachineZero());
+    AxisVector q(2);
+    q[m.requireAxis("C")] = 0.0;
+    q[m.requireAxis("X")] = 10.0;
+    const AxisVector c = m.toController(q);
+    EXPECT_NEAR(c[m.requireAxis("C")], -90.0 * kDeg, 1e-15);  // command 0 reads -90 deg on the controller
+    EXPECT_NEAR(c[m.requireAxis("X")], 260.0, 1e-12);         // command 10 mm is 260 mm from the controller's zero
+    EXPECT_LT((m.fromController(c) - q).norm(), 1e-12);
+    EXPECT_FALSE(test::multitasking().hasMachineZero());
+    test::writeText(p, "<machine name=\"x\">\n<tool>\n<axis name=\"X\" type=\"linear\" direction=\"1 0 0\" machine-zero=\"abc\"/>\n"
+                       "</tool>\n</machine>\n");
+    expectInputError([&] { readMachineXml(p); }, {p + ":3", "machine-zero"});
+}
+
 TEST(DeviationCsv, RoundTripInMicronsAndArcsecWithAliases) {
     const MachineModel& m = test::multitasking();
     const DeviationSet truth = readDeviationCsv(test::sourcePath("samples/deviations/multitasking-truth.csv"), m);

@@ -56,6 +56,25 @@ double ComponentBasis::evaluate(double q, const double* coef, bool moduloAxis) c
     return 0.0;
 }
 
+AxisVector MachineModel::toController(const AxisVector& q) const {
+    AxisVector p = q;
+    for (int i = 0; i < axisCount() && i < p.size(); ++i) p[i] -= axisLink(i).machineZero;
+    return p;
+}
+
+AxisVector MachineModel::fromController(const AxisVector& p) const {
+    AxisVector q = p;
+    for (int i = 0; i < axisCount() && i < q.size(); ++i) q[i] += axisLink(i).machineZero;
+    return q;
+}
+
+bool MachineModel::hasMachineZero() const {
+    for (const Chain* c : {&workpiece, &tool})
+        for (const Link& l : c->links)
+            if (l.axisIndex >= 0 && l.machineZero != 0.0) return true;
+    return false;
+}
+
 int MachineModel::axisIndex(std::string_view axis) const {
     for (int i = 0; i < axisCount(); ++i)
         if (axisNames[i] == axis) return i;

@@ -29,6 +29,10 @@ struct Link {
     double max = std::numeric_limits<double>::infinity();
     bool modulo = false;               ///< rotary axis that wraps at 360°
     int axisIndex = -1;                ///< index into AxisVector; -1 for fixed links
+    /// Where the controller's machine zero is on this axis: the command (mm or rad, in this description's frame) at
+    /// which the controller's machine coordinate of the axis reads 0. Controller position = command − machineZero.
+    /// Default 0: the commands of the description are the controller's machine coordinates.
+    double machineZero = 0.0;
 };
 
 struct Chain {
@@ -94,6 +98,12 @@ public:
     int deviationIndex(std::string_view nameOrAlias) const;
     /// Total length of the flat deviation vector.
     int parameterCount() const;
+    /// The controller's machine coordinates of commands q (command − machineZero, per axis; mm and rad).
+    AxisVector toController(const AxisVector& q) const;
+    /// Commands of this description from the controller's machine coordinates p (p + machineZero).
+    AxisVector fromController(const AxisVector& p) const;
+    /// True when some axis has a non-zero machineZero.
+    bool hasMachineZero() const;
     /// Fill axisNames/axisIndex/offsets and check consistency; throws ModelError.
     void finalize();
 };

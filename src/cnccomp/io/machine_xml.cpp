@@ -42,6 +42,7 @@ Link readLink(const XMLElement& e, const std::string& path) {
         if (!(l.min <= l.max)) xml::fail(e, path, "min must not exceed max");
         l.modulo = xml::boolean(e, path, "modulo", false);
         if (l.modulo && l.kind != AxisKind::Rotary) xml::fail(e, path, "only a rotary axis can be modulo");
+        l.machineZero = xml::number(e, path, "machine-zero", 0.0) * unit;
     } else {
         xml::fail(e, path, "expected <axis> or <fixed>");
     }
