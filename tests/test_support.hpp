@@ -7,8 +7,9 @@
 
 namespace cnccomp::test {
 
-inline std::string sourcePath(const std::string& rel) { return std::string(CNCCOMP_SOURCE_DIR) + "/" + rel; }
-inline std::string sharedPath(const std::string& rel) { return std::string(CNCCOMP_SHARED_DIR) + "/" + rel; }
+/// A file of the source tree / of ../shared (paths fixed at configure time, defined in test_support_impl.cpp only).
+std::string sourcePath(const std::string& rel);
+std::string sharedPath(const std::string& rel);
 inline const MachineModel& multitasking() {
     static const MachineModel m = readMachineXml(sourcePath("samples/machines/multitasking.xml"));
     return m;

@@ -9,6 +9,9 @@
 
 namespace cnccomp::test {
 
+std::string sourcePath(const std::string& rel) { return std::string(CNCCOMP_SOURCE_DIR) + "/" + rel; }
+std::string sharedPath(const std::string& rel) { return std::string(CNCCOMP_SHARED_DIR) + "/" + rel; }
+
 ScratchDir::ScratchDir(const std::string& tag) {
     std::random_device rd;
     path = std::filesystem::temp_directory_path() / ("cnccomp-" + tag + "-" + std::to_string(rd()));
