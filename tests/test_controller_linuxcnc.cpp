@@ -112,6 +112,28 @@ TEST(ControllerLinuxcnc, TrtFormulasInvertAndPinsReproduceTheExactTable) {
     EXPECT_NEAR(n.zOffset, 60, 1e-12);
 }
 
+TEST(ControllerLinuxcnc, Linuxcnc210XyzbcInverseDiffersAsTheFilesSay) {
+    // Transcription of xyzbcKinematicsInverse of LinuxCNC master (2.10, trtfuncs.c with conventional-directions = 0,
+    // the default): the same rotation as 2.9, dpx = −cos(B)·dx + sin(B)·dz + dx, dpz = −sin(B)·dx − cos(B)·dz + dz.
+    // README.txt of an xyzbc emit says the joints differ from 2.9's by 2·|sin B|·(z-offset + tool-offset) in X and
+    // 2·|sin B|·|x-offset| in Z: checked here against the 2.9 transcription (trt_kins.cpp), signs included.
+    using namespace linuxcnc;
+    const TrtPins p{205, -330, -470, -15, 0, 60, 100};
+    for (double b : {-80.0, -20.0, 35.0})
+        for (double c : {-400.0, 30.0}) {
+            const TrtPose w{{12, -34, 56}, b, c};
+            const double br = b * kDeg, cr = c * kDeg, con = -1;
+            const double x = w.xyz[0] - p.xRotPoint, y = w.xyz[1] - p.yRotPoint, z = w.xyz[2] - p.zRotPoint;
+            const double dx = p.xOffset, dz = p.zOffset + p.toolOffset;
+            const double dpx = -std::cos(br) * dx + std::sin(br) * dz + dx, dpz = -std::sin(br) * dx - std::cos(br) * dz + dz;
+            const double mx = std::cos(cr) * std::cos(br) * x + con * std::sin(cr) * std::cos(br) * y - con * std::sin(br) * z + dpx + p.xRotPoint;
+            const double mz = con * std::cos(cr) * std::sin(br) * x + std::sin(cr) * std::sin(br) * y + std::cos(br) * z + dpz + p.zRotPoint;
+            const TrtPose j = trtInverse(TrtType::BC, p, w);
+            EXPECT_NEAR(mx - j.xyz[0], 2 * std::sin(br) * dz, 1e-9);
+            EXPECT_NEAR(mz - j.xyz[2], -2 * std::sin(br) * dx, 1e-9);
+        }
+}
+
 TEST(ControllerLinuxcnc, PinsInTheDescriptionsFrameWouldMissByTensOfMillimetres) {
     // What the review found: pins in the machine-XML frame, blind to the tool-side offset. Rewrite cnccomp.hal that
     // way and the apply model (the LinuxCNC transcription) puts the tip tens of mm off; the emitted pins do not.
@@ -391,7 +413,7 @@ TEST(ControllerLinuxcnc, EmitCommandWritesFilesAndNeverAnInput) {
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("NOT compensated:"), std::string::npos);
     EXPECT_NE(r.out.find("EB0A"), std::string::npos);
-    for (const char* f : {"X.comp", "C.comp", "cnccomp.ini", "cnccomp.hal", "README.txt"})
+    for (const char* f : {"X.comp", "C.comp", "cnccomp.ini", "cnccomp.hal", "cnccomp-g54.ngc", "README.txt"})
         EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("out/") + f))) << f;
     // The deviation file sits where README.txt would go: nothing is written.
     std::filesystem::create_directories(dir.file("in"));

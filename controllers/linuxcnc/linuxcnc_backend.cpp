@@ -69,7 +69,7 @@ std::string readme(const LinuxcncPlan& plan, const std::string& module, const st
     if (plan.trt && *plan.trt == TrtType::BC)
         r += "Do NOT load on LinuxCNC 2.10/master: its xyzbc-trt-kins inverse (conventional-directions = 0) uses the opposite\n"
              "sign of sin(B) in its x-offset / z-offset + tool-offset terms, so the joints differ from 2.9's by up to\n"
-             "2*|sin B|*(z-offset + tool length) in X and 2*|sin B|*|x-offset| in Z.\n";
+             "2*|sin B|*|z-offset + tool length| in X and 2*|sin B|*|x-offset| in Z.\n";
     r += "\nHow to merge\n"
          "1. Tables: copy the .comp files into the folder of your machine INI (COMP_FILE names are relative to it).\n"
          "   They hold no comment lines: LinuxCNC stops reading a table at the first line that is not three numbers.\n"

@@ -217,7 +217,12 @@ std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& j
     fs::remove(out);
     std::string env = "env -u DISPLAY CNCCOMP_JOB=" + shellQuote(jobFile.string()) + " CNCCOMP_OUT=" + shellQuote(out.string());
     if (geteuid() == 0) {
-        // rtapi_app refuses root: it runs as 'nobody' and needs a fifo folder that user can write.
+        // rtapi_app refuses root: it runs as 'nobody' and needs a fifo folder that user can reach and write
+        // (whatever the umask made of the folders above it).
+        const auto open = fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                          fs::perms::others_exec;
+        fs::permissions(c.dir, open);
+        fs::permissions(c.dir.parent_path(), open);
         const fs::path fifo = c.dir / "rtapi";
         fs::create_directories(fifo);
         fs::permissions(fifo, fs::perms::all | fs::perms::sticky_bit);
