@@ -3,7 +3,8 @@
 
 LinuxCNC starts it as `driver.py -ini <ini>`; the run ends when it exits. It turns the machine on, homes every joint
 and then works through the job file ($CNCCOMP_JOB), one command per line:
-    mdi <G-code>     one MDI block; waits until the interpreter is idle and motion is in position
+    mdi <G-code>     one MDI block; waits until the interpreter is idle and motion is in position (a "G0 <words>"
+                     block also until the commanded position has reached its words)
     record <label>   waits until every joint's comp filter has reached its target (backlash-filt == backlash-corr,
                      at most 1 s) and writes one line to $CNCCOMP_OUT:
                      <label> <settled 0|1> <motion.tooloffset.z> then, per joint, joint.N.pos-cmd, then
@@ -51,10 +52,21 @@ def wait(predicate, timeout, what):
     raise RuntimeError("timeout waiting for " + what)
 
 
+def arrived(targets):
+    # stat.position: the commanded position motion works with = program + G5x offset + tool offset (no G92, no
+    # rotation in these jobs), so the move is over once it equals the block's words with those offsets.
+    return all(abs(stat.position[i] - (v + stat.g5x_offset[i] + stat.tool_offset[i])) < 1e-6 for i, v in targets)
+
+
 def mdi(block):
+    # A move's block names its target: waiting for "idle, in position, empty queue" alone can return before motion
+    # has picked the move up on a loaded machine.
+    words = block.split()
+    targets = [("XYZABCUVW".index(w[0]), float(w[1:])) for w in words[1:]] if words[0] == "G0" else []
     command.mdi(block)
     command.wait_complete(30)
-    wait(lambda: stat.interp_state == linuxcnc.INTERP_IDLE and stat.inpos and stat.queue == 0, 60, block)
+    wait(lambda: stat.interp_state == linuxcnc.INTERP_IDLE and stat.inpos and stat.queue == 0 and arrived(targets),
+         60, block)
     check_errors(block)
 
 
