@@ -76,6 +76,8 @@ std::string readme(const LinuxcncPlan& plan, const std::string& module, const st
          "   Nominals are joint positions (machine coordinates, from machine zero; mm, deg); the trims are deltas added\n"
          "   to the joint command. A table covers the joint's whole travel of the machine description: LinuxCNC looks it\n"
          "   up at the raw joint position (no modulo, also with WRAPPED_ROTARY = 1) and holds the end values beyond it.\n"
+         "   A joint takes its trim while it moves (forward column moving +, reverse moving -) and keeps it while it\n"
+         "   stands; after homing the trim is 0 until the joint's first move (control.c compute_screw_comp).\n"
          "2. INI: copy every KEY = value of cnccomp.ini into the section of the same name of your machine INI, replacing\n"
          "   the key where it is already there; keep everything else (limits, homing, scales).\n"
          "   BACKLASH: LinuxCNC does not apply [JOINT_n] BACKLASH to a joint with a COMP_FILE (ini-config.adoc).\n"
