@@ -1,5 +1,7 @@
-// LinuxCNC backend: trt kinematics formulas against the exact model, emit → apply on the erroneous machine
-// (≥ 90 % less tip error for what the backend claims), table format rules, goldens parsed back, readers, CLI.
+// LinuxCNC backend: trt pins against the exact model (LinuxCNC's frame, tool-side offsets, machine-zero, tool lengths),
+// emit → apply on the erroneous machine (≥ 90 % less tip error for what the backend claims, C beyond ±360°), table
+// rules (travel coverage, 256 lines, LinuxCNC's lookup), goldens parsed back, readers, CLI. The real LinuxCNC is the
+// oracle of tests/linuxcnc (a test program of its own).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,6 +20,7 @@
 #include "controllers/linuxcnc/comp_table.hpp"
 #include "controllers/linuxcnc/config_files.hpp"
 #include "controllers/linuxcnc/linuxcnc_plan.hpp"
+#include "test_support.hpp"
 #include "test_controller_common_support.hpp"
 
 namespace cnccomp::controllers {
@@ -27,9 +30,25 @@ using namespace testing;
 
 const std::vector<Sample> kSamples = {{"multitasking", "multitasking-truth"},
                                       {"controllers-table-table-ac", "controllers-table-table-ac"},
-                                      {"controllers-tilting-head-b", "controllers-tilting-head-b"}};
+                                      {"controllers-tilting-head-b", "controllers-tilting-head-b"},
+                                      {"table-table-bc", "table-table-bc-truth"}};
 
 EmitResult emitSample(const Sample& s, const DeviationSet& d) { return testing::emitSample("linuxcnc", s, d); }
+
+/// Workspace samples, and the same again with every modulo axis two turns up and three turns down (LinuxCNC looks
+/// its tables up at the raw joint position: C = 725° is not C = 5°).
+std::vector<AxisVector> samplesWithTurns(const MachineModel& m, int perAxis) {
+    std::vector<AxisVector> out = workspaceSamples(m, perAxis);
+    const size_t n = out.size();
+    for (double turns : {2.0, -3.0})
+        for (size_t i = 0; i < n; ++i) {
+            AxisVector q = out[i];
+            for (int a = 0; a < m.axisCount(); ++a)
+                if (m.axisLink(a).modulo) q[a] += turns * 2 * kPi;
+            out.push_back(q);
+        }
+    return out;
+}
 
 TEST(ControllerLinuxcnc, TrtFormulasInvertAndPinsReproduceTheExactTable) {
     using namespace linuxcnc;
@@ -41,33 +60,101 @@ TEST(ControllerLinuxcnc, TrtFormulasInvertAndPinsReproduceTheExactTable) {
                 const TrtPose back = trtInverse(t, pins, trtForward(t, pins, j));
                 for (int k = 0; k < 3; ++k) EXPECT_NEAR(back.xyz[k], j.xyz[k], 1e-10);
             }
-    // Pins from the pivot deviations: trtfuncs' forward of the joints is the tip in the erroneous table frame,
-    // shifted by the rotation point (the LinuxCNC world frame coincides with the joints at A = C = 0).
-    const MachineModel& m = machine("table-table-ac");
-    ASSERT_EQ(matchTrt(m), TrtType::AC);
+    EXPECT_EQ(matchTrt(machine("table-table-ac")), TrtType::AC);
+    EXPECT_EQ(matchTrt(machine("table-table-bc")), TrtType::BC);
     EXPECT_FALSE(matchTrt(machine("multitasking")));
     EXPECT_FALSE(matchTrt(machine("tilting-head-b")));
-    DeviationSet d(m);
-    d.set("EY0A", 0.03);
-    d.set("EZ0A", -0.02);
-    d.set("EX0C", 0.015);
-    d.set("EY0C", -0.025);
-    const TrtPins p = trtPins(m, TrtType::AC, &d);
-    const Kinematics k(m, d);
-    for (double a : {-1.2, 0.0, 0.7})
-        for (double c : {-2.5, 0.4, 3.0}) {
-            AxisVector q(m.axisCount());
-            q[m.requireAxis("A")] = a;
-            q[m.requireAxis("C")] = c;
-            q[m.requireAxis("X")] = 120;
-            q[m.requireAxis("Y")] = -75;
-            q[m.requireAxis("Z")] = 210;
-            const Vec3 tip = k.toolPointInWorkpiece(q, Vec3::Zero());
-            const TrtPose w = trtForward(TrtType::AC, p, {{120, -75, 210}, a / kDeg, c / kDeg});
-            EXPECT_NEAR(w.xyz[0], tip.x() + p.xRotPoint, 1e-11);
-            EXPECT_NEAR(w.xyz[1], tip.y() + p.yRotPoint, 1e-11);
-            EXPECT_NEAR(w.xyz[2], tip.z() + p.zRotPoint, 1e-11);
+    // Oracle: the exact kinematics. With the pins in LinuxCNC's frame, trtfuncs' forward of the joint positions
+    // (machine coordinates from machine zero, tool-offset = tool length) is the tool tip in the erroneous workpiece
+    // frame plus the G54 of cnccomp-g54.ngc plus the tool offset (0, 0, L), for every pose and tool length: so the
+    // module turns about the real axis lines, the tool-side offsets and machine-zero included (table-table-bc has
+    // a spindle offset of 10 20 30 mm and machine-zero 50 410 560 mm).
+    struct Case {
+        std::string machine, tilt;
+        std::vector<std::pair<std::string, double>> errors;
+    };
+    for (const Case& cs : {Case{"table-table-ac", "A", {{"EY0A", 0.03}, {"EZ0A", -0.02}, {"EX0C", 0.015}, {"EY0C", -0.025}}},
+                           Case{"table-table-bc", "B", {{"EX0B", 0.03}, {"EZ0B", -0.02}, {"EX0C", 0.015}, {"EY0C", -0.025}}}}) {
+        const MachineModel& m = machine(cs.machine);
+        const TrtType type = *matchTrt(m);
+        DeviationSet d(m);
+        for (const auto& [name, v] : cs.errors) d.set(name, v);
+        const Kinematics k(m, d);
+        const Vec3 g54 = trtWorkOffset(m, &d);
+        const int ax = m.requireAxis("X"), ay = m.requireAxis("Y"), az = m.requireAxis("Z"), at = m.requireAxis(cs.tilt),
+                  ac = m.requireAxis("C");
+        for (double length : {0.0, 80.0})
+            for (double tilt : {-1.2, 0.0, 0.7})
+                for (double c : {-12.5, 0.4, 7.0}) {
+                    AxisVector q(m.axisCount());
+                    q[at] = tilt;
+                    q[ac] = c;
+                    q[ax] = 120;
+                    q[ay] = 75;
+                    q[az] = 210;
+                    const AxisVector j = m.toController(q);
+                    TrtPins p = trtPins(m, type, &d);
+                    p.toolOffset = length;
+                    const TrtPose w = trtForward(type, p, {{j[ax], j[ay], j[az]}, j[at] / kDeg, j[ac] / kDeg});
+                    const Vec3 tip = k.toolPointInWorkpiece(q, k.toolPoint(length));
+                    EXPECT_NEAR(w.xyz[0], tip.x() + g54.x(), 1e-10) << cs.machine;
+                    EXPECT_NEAR(w.xyz[1], tip.y() + g54.y(), 1e-10) << cs.machine;
+                    EXPECT_NEAR(w.xyz[2], tip.z() + g54.z() + length, 1e-10) << cs.machine;
+                }
+    }
+    // The nominal pins of table-table-bc in LinuxCNC's frame, by hand from its description: C line through
+    // (250 + 15, 100 + 0, 180 − 60) of the bed, tool reference point at joint 0: (10, 20, 30) + (50, 410, 560).
+    const TrtPins n = trtPins(machine("table-table-bc"), TrtType::BC, nullptr);
+    EXPECT_NEAR(n.xRotPoint, 205, 1e-12);
+    EXPECT_NEAR(n.yRotPoint, -330, 1e-12);
+    EXPECT_NEAR(n.zRotPoint, -470, 1e-12);
+    EXPECT_NEAR(n.xOffset, -15, 1e-12);
+    EXPECT_NEAR(n.zOffset, 60, 1e-12);
+}
+
+TEST(ControllerLinuxcnc, Linuxcnc210XyzbcInverseDiffersAsTheFilesSay) {
+    // Transcription of xyzbcKinematicsInverse of LinuxCNC master (2.10, trtfuncs.c with conventional-directions = 0,
+    // the default): the same rotation as 2.9, dpx = −cos(B)·dx + sin(B)·dz + dx, dpz = −sin(B)·dx − cos(B)·dz + dz.
+    // README.txt of an xyzbc emit says the joints differ from 2.9's by 2·|sin B|·(z-offset + tool-offset) in X and
+    // 2·|sin B|·|x-offset| in Z: checked here against the 2.9 transcription (trt_kins.cpp), signs included.
+    using namespace linuxcnc;
+    const TrtPins p{205, -330, -470, -15, 0, 60, 100};
+    for (double b : {-80.0, -20.0, 35.0})
+        for (double c : {-400.0, 30.0}) {
+            const TrtPose w{{12, -34, 56}, b, c};
+            const double br = b * kDeg, cr = c * kDeg, con = -1;
+            const double x = w.xyz[0] - p.xRotPoint, y = w.xyz[1] - p.yRotPoint, z = w.xyz[2] - p.zRotPoint;
+            const double dx = p.xOffset, dz = p.zOffset + p.toolOffset;
+            const double dpx = -std::cos(br) * dx + std::sin(br) * dz + dx, dpz = -std::sin(br) * dx - std::cos(br) * dz + dz;
+            const double mx = std::cos(cr) * std::cos(br) * x + con * std::sin(cr) * std::cos(br) * y - con * std::sin(br) * z + dpx + p.xRotPoint;
+            const double mz = con * std::cos(cr) * std::sin(br) * x + std::sin(cr) * std::sin(br) * y + std::cos(br) * z + dpz + p.zRotPoint;
+            const TrtPose j = trtInverse(TrtType::BC, p, w);
+            EXPECT_NEAR(mx - j.xyz[0], 2 * std::sin(br) * dz, 1e-9);
+            EXPECT_NEAR(mz - j.xyz[2], -2 * std::sin(br) * dx, 1e-9);
         }
+}
+
+TEST(ControllerLinuxcnc, PinsInTheDescriptionsFrameWouldMissByTensOfMillimetres) {
+    // What the review found: pins in the machine-XML frame, blind to the tool-side offset. Rewrite cnccomp.hal that
+    // way and the apply model (the LinuxCNC transcription) puts the tip tens of mm off; the emitted pins do not.
+    const Sample& s = kSamples[3];
+    const MachineModel& m = machine(s.machine);
+    const DeviationSet d = deviations(s);
+    const EmitResult r = emitSample(s, d);
+    const auto samples = workspaceSamples(m, 3);
+    const DeviationSet claimed = claimedOnly(d, r);
+    const CompensationFigures good = evaluateCompensation(m, claimed, *backend("linuxcnc").apply(m, r.files), samples, 50.0);
+    EXPECT_LT(good.maxAfter, 1e-4);
+    std::vector<OutputFile> wrong = r.files;
+    for (OutputFile& f : wrong)
+        if (f.name == "cnccomp.hal") {
+            const linuxcnc::TrtPins p = *linuxcnc::parseHal(f.content, f.name, "xyzbc-trt-kins");
+            f.content = fmt::format("setp xyzbc-trt-kins.x-rot-point {}\nsetp xyzbc-trt-kins.y-rot-point {}\n"
+                                    "setp xyzbc-trt-kins.z-rot-point {}\nsetp xyzbc-trt-kins.x-offset {}\nsetp xyzbc-trt-kins.z-offset {}\n",
+                                    p.xRotPoint + 60, p.yRotPoint + 430, p.zRotPoint + 590, p.xOffset, p.zOffset);
+        }
+    const CompensationFigures bad = evaluateCompensation(m, claimed, *backend("linuxcnc").apply(m, wrong), samples, 50.0);
+    EXPECT_GT(bad.maxAfter, 10.0);
 }
 
 TEST(ControllerLinuxcnc, CompensatesWhatItClaimsByAtLeastNinetyPercent) {
@@ -78,7 +165,7 @@ TEST(ControllerLinuxcnc, CompensatesWhatItClaimsByAtLeastNinetyPercent) {
         const EmitResult r = emitSample(s, all);
         ASSERT_FALSE(r.compensated.empty()) << s.machine;
         const DeviationSet claimed = claimedOnly(all, r);
-        const auto samples = workspaceSamples(m, 5);
+        const auto samples = samplesWithTurns(m, 5);
         const CompensationFigures f = emitApplyEvaluate(b, m, claimed, samples, 100.0);
         const CompensationFigures g = emitApplyEvaluate(b, m, all, samples, 100.0);
         std::cout << fmt::format("[linuxcnc] {:<28} claimed: max {:8.3f} -> {:7.3f} um, rms {:7.3f} -> {:6.3f} um | "
@@ -87,6 +174,7 @@ TEST(ControllerLinuxcnc, CompensatesWhatItClaimsByAtLeastNinetyPercent) {
                                  g.maxBefore / kUm, g.maxAfter / kUm, f.points);
         EXPECT_GT(f.maxBefore, 5 * kUm) << s.machine;
         EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore) << s.machine;
+        EXPECT_LT(f.maxAfter, 0.05 * kUm) << s.machine;  // exact up to the tables' interpolation
         EXPECT_LT(g.maxAfter, g.maxBefore) << s.machine;
         // Every present deviation is listed exactly once.
         size_t present = 0;
@@ -118,16 +206,11 @@ TEST(ControllerLinuxcnc, TablesKeepTheLinuxcncRules) {
             }
             EXPECT_GE(rows.size(), 2u);
             EXPECT_LE(rows.size(), 256u) << f.name;
+            // The table covers the axis' whole travel in LinuxCNC's coordinates (command − machine-zero).
             const Link& l = m.axisLink(m.requireAxis(f.name.substr(0, f.name.size() - 5)));
-            if (l.modulo) {  // closes on itself over one turn
-                EXPECT_EQ(rows.front()[0], 0.0);
-                EXPECT_EQ(rows.back()[0], 360.0);
-                EXPECT_EQ(rows.front()[1], rows.back()[1]);
-                EXPECT_EQ(rows.front()[2], rows.back()[2]);
-            } else {
-                EXPECT_NEAR(rows.front()[0], l.min / (l.kind == AxisKind::Rotary ? kDeg : 1.0), 1e-6);
-                EXPECT_NEAR(rows.back()[0], l.max / (l.kind == AxisKind::Rotary ? kDeg : 1.0), 1e-6);
-            }
+            const double unit = l.kind == AxisKind::Rotary ? kDeg : 1.0;
+            EXPECT_NEAR(rows.front()[0], (l.min - l.machineZero) / unit, 1e-6) << f.name;
+            EXPECT_NEAR(rows.back()[0], (l.max - l.machineZero) / unit, 1e-6) << f.name;
         }
     }
     // A table over 256 lines is refused.
@@ -172,7 +255,12 @@ TEST(ControllerLinuxcnc, ReadersNameFileAndLine) {
     EXPECT_EQ(line([] { parseCompTable("0 0 0\n10 0 0\n10 0 0\n", "x.comp"); }), 3);
     EXPECT_EQ(line([] { parseCompTable("0 0 0\n# comment\n", "x.comp"); }), 2);
     EXPECT_EQ(line([] { parseCompTable("0 nan 0\n1 0 0\n", "x.comp"); }), 1);
-    EXPECT_EQ(line([] { parseIni("[KINS]\nKINEMATICS = trivkins coordinates=XYZ\n[JOINT_0]\nCOMP_FILE_TYPE = 0\n", "a.ini"); }), 4);
+    EXPECT_EQ(line([] { parseIni("[KINS]\nKINEMATICS = trivkins coordinates=XYZ\n[JOINT_0]\nCOMP_FILE_TYPE = 2\n", "a.ini"); }), 4);
+    EXPECT_EQ(line([] { parseWorkOffset("; c\nG10 L2 P1 X1 Y2\n", "g.ngc"); }), 2);
+    EXPECT_EQ(line([] { parseWorkOffset("G10 L2 P1 X1 Y2 Q3\n", "g.ngc"); }), 1);
+    EXPECT_EQ(line([] { parseWorkOffset("G10 L2 P1 X1 Y2 Zabc\n", "g.ngc"); }), 1);
+    EXPECT_EQ(line([] { parseWorkOffset("; only comments\nM2\n", "g.ngc"); }), 0);
+    EXPECT_EQ(parseWorkOffset("(x)\nG10 L2 P1 X1.5 Y-2 Z3 ; c\nM2\n", "g.ngc"), (std::array<double, 3>{1.5, -2, 3}));
     EXPECT_EQ(line([] { parseIni("[KINS]\nKINEMATICS trivkins\n", "a.ini"); }), 2);
     EXPECT_EQ(line([] { parseHal("setp xyzac-trt-kins.w-offset 1\n", "a.hal", "xyzac-trt-kins"); }), 1);
     EXPECT_EQ(line([] { parseHal("# ok\nsetp xyzac-trt-kins.y-offset one\n", "a.hal", "xyzac-trt-kins"); }), 2);
@@ -191,6 +279,124 @@ TEST(ControllerLinuxcnc, ReadersNameFileAndLine) {
     EXPECT_THROW(backend("linuxcnc").apply(machine(s.machine), other.files), InputError);
 }
 
+TEST(ControllerLinuxcnc, CompTableLookupFollowsLinuxcnc) {
+    // control.c compute_screw_comp / motion.c: forward column moving +, reverse moving −, linear in between, end
+    // values held beyond the ends, no modulo; usrmotintf.cc: type 0 holds actual positions (trim = nominal − value).
+    using namespace linuxcnc;
+    const CompTable t = parseCompTable("-10 0.01 -0.01\n0 0.02 0\n10 0.04 0.01\n", "t.comp");
+    EXPECT_DOUBLE_EQ(t.trim(5, 1), 0.03);
+    EXPECT_DOUBLE_EQ(t.trim(5, -1), 0.005);
+    EXPECT_DOUBLE_EQ(t.trim(5, 0), 0.0175);
+    EXPECT_DOUBLE_EQ(t.trim(-20, 1), 0.01);
+    EXPECT_DOUBLE_EQ(t.trim(-10, -1), -0.01);
+    EXPECT_DOUBLE_EQ(t.trim(10, 1), 0.04);
+    EXPECT_DOUBLE_EQ(t.trim(370, -1), 0.01);
+    const CompTable a = fromActualPositions(parseCompTable("0 0.001 -0.001\n100 100.002 99.999\n", "a.comp"));
+    EXPECT_NEAR(a.trim(0, 1), -0.001, 1e-15);
+    EXPECT_NEAR(a.trim(100, -1), 0.001, 1e-12);
+}
+
+/// A machine written into a scratch folder: C table (modulo, travel ±turns·360°) with a Fourier positioning
+/// error, X Y Z slides; `extra` goes into the A axis (e.g. machine-zero).
+MachineModel fourierMachine(const test::ScratchDir& dir, int turns, const std::string& extra = "") {
+    const std::string path = dir.file(fmt::format("m{}.xml", turns));
+    test::writeText(path, fmt::format(R"(<machine name="fourier">
+<workpiece>
+  <axis name="A" type="rotary" direction="1 0 0" min="-90" max="90" {}/>
+  <axis name="C" type="rotary" direction="0 0 1" min="-{}" max="{}" modulo="true"/>
+</workpiece>
+<tool direction="0 0 -1">
+  <axis name="X" type="linear" direction="1 0 0" min="-300" max="300"/>
+  <axis name="Y" type="linear" direction="0 1 0" min="-300" max="300"/>
+  <axis name="Z" type="linear" direction="0 0 1" min="-300" max="300"/>
+</tool>
+<deviations><component name="ECC" link="C" component="c" basis="fourier" order="2"/></deviations>
+</machine>
+)", extra, 360 * turns, 360 * turns));
+    return readMachineXml(path);
+}
+
+TEST(ControllerLinuxcnc, RotaryTablesCoverTheTravelAtASpacingThatDividesATurn) {
+    test::ScratchDir dir("linuxcnc-fourier");
+    for (int turns : {1, 10}) {
+        const MachineModel m = fourierMachine(dir, turns);
+        DeviationSet d(m);
+        const DeviationDef& ecc = m.deviations[m.deviationIndex("ECC")];
+        d.values.segment(ecc.offset, 4) << 8 * kArcsec, -5 * kArcsec, 3 * kArcsec, 2 * kArcsec;
+        d.present[m.deviationIndex("ECC")] = 1;
+        const EmitResult r = backend("linuxcnc").emit({m, d, "d.csv", "2024-01-01"});
+        const linuxcnc::CompTable t = linuxcnc::parseCompTable(requireFile(r.files, "C.comp", "test").content, "C.comp");
+        // ±360°: 3° (241 lines); ±3600°: 30° (241 lines); every point a multiple of the spacing, ends at the travel.
+        const double h = turns == 1 ? 3.0 : 30.0;
+        EXPECT_EQ(t.nominal.size(), static_cast<size_t>(2 * 360 * turns / h + 1));
+        for (double n : t.nominal) EXPECT_NEAR(std::remainder(n, h), 0.0, 1e-9) << n;
+        EXPECT_EQ(t.nominal.front(), -360.0 * turns);
+        EXPECT_EQ(t.nominal.back(), 360.0 * turns);
+        // The same trim every turn, at the raw position (7 turns apart as LinuxCNC sees them).
+        if (turns == 10) {
+            for (double c : {-2.5, 17.0, 133.3}) EXPECT_NEAR(t.trim(c + 7 * 360.0), t.trim(c), 1e-7) << c;
+        }
+        // The interpolation error is stated in every header.
+        EXPECT_NE(requireFile(r.files, "README.txt", "test").content.find("C.comp: 241 points"), std::string::npos);
+        EXPECT_NE(requireFile(r.files, "README.txt", "test").content.find("largest interpolation error"), std::string::npos);
+    }
+    // No finite travel: refused with the reason.
+    std::string xml = test::readText(dir.file("m1.xml"));
+    xml.replace(xml.find(R"(min="-360" max="360" )"), 21, "");
+    test::writeText(dir.file("inf.xml"), xml);
+    const MachineModel inf = readMachineXml(dir.file("inf.xml"));
+    DeviationSet di(inf);
+    di.values[inf.deviations[0].offset] = 1e-5;
+    di.present[0] = 1;
+    try {
+        backend("linuxcnc").emit({inf, di, "d.csv", "2024-01-01"});
+        FAIL() << "infinite travel accepted";
+    } catch (const ModelError& e) {
+        EXPECT_NE(std::string(e.what()).find("travel"), std::string::npos) << e.what();
+    }
+}
+
+TEST(ControllerLinuxcnc, TrtNeedsTheRotaryJointsZeroedWhereTheTableIsLevel) {
+    test::ScratchDir dir("linuxcnc-rotary-zero");
+    const MachineModel m = fourierMachine(dir, 1, R"(machine-zero="90")");
+    try {
+        backend("linuxcnc").emit({m, DeviationSet(m), "d.csv", "2024-01-01"});
+        FAIL() << "a tilt axis with machine-zero 90 accepted";
+    } catch (const ModelError& e) {
+        EXPECT_NE(std::string(e.what()).find("machine-zero"), std::string::npos) << e.what();
+    }
+}
+
+TEST(ControllerLinuxcnc, FilesSayVersionFrameBacklashAndHowToMerge) {
+    for (const Sample& s : kSamples) {
+        const EmitResult r = emitSample(s, deviations(s));
+        const bool trt = linuxcnc::matchTrt(machine(s.machine)).has_value();
+        for (const OutputFile& f : r.files) {
+            if (f.name.ends_with(".comp")) continue;
+            EXPECT_NE(f.content.find("LinuxCNC 2.9"), std::string::npos) << s.machine << "/" << f.name;
+            EXPECT_NE(f.content.find("ignores BACKLASH"), std::string::npos) << s.machine << "/" << f.name;
+            if (trt) {
+                EXPECT_NE(f.content.find("pins: ABSOLUTE, LinuxCNC's frame"), std::string::npos) << s.machine << "/" << f.name;
+            }
+        }
+        const std::string readme = requireFile(r.files, "README.txt", "test").content;
+        EXPECT_NE(readme.find("add +b/2 to every forward trim and -b/2 to every reverse trim"), std::string::npos) << s.machine;
+        const std::string ini = requireFile(r.files, "cnccomp.ini", "test").content;
+        EXPECT_EQ(ini.find("WRAPPED_ROTARY"), std::string::npos) << s.machine;  // tables cover the travel instead
+        size_t joints = 0, warnings = 0;
+        for (size_t at = 0; (at = ini.find("COMP_FILE = ", at)) != std::string::npos; ++at) ++joints;
+        for (size_t at = 0; (at = ini.find("does not apply BACKLASH to this joint", at)) != std::string::npos; ++at) ++warnings;
+        EXPECT_EQ(joints, warnings) << s.machine;
+        if (!trt) continue;
+        EXPECT_NE(readme.find("They REPLACE your values of exactly these pins"), std::string::npos);
+        EXPECT_NE(readme.find("x-rot-point y-rot-point z-rot-point"), std::string::npos);
+        EXPECT_NE(readme.find("add the listed deltas"), std::string::npos);
+        EXPECT_EQ(readme.find("2.10/master") != std::string::npos, *linuxcnc::matchTrt(machine(s.machine)) == linuxcnc::TrtType::BC);
+        const std::string hal = requireFile(r.files, "cnccomp.hal", "test").content;
+        EXPECT_NE(hal.find("# x-rot-point  nominal"), std::string::npos) << hal;
+    }
+}
+
 TEST(ControllerLinuxcnc, ImplausibleValuesAreRefused) {
     const MachineModel& m = machine("multitasking");
     DeviationSet d(m);
@@ -207,7 +413,7 @@ TEST(ControllerLinuxcnc, EmitCommandWritesFilesAndNeverAnInput) {
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("NOT compensated:"), std::string::npos);
     EXPECT_NE(r.out.find("EB0A"), std::string::npos);
-    for (const char* f : {"X.comp", "C.comp", "cnccomp.ini", "cnccomp.hal", "README.txt"})
+    for (const char* f : {"X.comp", "C.comp", "cnccomp.ini", "cnccomp.hal", "cnccomp-g54.ngc", "README.txt"})
         EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("out/") + f))) << f;
     // The deviation file sits where README.txt would go: nothing is written.
     std::filesystem::create_directories(dir.file("in"));

@@ -3,13 +3,22 @@
 set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config libeigen3-dev libnlopt-cxx-dev libtinyxml2-dev libfmt-dev libcli11-dev
           libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev)
-missing=()
+# Installed without their recommends: linuxcnc-uspace (the real LinuxCNC 2.9, the oracle of tests/linuxcnc) recommends
+# a real-time kernel, Qt and its documentation; the tests run only its simulator (34 MB download).
+lean=(linuxcnc-uspace)
+missing=(); missing_lean=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-if ((${#missing[@]})); then
-  echo "installing: ${missing[*]}"
+for p in "${lean[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing_lean+=("$p")
+done
+if ((${#missing[@]} + ${#missing_lean[@]})); then
+  echo "installing: ${missing[*]} ${missing_lean[*]}"
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"
+  if ((${#missing[@]})); then DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"; fi
+  if ((${#missing_lean[@]})); then
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing_lean[@]}"
+  fi
 fi

@@ -11,15 +11,27 @@
 
 namespace cnccomp::controllers::linuxcnc {
 
-double CompTable::trim(double p) const {
+double CompTable::trim(double p, int direction) const {
     const size_t n = nominal.size();
     if (n == 0) return 0.0;
-    const auto value = [&](size_t i) { return 0.5 * (forward[i] + reverse[i]); };
-    if (p <= nominal.front()) return value(0);
+    const auto value = [&](size_t i) {
+        return direction > 0 ? forward[i] : direction < 0 ? reverse[i] : 0.5 * (forward[i] + reverse[i]);
+    };
+    if (p < nominal.front()) return value(0);
     if (p >= nominal.back()) return value(n - 1);
+    // The entry with nominal <= p < next nominal; trim + slope · (p − nominal), slope from this entry to the next.
     const size_t i = static_cast<size_t>(std::upper_bound(nominal.begin(), nominal.end(), p) - nominal.begin()) - 1;
-    const double f = (p - nominal[i]) / (nominal[i + 1] - nominal[i]);
-    return value(i) + (value(i + 1) - value(i)) * f;
+    const double slope = (value(i + 1) - value(i)) / (nominal[i + 1] - nominal[i]);
+    return value(i) + slope * (p - nominal[i]);
+}
+
+CompTable fromActualPositions(const CompTable& t) {
+    CompTable out = t;
+    for (size_t i = 0; i < t.nominal.size(); ++i) {
+        out.forward[i] = t.nominal[i] - t.forward[i];
+        out.reverse[i] = t.nominal[i] - t.reverse[i];
+    }
+    return out;
 }
 
 std::string formatCompTable(const CompTable& t, const std::string& name) {
@@ -33,7 +45,7 @@ std::string formatCompTable(const CompTable& t, const std::string& name) {
             throw ModelError(fmt::format("{}: line {} is not finite", name, i + 1));
         if (i > 0 && !(t.nominal[i] > t.nominal[i - 1]))
             throw ModelError(fmt::format("{}: nominals must be strictly increasing (line {})", name, i + 1));
-        out += fmt::format("{} {} {}\n", fixed(t.nominal[i], 6), fixed(t.forward[i], 6), fixed(t.reverse[i], 6));
+        out += fmt::format("{} {} {}\n", fixed(t.nominal[i], 6), fixed(t.forward[i], 7), fixed(t.reverse[i], 7));
     }
     return out;
 }

@@ -12,11 +12,17 @@ namespace cnccomp::controllers::linuxcnc {
 inline constexpr int kMaxCompLines = 256;
 
 struct CompTable {
-    std::vector<double> nominal, forward, reverse;  ///< mm or deg
-    /// Trim at a commanded position: linear interpolation, ends held. LinuxCNC uses the forward column when the
-    /// joint moves in +, the reverse column in −; this model has no direction and takes their mean.
-    double trim(double position) const;
+    std::vector<double> nominal, forward, reverse;  ///< mm or deg; trims (type 1 meaning)
+    /// The trim LinuxCNC adds at a joint position (control.c compute_screw_comp): the forward column while the joint
+    /// moves in + (direction > 0), the reverse column in − (direction < 0); direction 0 = their mean (a model
+    /// without the direction). Linear interpolation between lines, the end values held beyond the ends (the table
+    /// sits between −DBL_MAX and +DBL_MAX sentinels with zero slope, motion.c), looked up at the raw position.
+    double trim(double position, int direction = 0) const;
 };
+
+/// The trims of a table read as COMP_FILE_TYPE 0 (columns are actual positions): trim = nominal − column
+/// (usrmotintf.cc usrmotLoadComp).
+CompTable fromActualPositions(const CompTable& type0);
 
 /// The file text; throws ModelError when the table breaks a LinuxCNC rule (lines, order, finite numbers).
 std::string formatCompTable(const CompTable& t, const std::string& name);

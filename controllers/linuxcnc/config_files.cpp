@@ -38,11 +38,9 @@ IniFragment parseIni(const std::string& text, const std::string& name) {
                 if (value.empty()) throw InputError(name, l.number, "COMP_FILE needs a file name");
                 ini.compFile[static_cast<int>(*n)] = value;
             } else if (key == "COMP_FILE_TYPE") {
-                if (value != "1") throw InputError(name, l.number, "this backend writes trims: COMP_FILE_TYPE must be 1");
+                if (value != "0" && value != "1") throw InputError(name, l.number, "COMP_FILE_TYPE must be 0 or 1");
+                ini.compType[static_cast<int>(*n)] = value == "1" ? 1 : 0;
             }
-        } else if (section.starts_with("AXIS_") && section.size() == 6 && key == "WRAPPED_ROTARY") {
-            if (value != "0" && value != "1") throw InputError(name, l.number, "WRAPPED_ROTARY must be 0 or 1");
-            ini.wrapped[section[5]] = value == "1";
         }
     }
     if (ini.kinematics.empty()) throw InputError(name, 0, "no [KINS] KINEMATICS line");
@@ -77,6 +75,27 @@ std::optional<TrtPins> parseHal(const std::string& text, const std::string& name
     }
     if (!any) return std::nullopt;
     return p;
+}
+
+std::array<double, 3> parseWorkOffset(const std::string& text, const std::string& name) {
+    std::optional<std::array<double, 3>> g54;
+    for (const TextLine& l : splitLines(text)) {
+        std::string_view s = trim(l.text);
+        if (const size_t semi = s.find(';'); semi != std::string_view::npos) s = trim(s.substr(0, semi));
+        if (s.empty() || (s.front() == '(' && s.back() == ')') || s == "M2" || s == "M30") continue;
+        const auto tok = tokens(s);
+        if (tok.size() != 6 || tok[0] != "G10" || tok[1] != "L2" || tok[2] != "P1")
+            throw InputError(name, l.number, "expected 'G10 L2 P1 X<mm> Y<mm> Z<mm>'");
+        std::array<double, 3> v{};
+        for (int k = 0; k < 3; ++k) {
+            const std::string_view w = tok[3 + k];
+            if (w.empty() || w.front() != "XYZ"[k]) throw InputError(name, l.number, fmt::format("expected the {} word", "XYZ"[k]));
+            v[k] = requireNumber(w.substr(1), name, l.number, fmt::format("a number after {}", "XYZ"[k]));
+        }
+        g54 = v;
+    }
+    if (!g54) throw InputError(name, 0, "no 'G10 L2 P1 X Y Z' line (the G54 work offset)");
+    return *g54;
 }
 
 }  // namespace cnccomp::controllers::linuxcnc

@@ -1,5 +1,7 @@
 #pragma once
-// The INI and HAL fragments of the LinuxCNC backend, and their readers (what the apply model takes from them).
+// The INI and HAL fragments and the work-offset program of the LinuxCNC backend, and their readers (what the apply
+// model takes from them).
+#include <array>
 #include <map>
 #include <optional>
 #include <string>
@@ -13,15 +15,19 @@ struct IniFragment {
     std::string kinematics;    ///< module name
     std::string coordinates;   ///< joint letters, e.g. XYZAC
     std::map<int, std::string> compFile;  ///< joint number → COMP_FILE
-    std::map<char, bool> wrapped;         ///< axis letter → WRAPPED_ROTARY
+    std::map<int, int> compType;          ///< joint number → COMP_FILE_TYPE (0 when not given, as inijoint.cc)
 };
 
 /// Parses `[SECTION]`, `KEY = value`, '#' / ';' comments. InputError(file:line) on anything else, on a
-/// COMP_FILE_TYPE other than 1, on a KINEMATICS line without coordinates=.
+/// COMP_FILE_TYPE other than 0 or 1, on a KINEMATICS line without coordinates=.
 IniFragment parseIni(const std::string& text, const std::string& name);
 
 /// The `setp <module>.<pin> <value>` lines of a HAL fragment; `net`/`loadrt`/comments ignored, anything else an error.
 /// Unknown pins of the module are errors. Returns nullopt when the fragment sets no pin.
 std::optional<TrtPins> parseHal(const std::string& text, const std::string& name, const std::string& module);
+
+/// The work offset a program sets with `G10 L2 P1 X… Y… Z…` (G54, mm); ';' and '(…)' comments, blank lines and M2
+/// allowed, anything else an error. InputError when no G10 L2 P1 line is there.
+std::array<double, 3> parseWorkOffset(const std::string& text, const std::string& name);
 
 }  // namespace cnccomp::controllers::linuxcnc

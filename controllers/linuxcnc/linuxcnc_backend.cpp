@@ -1,120 +1,120 @@
-// LinuxCNC backend: joint compensation tables (COMP_FILE_TYPE 1), INI and HAL fragments for the trt kinematics
-// pins, a README.txt; and the apply model that reads them back and moves like LinuxCNC (kinematics inverse with
-// the HAL pins, then the joint trims).
+// LinuxCNC backend (LinuxCNC 2.9): joint compensation tables (COMP_FILE_TYPE 1), INI and HAL fragments for the trt
+// kinematics pins (absolute, LinuxCNC's frame), the G54 of the workpiece origin, a README.txt that says how to merge
+// them; and the apply model (linuxcnc_apply.hpp) that reads them back and moves like LinuxCNC.
 #include <algorithm>
 #include <cmath>
-#include <set>
 
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
 #include "controllers/common/controller_model.hpp"
-#include "controllers/common/files.hpp"
 #include "controllers/common/header.hpp"
 #include "controllers/linuxcnc/comp_table.hpp"
-#include "controllers/linuxcnc/config_files.hpp"
+#include "controllers/linuxcnc/linuxcnc_apply.hpp"
 #include "controllers/linuxcnc/linuxcnc_plan.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
 namespace {
 
-constexpr const char* kIni = "cnccomp.ini";
-constexpr const char* kHal = "cnccomp.hal";
-constexpr const char* kReadme = "README.txt";
+std::string compFileName(const JointPlan& j) { return j.name + ".comp"; }
+std::string unitName(bool rotary) { return rotary ? "deg" : "mm"; }
 
-double unitScale(bool rotary) { return rotary ? 1.0 / kDeg : 1.0; }
+/// One joint's table: points over the travel, trims in LinuxCNC units, and the largest gap between the table's
+/// linear interpolation and the exact trim (checked at 8 points inside every interval).
+struct JointTable {
+    CompTable table;
+    double interpolationError = 0;  ///< mm or deg
+};
 
-/// Table nodes (internal units) of a joint: exact breakpoints of table-type component errors when they fit,
-/// otherwise 256 equidistant points; a modulo joint gets [0°, 360°] and closes on itself.
-std::vector<double> tableNodes(const MachineModel& m, const JointPlan& j) {
-    bool allTables = true;
-    std::set<double> nodes;
-    const Link& l = m.axisLink(j.axis);
-    for (const OwnComponent& c : j.components) {
-        const ComponentBasis& b = m.deviations[c.deviation].basis;
-        if (b.type != ComponentBasis::Type::Table) allTables = false;
-        for (double n : b.nodes) nodes.insert(n);
+JointTable jointTable(const MachineModel& m, const DeviationSet& d, const JointPlan& j) {
+    JointTable out;
+    const double unit = j.rotary ? kDeg : 1.0, limit = 5.0 * unit;
+    const std::vector<double> nodes = tableNodes(m, j);
+    for (double p : nodes) {
+        const double trim = jointTrim(m, d, j, p);
+        if (!std::isfinite(trim) || std::abs(trim) > limit)
+            throw ModelError(fmt::format("joint {}: trim {:.4f} at {:.4f} exceeds the ±5 {} sanity limit (check the deviation units)",
+                                         j.name, trim / unit, p / unit, unitName(j.rotary)));
+        out.table.nominal.push_back((p - j.machineZero) / unit);
+        out.table.forward.push_back(trim / unit);
+        out.table.reverse.push_back(trim / unit);
     }
-    std::vector<double> out;
-    if (j.modulo) {
-        const double period = 2 * kPi;
-        std::set<double> wrapped{0.0, period};
-        for (double n : nodes) {
-            double u = std::fmod(n, period);
-            if (u < 0) u += period;
-            wrapped.insert(u);
+    for (size_t i = 0; i + 1 < nodes.size(); ++i)
+        for (int k = 1; k < 8; ++k) {
+            const double p = nodes[i] + (nodes[i + 1] - nodes[i]) * k / 8.0;
+            const double table = out.table.trim((p - j.machineZero) / unit) * unit;
+            out.interpolationError = std::max(out.interpolationError, std::abs(table - jointTrim(m, d, j, p)) / unit);
         }
-        if (!j.components.empty() && (!allTables || wrapped.size() > static_cast<size_t>(kMaxCompLines))) {
-            wrapped.clear();
-            for (int i = 0; i <= 240; ++i) wrapped.insert(i * 1.5 * kDeg);  // 1.5° divides 360°
-        }
-        for (double u : wrapped)
-            if (out.empty() || u - out.back() > 1e-12) out.push_back(u);
-        return out;
-    }
-    if (!std::isfinite(l.min) || !std::isfinite(l.max) || !(l.max > l.min))
-        throw ModelError(fmt::format("axis {} has no finite travel: a LinuxCNC table needs one", l.name));
-    std::set<double> s{l.min, l.max};
-    for (double n : nodes)
-        if (n > l.min && n < l.max) s.insert(n);
-    if (!j.components.empty() && (!allTables || s.size() > static_cast<size_t>(kMaxCompLines))) {
-        s.clear();
-        for (int i = 0; i < kMaxCompLines; ++i) s.insert(l.min + (l.max - l.min) * i / (kMaxCompLines - 1));
-    }
-    for (double u : s)
-        if (out.empty() || u - out.back() > 1e-12) out.push_back(u);
     return out;
 }
 
-std::string compFileName(const JointPlan& j) { return j.name + ".comp"; }
+std::string pinLine(const std::string& module, const char* pin, double nominal, double value) {
+    return fmt::format("# {:<12} nominal {:>14}  delta {:>10}  new {:>14}\n", pin, fixed(nominal, 6), fixed(value - nominal, 6),
+                       fixed(value, 6)) +
+           fmt::format("setp {}.{} {}\n", module, pin, fixed(value, 6));
+}
 
-class LinuxcncApplied final : public AppliedCompensation {
-public:
-    const MachineModel* machine = nullptr;
-    std::vector<int> jointAxis;
-    std::optional<TrtType> trt;
-    TrtPins nominal, pins;
-    std::array<double, 3> shift{};
-    std::vector<std::optional<CompTable>> tables;
-    std::vector<char> wrap;
-    int jx = -1, jy = -1, jz = -1, jt = -1, jc = -1;  // joint numbers of the trt letters
-
-    AxisVector driveCommands(const AxisVector& q) const override {
-        const int n = static_cast<int>(jointAxis.size());
-        std::array<double, kMaxAxes> J{};
-        for (int i = 0; i < n; ++i) J[i] = q[jointAxis[i]] * unitScale(machine->axisLink(jointAxis[i]).kind == AxisKind::Rotary);
-        if (trt) {
-            // The program (nominal machine, work offsets referring to the table centre) → world coordinates of the
-            // module, shifted by the work-offset change README.txt asks for, → joints with the corrected pins.
-            TrtPose j{{J[jx], J[jy], J[jz]}, J[jt], J[jc]};
-            TrtPose w = trtForward(*trt, nominal, j);
-            for (int k = 0; k < 3; ++k) w.xyz[k] += shift[k];
-            const TrtPose jj = trtInverse(*trt, pins, w);
-            J[jx] = jj.xyz[0];
-            J[jy] = jj.xyz[1];
-            J[jz] = jj.xyz[2];
-        }
-        for (int i = 0; i < n; ++i) {
-            if (!tables[i]) continue;
-            double p = J[i];
-            if (wrap[i]) {
-                p = std::fmod(p, 360.0);
-                if (p < 0) p += 360.0;
-            }
-            J[i] += tables[i]->trim(p);
-        }
-        AxisVector out = q;
-        for (int i = 0; i < n; ++i)
-            out[jointAxis[i]] = J[i] / unitScale(machine->axisLink(jointAxis[i]).kind == AxisKind::Rotary);
-        return out;
+std::string readme(const LinuxcncPlan& plan, const std::string& module, const std::vector<OutputFile>& tables) {
+    std::string r = "\nFiles\n";
+    for (const OutputFile& f : tables)
+        r += fmt::format("  {:<16} joint table: nominal joint position, forward trim, reverse trim (COMP_FILE_TYPE 1)\n", f.name);
+    r += fmt::format("  {:<16} INI fragment: [KINS] and the [JOINT_n] COMP_FILE lines\n", kIniFile);
+    if (plan.trt) {
+        r += fmt::format("  {:<16} HAL fragment: absolute values of the {} pins, tool-offset net\n", kHalFile, module);
+        r += fmt::format("  {:<16} G54 of the machine description's workpiece origin (absolute)\n", kWorkOffsetFile);
+    } else {
+        r += fmt::format("  {:<16} HAL fragment (trivkins: nothing to set)\n", kHalFile);
     }
-};
+    r += "\nFor LinuxCNC 2.9 (checked in cnccomp's tests against the real LinuxCNC 2.9 of Debian 12, linuxcnc-uspace).\n";
+    if (plan.trt && *plan.trt == TrtType::BC)
+        r += "Do NOT load on LinuxCNC 2.10/master: its xyzbc-trt-kins inverse (conventional-directions = 0) uses the opposite\n"
+             "sign of sin(B) in its x-offset / z-offset + tool-offset terms, so the joints differ from 2.9's by up to\n"
+             "2*|sin B|*|z-offset + tool length| in X and 2*|sin B|*|x-offset| in Z.\n";
+    r += "\nHow to merge\n"
+         "1. Tables: copy the .comp files into the folder of your machine INI (COMP_FILE names are relative to it).\n"
+         "   They hold no comment lines: LinuxCNC stops reading a table at the first line that is not three numbers.\n"
+         "   Nominals are joint positions (machine coordinates, from machine zero; mm, deg); the trims are deltas added\n"
+         "   to the joint command. A table covers the joint's whole travel of the machine description: LinuxCNC looks it\n"
+         "   up at the raw joint position (no modulo, also with WRAPPED_ROTARY = 1) and holds the end values beyond it.\n"
+         "   A joint takes its trim while it moves (forward column moving +, reverse moving -) and keeps it while it\n"
+         "   stands; after homing the trim is 0 until the joint's first move (control.c compute_screw_comp).\n"
+         "2. INI: copy every KEY = value of cnccomp.ini into the section of the same name of your machine INI, replacing\n"
+         "   the key where it is already there; keep everything else (limits, homing, scales).\n"
+         "   BACKLASH: LinuxCNC does not apply [JOINT_n] BACKLASH to a joint with a COMP_FILE (ini-config.adoc).\n"
+         "   These tables carry no reversal error (forward = reverse): the deviation set has none. If a joint has\n"
+         "   BACKLASH = b today, add +b/2 to every forward trim and -b/2 to every reverse trim of its table, or that\n"
+         "   backlash compensation is lost.\n";
+    if (plan.trt) {
+        r += fmt::format(
+            "3. HAL: cnccomp.hal holds ABSOLUTE values in LinuxCNC's frame (mm; the joints are the tool control point at\n"
+            "   tool length 0, measured from machine zero). They REPLACE your values of exactly these pins of {}:\n"
+            "     {}\n"
+            "   Delete or overwrite your own setp lines of these pins (or load cnccomp.hal as a HALFILE after yours:\n"
+            "   a later setp wins); a pin driven by a signal (net ... with sets) takes the new value through its\n"
+            "   signal: sets <signal> <value> instead of the setp line.\n"
+            "   Before replacing: your current values must equal the 'nominal' ones listed in cnccomp.hal (the machine\n"
+            "   description's geometry in LinuxCNC's frame). If they do not, the description does not describe this\n"
+            "   machine as LinuxCNC sees it (offsets, machine-zero): fix it and emit again, or add the listed deltas to\n"
+            "   your own values instead of replacing them.\n"
+            "   The tool-offset pin must carry the active tool length: keep your own net of motion.tooloffset.z to it,\n"
+            "   or the net line of cnccomp.hal, never both.\n"
+            "4. G54: cnccomp-g54.ngc sets G54 to the workpiece origin of the machine description (the table frame at\n"
+            "   {} = C = 0) as identified, for programs written for that origin. If you touch off or probe the part at\n"
+            "   {} = C = 0 as usual, your probing already sees the true table: do not run it.\n",
+            module, *plan.trt == TrtType::AC ? "x-rot-point y-rot-point z-rot-point y-offset z-offset" : "x-rot-point y-rot-point z-rot-point x-offset z-offset",
+            *plan.trt == TrtType::AC ? "A" : "B", *plan.trt == TrtType::AC ? "A" : "B");
+    } else {
+        r += "3. HAL: nothing to merge (trivkins has no geometry pins).\n";
+    }
+    return r;
+}
 
 class LinuxcncBackend final : public Backend {
 public:
     std::string_view name() const override { return "linuxcnc"; }
     std::string_view description() const override {
-        return "LinuxCNC 2.9: joint COMP_FILE_TYPE 1 tables, INI/HAL fragments for xyzac/xyzbc-trt-kins pins";
+        return "LinuxCNC 2.9: joint COMP_FILE_TYPE 1 tables, INI/HAL fragments for xyzac/xyzbc-trt-kins pins (absolute, "
+               "LinuxCNC's frame), G54 program";
     }
 
     EmitResult emit(const EmitRequest& r) const override {
@@ -124,116 +124,87 @@ public:
         out.compensated = plan.compensated;
         out.notCompensated = plan.notCompensated;
         const std::string module = plan.trt ? trtModule(*plan.trt) : "trivkins";
-        std::vector<std::string> notes{
-            fmt::format("kinematics: {} coordinates={} (joint n = letter n)", module, plan.coordinates),
-            "tables: COMP_FILE_TYPE 1, trims added to the joint command, forward = reverse (no reversal error given)"};
-        bool wrapped = false;
-        for (const JointPlan& j : plan.joints) wrapped |= j.modulo && j.hasTable();
-        if (wrapped)
-            notes.push_back("[G] modulo tables span 0..360 deg and assume WRAPPED_ROTARY = 1 keeps the joint position in 0..360");
-        if (plan.trt) {
-            notes.push_back(fmt::format("pins in the machine model's frame (origin at the nominal {} / C intersection); nominal "
-                                        "x/y/z-rot-point {} {} {} mm",
-                                        *plan.trt == TrtType::AC ? "A" : "B", fixed(plan.nominalPins.xRotPoint, 6),
-                                        fixed(plan.nominalPins.yRotPoint, 6), fixed(plan.nominalPins.zRotPoint, 6)));
-            notes.push_back(fmt::format("work offsets that refer to the table centre move by X {} Y {} Z {} mm (e.g. G10 L2 P1 adds them)",
-                                        fixed(plan.workOffsetShift[0], 6), fixed(plan.workOffsetShift[1], 6),
-                                        fixed(plan.workOffsetShift[2], 6)));
-            notes.push_back(fmt::format("[G] the tool-offset pin is expected to be driven by motion.tooloffset.z (net in the HAL file)"));
-        }
-        const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC ({})", module), out, notes);
 
-        // Tables.
+        // Tables first: their coverage goes into every header.
+        std::vector<OutputFile> tables;
+        std::vector<std::string> tableNotes;
         std::string iniJoints;
         for (size_t n = 0; n < plan.joints.size(); ++n) {
             const JointPlan& j = plan.joints[n];
             if (!j.hasTable()) continue;
-            CompTable t;
-            const double s = unitScale(j.rotary);
-            for (double p : tableNodes(m, j)) {
-                const double trim = jointTrim(m, r.deviations, j, p);
-                const double limit = j.rotary ? 5.0 * kDeg : 5.0;
-                if (!std::isfinite(trim) || std::abs(trim) > limit)
-                    throw ModelError(fmt::format("joint {}: trim {:.4f} at {:.4f} exceeds the ±5 {} sanity limit (check the deviation units)",
-                                                 j.name, trim * s, p * s, j.rotary ? "deg" : "mm"));
-                t.nominal.push_back(p * s);
-                t.forward.push_back(trim * s);
-                t.reverse.push_back(trim * s);
-            }
-            if (j.modulo) t.forward.back() = t.reverse.back() = t.forward.front();  // closes on itself
-            out.files.push_back({compFileName(j), formatCompTable(t, compFileName(j))});
-            iniJoints += fmt::format("\n[JOINT_{}]\n# axis {}\nCOMP_FILE = {}\nCOMP_FILE_TYPE = 1\n", n, j.name, compFileName(j));
-            if (j.modulo) iniJoints += fmt::format("\n[AXIS_{}]\n# [G] keeps the joint in 0..360 so that the table applies every turn\nWRAPPED_ROTARY = 1\n", j.name);
+            const JointTable t = jointTable(m, r.deviations, j);
+            const std::string unit = unitName(j.rotary);
+            tableNotes.push_back(fmt::format("{}: {} points, joint {} .. {} {} (the whole travel); largest interpolation error {:.2e} {}",
+                                             compFileName(j), t.table.nominal.size(), fixed(t.table.nominal.front(), 3),
+                                             fixed(t.table.nominal.back(), 3), unit, t.interpolationError, unit));
+            tables.push_back({compFileName(j), formatCompTable(t.table, compFileName(j))});
+            iniJoints += fmt::format("\n[JOINT_{}]\n# axis {}: LinuxCNC does not apply BACKLASH to this joint while COMP_FILE is set "
+                                     "(README.txt)\nCOMP_FILE = {}\nCOMP_FILE_TYPE = 1\n",
+                                     n, j.name, compFileName(j));
         }
+
+        std::vector<std::string> notes{
+            "for LinuxCNC 2.9 (trtfuncs.c, control.c, usrmotintf.cc of 2.9); checked against the real LinuxCNC 2.9 "
+            "(Debian 12 linuxcnc-uspace)",
+            fmt::format("kinematics: {} coordinates={} (joint n = letter n)", module, plan.coordinates),
+            "tables: COMP_FILE_TYPE 1, nominal = joint position (from machine zero), trims (deltas) added to the joint command"};
+        if (plan.trt && *plan.trt == TrtType::BC)
+            notes.push_back("NOT for LinuxCNC 2.10/master: its xyzbc-trt-kins inverse differs from 2.9's in the sign of the "
+                            "sin(B) offset terms (README.txt)");
+        if (!tables.empty())
+            notes.push_back("WARNING: LinuxCNC ignores BACKLASH for a joint with COMP_FILE; forward = reverse here (no reversal "
+                            "error in the deviation set): put the joint's backlash into the columns (README.txt)");
+        notes.insert(notes.end(), tableNotes.begin(), tableNotes.end());
+        if (plan.trt) {
+            const TrtPins &p = plan.pins, &n = plan.nominalPins;
+            const bool ac = *plan.trt == TrtType::AC;
+            notes.push_back(fmt::format("pins: ABSOLUTE, LinuxCNC's frame (mm from machine zero, joints = tool control point); "
+                                        "nominal x/y/z-rot-point {} {} {}, {} {}, z-offset {}; new {} {} {}, {} {}, z-offset {}",
+                                        fixed(n.xRotPoint, 6), fixed(n.yRotPoint, 6), fixed(n.zRotPoint, 6), ac ? "y-offset" : "x-offset",
+                                        fixed(ac ? n.yOffset : n.xOffset, 6), fixed(n.zOffset, 6), fixed(p.xRotPoint, 6),
+                                        fixed(p.yRotPoint, 6), fixed(p.zRotPoint, 6), ac ? "y-offset" : "x-offset",
+                                        fixed(ac ? p.yOffset : p.xOffset, 6), fixed(p.zOffset, 6)));
+            notes.push_back(fmt::format("G54 of the workpiece origin: ABSOLUTE, nominal X {} Y {} Z {}, new X {} Y {} Z {} mm",
+                                        fixed(plan.nominalWorkOffset.x(), 6), fixed(plan.nominalWorkOffset.y(), 6),
+                                        fixed(plan.nominalWorkOffset.z(), 6), fixed(plan.workOffset.x(), 6),
+                                        fixed(plan.workOffset.y(), 6), fixed(plan.workOffset.z(), 6)));
+            notes.push_back(fmt::format("tool-offset: motion.tooloffset.z => {}.tool-offset (the TCP needs the active tool length)", module));
+        }
+        const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC 2.9 ({})", module), out, notes);
+
+        out.files = tables;
         std::string ini = formatHeader(h, "# ");
         ini += fmt::format("\n[KINS]\nKINEMATICS = {} coordinates={}\nJOINTS = {}\n", module, plan.coordinates, plan.joints.size());
         ini += iniJoints;
+        out.files.push_back({kIniFile, ini});
         std::string hal = formatHeader(h, "# ");
         if (plan.trt) {
-            const TrtPins& p = plan.pins;
-            hal += fmt::format("\nnet tooloffset-z motion.tooloffset.z => {}.tool-offset\n", module);
-            hal += fmt::format("setp {}.x-rot-point {}\nsetp {}.y-rot-point {}\nsetp {}.z-rot-point {}\n", module, fixed(p.xRotPoint, 6),
-                               module, fixed(p.yRotPoint, 6), module, fixed(p.zRotPoint, 6));
-            if (*plan.trt == TrtType::AC) hal += fmt::format("setp {}.y-offset {}\n", module, fixed(p.yOffset, 6));
-            else hal += fmt::format("setp {}.x-offset {}\n", module, fixed(p.xOffset, 6));
-            hal += fmt::format("setp {}.z-offset {}\n", module, fixed(p.zOffset, 6));
+            const TrtPins &p = plan.pins, &n = plan.nominalPins;
+            hal += fmt::format("\n# Absolute values in LinuxCNC's frame; they replace these pins' values (README.txt).\n"
+                               "net tooloffset-z motion.tooloffset.z => {}.tool-offset\n",
+                               module);
+            hal += pinLine(module, "x-rot-point", n.xRotPoint, p.xRotPoint);
+            hal += pinLine(module, "y-rot-point", n.yRotPoint, p.yRotPoint);
+            hal += pinLine(module, "z-rot-point", n.zRotPoint, p.zRotPoint);
+            if (*plan.trt == TrtType::AC) hal += pinLine(module, "y-offset", n.yOffset, p.yOffset);
+            else hal += pinLine(module, "x-offset", n.xOffset, p.xOffset);
+            hal += pinLine(module, "z-offset", n.zOffset, p.zOffset);
+            std::string g54 = formatHeader(h, "; ");
+            g54 += fmt::format("\n; G54 = the workpiece origin of the machine description in LinuxCNC's frame, absolute (README.txt)\n"
+                               "G10 L2 P1 X{} Y{} Z{}\nM2\n",
+                               fixed(plan.workOffset.x(), 6), fixed(plan.workOffset.y(), 6), fixed(plan.workOffset.z(), 6));
+            out.files.push_back({kHalFile, hal});
+            out.files.push_back({kWorkOffsetFile, g54});
         } else {
             hal += "\n# trivkins: no kinematics pins to set\n";
+            out.files.push_back({kHalFile, hal});
         }
-        std::string readme = formatHeader(h, "");
-        readme += "\nFiles\n";
-        for (const OutputFile& f : out.files) readme += fmt::format("  {:<12} joint compensation table (nominal forward-trim reverse-trim)\n", f.name);
-        readme += fmt::format("  {:<12} INI fragment: merge [KINS] and the [JOINT_n] COMP_FILE lines into the machine INI\n", kIni);
-        readme += fmt::format("  {:<12} HAL fragment: add to a HAL file loaded after the kinematics module\n", kHal);
-        readme += "\nThe .comp files hold no comment lines: LinuxCNC stops reading a table at the first line that is not\n"
-                  "three numbers. Units: mm for linear joints, degrees for rotary joints.\n";
-        out.files.push_back({kIni, ini});
-        out.files.push_back({kHal, hal});
-        out.files.push_back({kReadme, readme});
+        out.files.push_back({kReadmeFile, formatHeader(h, "") + readme(plan, module, tables)});
         return out;
     }
 
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& m, const std::vector<OutputFile>& files) const override {
-        const IniFragment ini = parseIni(requireFile(files, kIni, "LinuxCNC").content, kIni);
-        auto a = std::make_unique<LinuxcncApplied>();
-        a->machine = &m;
-        if (static_cast<int>(ini.coordinates.size()) != m.axisCount())
-            throw InputError(kIni, 0, fmt::format("coordinates={} do not match the {} axes of machine '{}'", ini.coordinates,
-                                                  m.axisCount(), m.name));
-        for (char c : ini.coordinates) {
-            const int axis = m.axisIndex(std::string(1, c));
-            if (axis < 0) throw InputError(kIni, 0, fmt::format("machine '{}' has no axis {}", m.name, c));
-            a->jointAxis.push_back(axis);
-        }
-        if (ini.kinematics != "trivkins") {
-            const auto type = matchTrt(m);
-            if (!type || trtModule(*type) != ini.kinematics)
-                throw InputError(kIni, 0, fmt::format("kinematics {} does not fit machine '{}'", ini.kinematics, m.name));
-            a->trt = type;
-            const auto pins = parseHal(requireFile(files, kHal, "LinuxCNC").content, kHal, ini.kinematics);
-            if (!pins) throw InputError(kHal, 0, fmt::format("no {} pin is set", ini.kinematics));
-            a->pins = *pins;
-            a->nominal = trtPins(m, *type, nullptr);
-            a->pins.toolOffset = a->nominal.toolOffset = 0.0;  // both sides see the same tool offset
-            a->shift = {a->pins.xRotPoint - a->nominal.xRotPoint, a->pins.yRotPoint - a->nominal.yRotPoint,
-                        a->pins.zRotPoint - a->nominal.zRotPoint};
-            const auto jointOf = [&](char c) { return static_cast<int>(ini.coordinates.find(c)); };
-            a->jx = jointOf('X');
-            a->jy = jointOf('Y');
-            a->jz = jointOf('Z');
-            a->jt = jointOf(*type == TrtType::AC ? 'A' : 'B');
-            a->jc = jointOf('C');
-        }
-        a->tables.resize(ini.coordinates.size());
-        a->wrap.assign(ini.coordinates.size(), 0);
-        for (const auto& [n, file] : ini.compFile) {
-            if (n >= static_cast<int>(ini.coordinates.size()))
-                throw InputError(kIni, 0, fmt::format("[JOINT_{}] but only {} joints", n, ini.coordinates.size()));
-            a->tables[n] = parseCompTable(requireFile(files, file, "LinuxCNC").content, file);
-            const auto w = ini.wrapped.find(ini.coordinates[n]);
-            a->wrap[n] = w != ini.wrapped.end() && w->second;
-        }
-        return a;
+        return std::make_unique<LinuxcncModel>(m, files);
     }
 };
 

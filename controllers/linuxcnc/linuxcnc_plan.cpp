@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "controllers/linuxcnc/comp_table.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
 namespace {
@@ -88,23 +90,52 @@ std::optional<TrtType> matchTrt(const MachineModel& m) {
     return std::nullopt;
 }
 
+namespace {
+
+/// Translation of link i of the workpiece chain at rotary position 0: its placement plus, with a deviation set, its
+/// translation location errors (the frames before it are unrotated on a trt machine).
+Vec3 workpieceTranslation(const MachineModel& m, int i, const DeviationSet* d) {
+    Vec3 t = m.workpiece.links[i].placement.translation();
+    if (d)
+        for (const DeviationDef& def : m.deviations)
+            if (def.side == Side::Workpiece && def.link == i && def.kind == DeviationKind::Location && def.component < 3)
+                t[def.component] += d->values[def.offset];
+    return t;
+}
+
+/// T0: the nominal tool control point (tool length 0) in the bed frame at joint position 0 of every linear joint,
+/// i.e. the origin of LinuxCNC's frame: the tool chain's fixed offsets plus each slide at its machine-zero.
+Vec3 linuxcncOrigin(const MachineModel& m) {
+    Vec3 t = Vec3::Zero();
+    for (const Link& l : m.tool.links) {
+        t += l.placement.translation();
+        if (l.kind == AxisKind::Linear) t += l.direction * l.machineZero;
+    }
+    return t;
+}
+
+void requireRotaryZero(const MachineModel& m, int link, TrtType type) {
+    const Link& l = m.workpiece.links[link];
+    if (l.machineZero != 0.0)
+        throw ModelError(fmt::format("{}: axis {} has machine-zero {} deg, but LinuxCNC's {} needs the {} joint to read 0 where "
+                                     "the table is level and unturned (trtfuncs.c); home the joint there",
+                                     m.name, l.name, l.machineZero / kDeg, trtModule(type), l.name));
+}
+
+}  // namespace
+
 TrtPins trtPins(const MachineModel& m, TrtType type, const DeviationSet* d) {
     const auto [tilt, c] = trtLinks(m);
+    requireRotaryZero(m, tilt, type);
+    requireRotaryZero(m, c, type);
     Vec3 a = Vec3::Zero(), cc = Vec3::Zero();
-    for (int i = 0; i <= c; ++i) {
-        Vec3 t = m.workpiece.links[i].placement.translation();
-        if (d)
-            for (size_t k = 0; k < m.deviations.size(); ++k) {
-                const DeviationDef& def = m.deviations[k];
-                if (def.side == Side::Workpiece && def.link == i && def.kind == DeviationKind::Location && def.component < 3)
-                    t[def.component] += d->values[def.offset];
-            }
-        (i <= tilt ? a : cc) += t;
-    }
-    // J = a + R1·(c + R2·p) equals trtfuncs' J = r + d − R1·d + R1·R2·(p − r) in world coordinates p + r when
-    // r = a + c and d = −c (the component of d along the tilt axis cancels).
+    for (int i = 0; i <= c; ++i) (i <= tilt ? a : cc) += workpieceTranslation(m, i, d);
+    // In the bed frame the tilt axis line passes through a, the C line (at tilt 0) through a + cc. trtfuncs.c's
+    // inverse, J = r + D + R_tilt·(R_C·(p − r) − D), turns about the C line through r and the tilt line through
+    // r + D (D = (0, y-offset, z-offset) for AC, (x-offset, 0, z-offset) for BC): so r = a + cc − T0 in LinuxCNC's
+    // frame, and D = −cc (its component along the tilt axis does not matter).
+    const Vec3 r = a + cc - linuxcncOrigin(m);
     TrtPins p;
-    const Vec3 r = a + cc;
     p.xRotPoint = r.x();
     p.yRotPoint = r.y();
     p.zRotPoint = r.z();
@@ -112,6 +143,12 @@ TrtPins trtPins(const MachineModel& m, TrtType type, const DeviationSet* d) {
     else p.xOffset = -cc.x();
     p.zOffset = -cc.z();
     return p;
+}
+
+Vec3 trtWorkOffset(const MachineModel& m, const DeviationSet* d) {
+    Vec3 o = Vec3::Zero();
+    for (int i = 0; i < static_cast<int>(m.workpiece.links.size()); ++i) o += workpieceTranslation(m, i, d);
+    return o - linuxcncOrigin(m);
 }
 
 LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
@@ -123,6 +160,7 @@ LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
         j.name = l.name;
         j.rotary = l.kind == AxisKind::Rotary;
         j.modulo = l.modulo;
+        j.machineZero = l.machineZero;
         plan.coordinates += l.name;
         plan.joints.push_back(j);
     }
@@ -136,8 +174,8 @@ LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
     if (plan.trt) {
         plan.nominalPins = trtPins(m, *plan.trt, nullptr);
         plan.pins = trtPins(m, *plan.trt, &d);
-        plan.workOffsetShift = {plan.pins.xRotPoint - plan.nominalPins.xRotPoint, plan.pins.yRotPoint - plan.nominalPins.yRotPoint,
-                                plan.pins.zRotPoint - plan.nominalPins.zRotPoint};
+        plan.nominalWorkOffset = trtWorkOffset(m, nullptr);
+        plan.workOffset = trtWorkOffset(m, &d);
         trtLast = trtLinks(m).second;
     }
     const std::string module = plan.trt ? trtModule(*plan.trt) : "trivkins";
@@ -160,7 +198,6 @@ LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
     for (const auto& [axis, u] : shiftAxes) shiftNames += m.axisNames[axis];
 
     Vec3 shift = Vec3::Zero();  // wanted correction of the tool relative to the workpiece, bed frame
-    std::vector<std::string> shifted;
     for (size_t k = 0; k < m.deviations.size(); ++k) {
         if (!d.present[k]) continue;
         const DeviationDef& def = m.deviations[k];
@@ -195,8 +232,9 @@ LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
             continue;
         }
         // Translation location error.
-        if (plan.trt && def.side == Side::Workpiece && def.link <= trtLast) {
-            yes(fmt::format("position of the {} axis line: {} HAL pins (rot-point / offset)", l.name, module));
+        if (plan.trt && def.side == Side::Workpiece) {
+            if (def.link <= trtLast) yes(fmt::format("position of the {} axis line: {} HAL pins (rot-point / offset)", l.name, module));
+            else yes(fmt::format("position of the workpiece origin on the table ({}): G54 of cnccomp-g54.ngc", l.name));
             continue;
         }
         if (def.link <= firstRotary(c)) {
@@ -238,6 +276,55 @@ double jointTrim(const MachineModel& m, const DeviationSet& d, const JointPlan& 
         q = p + j.constantTrim - e;
     }
     return q - p;
+}
+
+std::vector<double> tableNodes(const MachineModel& m, const JointPlan& j) {
+    const Link& l = m.axisLink(j.axis);
+    const double unit = j.rotary ? kDeg : 1.0;
+    if (!std::isfinite(l.min) || !std::isfinite(l.max) || !(l.max > l.min))
+        throw ModelError(fmt::format("{}: axis {} has no finite travel (min/max): LinuxCNC looks a compensation table up at the raw "
+                                     "joint position (no modulo), so the table must cover the joint's travel",
+                                     m.name, l.name));
+    bool allTables = true;
+    std::set<double> s{l.min, l.max};
+    const double period = 2 * kPi;
+    for (const OwnComponent& c : j.components) {
+        const ComponentBasis& b = m.deviations[c.deviation].basis;
+        if (b.type != ComponentBasis::Type::Table) allTables = false;
+        for (double n : b.nodes) {
+            if (!j.modulo) {
+                if (n > l.min && n < l.max) s.insert(n);
+                continue;
+            }
+            // A modulo table repeats every turn: its breakpoints come back at n + k·360°.
+            for (double k = std::ceil((l.min - n) / period); n + k * period < l.max; ++k)
+                if (n + k * period > l.min) s.insert(n + k * period);
+            if (s.size() > static_cast<size_t>(kMaxCompLines)) break;
+        }
+    }
+    if (!j.components.empty() && (!allTables || s.size() > static_cast<size_t>(kMaxCompLines))) {
+        s = {l.min, l.max};
+        if (j.modulo) {
+            // Equidistant at a spacing that divides 360°, aligned to multiples of it: every turn gets the same points.
+            static constexpr double kDivisors[] = {0.25, 0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7.5, 8, 9, 10, 12, 15, 18, 20, 22.5,
+                                                   24, 30, 36, 40, 45, 60, 72, 90, 120, 180, 360};
+            for (double deg : kDivisors) {
+                const double h = deg * kDeg;
+                const double first = std::ceil(l.min / h), last = std::floor(l.max / h);
+                if (last - first + 3 > kMaxCompLines) continue;
+                for (double k = first; k <= last; ++k) s.insert(k * h);
+                break;
+            }
+        } else {
+            for (int i = 1; i + 1 < kMaxCompLines; ++i) s.insert(l.min + (l.max - l.min) * i / (kMaxCompLines - 1));
+        }
+    }
+    std::vector<double> out;
+    // Nodes closer than 1e-6 mm / deg would print as the same nominal: keep the first.
+    for (double u : s)
+        if (out.empty() || u - out.back() > 1e-6 * unit) out.push_back(u);
+    if (out.back() != l.max) out.back() = l.max;
+    return out;
 }
 
 }  // namespace cnccomp::controllers::linuxcnc

@@ -1,0 +1,127 @@
+#!/usr/bin/python3
+"""Headless LinuxCNC "display" of cnccomp's oracle tests (tests/linuxcnc/test_linuxcnc_sim.cpp).
+
+LinuxCNC starts it as `driver.py -ini <ini>`; the run ends when it exits. It turns the machine on, homes every joint
+and then works through the job file ($CNCCOMP_JOB), one command per line:
+    mdi <G-code>     one MDI block; waits until the interpreter is idle and motion is in position (a "G0 <words>"
+                     block also until the commanded position has reached its words)
+    record <label>   waits until every joint's comp filter has reached its target (backlash-filt == backlash-corr,
+                     at most 1 s) and writes one line to $CNCCOMP_OUT:
+                     <label> <settled 0|1> <motion.tooloffset.z> then, per joint, joint.N.pos-cmd, then
+                     joint.N.motor-pos-cmd, joint.N.backlash-corr, joint.N.backlash-filt (repr, full precision)
+The output is written to $CNCCOMP_OUT.part and renamed when the whole job is done, so an output file means success.
+Any LinuxCNC error (error channel) or timeout ends the run with exit code 1 and the reason on stderr.
+Needs /usr/bin/python3 (the linuxcnc and hal modules of the Debian package live in the system dist-packages).
+"""
+import os
+import sys
+import time
+
+import hal
+import linuxcnc
+
+INI = linuxcnc.ini(sys.argv[sys.argv.index("-ini") + 1])
+JOINTS = int(INI.find("KINS", "JOINTS"))
+JOB = [line.rstrip("\n") for line in open(os.environ["CNCCOMP_JOB"])]
+OUT = os.environ["CNCCOMP_OUT"]
+
+stat, command, errors = linuxcnc.stat(), linuxcnc.command(), linuxcnc.error_channel()
+comp = hal.component("cnccomp-driver")
+comp.ready()
+
+
+def check_errors(context):
+    while True:
+        err = errors.poll()
+        if not err:
+            return
+        kind, text = err
+        if kind in (linuxcnc.NML_ERROR, linuxcnc.OPERATOR_ERROR):
+            raise RuntimeError("LinuxCNC error during %s: %s" % (context, text))
+        sys.stderr.write("LinuxCNC message during %s: %s\n" % (context, text))
+
+
+def wait(predicate, timeout, what):
+    start = time.time()
+    while time.time() - start < timeout:
+        stat.poll()
+        if predicate():
+            return
+        check_errors(what)
+        time.sleep(0.002)
+    raise RuntimeError("timeout waiting for " + what)
+
+
+def arrived(targets):
+    # stat.position: the commanded position motion works with = program + G5x offset + tool offset (no G92, no
+    # rotation in these jobs), so the move is over once it equals the block's words with those offsets.
+    return all(abs(stat.position[i] - (v + stat.g5x_offset[i] + stat.tool_offset[i])) < 1e-6 for i, v in targets)
+
+
+def mdi(block):
+    # A move's block names its target: waiting for "idle, in position, empty queue" alone can return before motion
+    # has picked the move up on a loaded machine.
+    words = block.split()
+    targets = [("XYZABCUVW".index(w[0]), float(w[1:])) for w in words[1:]] if words[0] == "G0" else []
+    command.mdi(block)
+    command.wait_complete(30)
+    wait(lambda: stat.interp_state == linuxcnc.INTERP_IDLE and stat.inpos and stat.queue == 0 and arrived(targets),
+         60, block)
+    check_errors(block)
+
+
+def pins(name):
+    return [float(hal.get_value(name % j)) for j in range(JOINTS)]
+
+
+def record(label):
+    start, settled = time.time(), False
+    while time.time() - start < 1.0:
+        if all(c == f for c, f in zip(pins("joint.%d.backlash-corr"), pins("joint.%d.backlash-filt"))):
+            settled = True
+            break
+        time.sleep(0.002)
+    values = (pins("joint.%d.pos-cmd") + pins("joint.%d.motor-pos-cmd") + pins("joint.%d.backlash-corr")
+              + pins("joint.%d.backlash-filt"))
+    return " ".join([label, "1" if settled else "0", repr(float(hal.get_value("motion.tooloffset.z")))]
+                    + [repr(v) for v in values])
+
+
+def main():
+    wait(lambda: stat.task_state != 0, 10, "task")
+    command.state(linuxcnc.STATE_ESTOP_RESET)
+    wait(lambda: stat.task_state == linuxcnc.STATE_ESTOP_RESET, 5, "estop reset")
+    command.state(linuxcnc.STATE_ON)
+    wait(lambda: stat.task_state == linuxcnc.STATE_ON, 5, "machine on")
+    command.mode(linuxcnc.MODE_MANUAL)
+    command.wait_complete()
+    command.teleop_enable(0)
+    command.wait_complete()
+    command.home(-1)
+    command.wait_complete()
+    wait(lambda: all(stat.homed[j] for j in range(JOINTS)), 10, "homing")
+    command.mode(linuxcnc.MODE_MDI)
+    command.wait_complete()
+    lines = []
+    for step in JOB:
+        if not step.strip():
+            continue
+        verb, _, rest = step.partition(" ")
+        if verb == "mdi":
+            mdi(rest)
+        elif verb == "record":
+            lines.append(record(rest))
+        else:
+            raise RuntimeError("unknown job line: " + step)
+    with open(OUT + ".part", "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.rename(OUT + ".part", OUT)
+    command.state(linuxcnc.STATE_OFF)
+    command.wait_complete()
+
+
+try:
+    main()
+except Exception as ex:  # the reason goes to LinuxCNC's log, which the test prints
+    sys.stderr.write("cnccomp driver: %s\n" % ex)
+    sys.exit(1)

@@ -1,0 +1,261 @@
+#include "linuxcnc/linuxcnc_sim.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "controllers/linuxcnc/config_files.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp::test::linuxcnc_sim {
+namespace fs = std::filesystem;
+namespace {
+
+std::string trimmed(const std::string& s) {
+    const size_t a = s.find_first_not_of(" \t\r");
+    if (a == std::string::npos) return {};
+    return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+std::string tail(const std::string& text, size_t lines) {
+    size_t pos = text.size(), n = 0;
+    while (pos > 0 && n <= lines) {
+        pos = text.rfind('\n', pos - 1);
+        if (pos == std::string::npos) return text;
+        ++n;
+    }
+    return text.substr(pos);
+}
+
+/// The machine's own INI before the merge: what a LinuxCNC configuration of this machine holds anyway (travel in
+/// LinuxCNC's coordinates = description travel − machine-zero, homing at joint position 0, BACKLASH), with trivkins
+/// in [KINS] until cnccomp.ini replaces it.
+std::string baseIni(const MachineModel& m, const std::string& coordinates, double backlash) {
+    std::string s = fmt::format(R"([EMC]
+VERSION = 1.1
+MACHINE = cnccomp-oracle-{}
+DEBUG = 0
+
+[DISPLAY]
+DISPLAY = ./driver.py
+POSITION_OFFSET = RELATIVE
+POSITION_FEEDBACK = COMMANDED
+
+[RS274NGC]
+PARAMETER_FILE = sim.var
+
+[KINS]
+KINEMATICS = trivkins coordinates={}
+JOINTS = {}
+
+[EMCMOT]
+EMCMOT = motmod
+SERVO_PERIOD = 50000
+COMM_TIMEOUT = 30.0
+
+[TASK]
+TASK = milltask
+CYCLE_TIME = 0.001
+
+[EMCIO]
+EMCIO = io
+CYCLE_TIME = 0.010
+TOOL_TABLE = sim.tbl
+
+[HAL]
+# README.txt: cnccomp.hal loaded after the machine's own HAL file (its setp lines win)
+HALFILE = base.hal
+HALFILE = cnccomp.hal
+
+[TRAJ]
+COORDINATES = {}
+LINEAR_UNITS = mm
+ANGULAR_UNITS = deg
+DEFAULT_LINEAR_VELOCITY = 100
+MAX_LINEAR_VELOCITY = 50000
+DEFAULT_LINEAR_ACCELERATION = 5000
+MAX_LINEAR_ACCELERATION = 100000
+MAX_ANGULAR_VELOCITY = 50000
+)",
+                                m.name, coordinates, coordinates.size(), coordinates);
+    for (char c : coordinates)
+        s += fmt::format("\n[AXIS_{}]\nMIN_LIMIT = -100000\nMAX_LIMIT = 100000\nMAX_VELOCITY = 50000\nMAX_ACCELERATION = 50000\n", c);
+    for (size_t n = 0; n < coordinates.size(); ++n) {
+        const Link& l = m.axisLink(m.requireAxis(std::string(1, coordinates[n])));
+        const double unit = l.kind == AxisKind::Rotary ? kDeg : 1.0;
+        s += fmt::format("\n[JOINT_{}]\nTYPE = {}\nHOME = 0\nMIN_LIMIT = {}\nMAX_LIMIT = {}\nMAX_VELOCITY = 50000\n"
+                         "MAX_ACCELERATION = 50000\nBACKLASH = {}\nHOME_SEARCH_VEL = 0\nHOME_SEQUENCE = 0\n",
+                         n, l.kind == AxisKind::Rotary ? "ANGULAR" : "LINEAR", (l.min - l.machineZero) / unit,
+                         (l.max - l.machineZero) / unit, backlash);
+    }
+    return s;
+}
+
+/// Ideal drives, estop and tool-change loopbacks; no geometry pin (cnccomp.hal sets them).
+std::string baseHal(int joints) {
+    std::string s = "loadrt [KINS]KINEMATICS\n"
+                    "loadrt [EMCMOT]EMCMOT servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS\n"
+                    "addf motion-command-handler servo-thread\naddf motion-controller servo-thread\n";
+    for (int j = 0; j < joints; ++j) s += fmt::format("net j{0} joint.{0}.motor-pos-cmd => joint.{0}.motor-pos-fb\n", j);
+    s += "net estop-loop iocontrol.0.user-enable-out => iocontrol.0.emc-enable-in\n"
+         "net tool-prep-loop iocontrol.0.tool-prepare => iocontrol.0.tool-prepared\n"
+         "net tool-change-loop iocontrol.0.tool-change => iocontrol.0.tool-changed\n";
+    return s;
+}
+
+}  // namespace
+
+std::string unavailableReason() {
+    if (std::system("command -v linuxcnc > /dev/null 2>&1") != 0)
+        return "LinuxCNC is not installed (Debian 12: apt-get install linuxcnc-uspace, see tools/deps.sh)";
+    if (std::system("/usr/bin/python3 -c 'import linuxcnc, hal' > /dev/null 2>&1") != 0)
+        return "the python3 modules linuxcnc and hal do not load (package linuxcnc-uspace)";
+    if (std::system("command -v timeout > /dev/null 2>&1") != 0) return "coreutils' timeout is missing";
+    return {};
+}
+
+std::string mergeIni(const std::string& base, const std::string& fragment) {
+    // Fragment: section → ordered (key, value).
+    std::vector<std::pair<std::string, std::vector<std::pair<std::string, std::string>>>> frag;
+    {
+        std::istringstream in(fragment);
+        std::string line;
+        while (std::getline(in, line)) {
+            const std::string t = trimmed(line);
+            if (t.empty() || t[0] == '#' || t[0] == ';') continue;
+            if (t[0] == '[') {
+                frag.push_back({t, {}});
+                continue;
+            }
+            const size_t eq = t.find('=');
+            if (eq == std::string::npos || frag.empty()) throw std::runtime_error("INI fragment: bad line " + t);
+            frag.back().second.emplace_back(trimmed(t.substr(0, eq)), trimmed(t.substr(eq + 1)));
+        }
+    }
+    // Base: lines grouped by section (a leading group "" before the first section).
+    std::vector<std::pair<std::string, std::vector<std::string>>> sections{{"", {}}};
+    {
+        std::istringstream in(base);
+        std::string line;
+        while (std::getline(in, line)) {
+            const std::string t = trimmed(line);
+            if (!t.empty() && t[0] == '[') sections.push_back({t, {}});
+            sections.back().second.push_back(line);
+        }
+    }
+    for (const auto& [name, keys] : frag) {
+        auto it = std::find_if(sections.begin(), sections.end(), [&](const auto& s) { return s.first == name; });
+        if (it == sections.end()) {
+            sections.push_back({name, {"", name}});
+            it = sections.end() - 1;
+        }
+        for (const auto& [key, value] : keys) {
+            bool replaced = false;
+            for (std::string& l : it->second) {
+                const std::string t = trimmed(l);
+                const size_t eq = t.find('=');
+                if (t.empty() || t[0] == '[' || t[0] == '#' || eq == std::string::npos || trimmed(t.substr(0, eq)) != key) continue;
+                l = key + " = " + value;
+                replaced = true;
+            }
+            if (!replaced) {
+                // After the section's last non-blank line.
+                auto pos = it->second.end();
+                while (pos != it->second.begin() && trimmed(*(pos - 1)).empty()) --pos;
+                it->second.insert(pos, key + " = " + value);
+            }
+        }
+    }
+    std::string out;
+    for (const auto& [name, lines] : sections)
+        for (const std::string& l : lines) out += l + "\n";
+    return out;
+}
+
+SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const fs::path& dir, const std::vector<Tool>& tools,
+                         double backlash) {
+    SimConfig c;
+    c.dir = dir;
+    fs::create_directories(dir);
+    const std::string fragment = readText((emitted / "cnccomp.ini").string());
+    const std::string coordinates = controllers::linuxcnc::parseIni(fragment, "cnccomp.ini").coordinates;
+    c.joints = static_cast<int>(coordinates.size());
+    c.ini = dir / "sim.ini";
+    writeText(c.ini.string(), mergeIni(baseIni(m, coordinates, backlash), fragment));
+    writeText((dir / "base.hal").string(), baseHal(c.joints));
+    for (const auto& e : fs::directory_iterator(emitted))
+        if (e.path().extension() == ".comp" || e.path().filename() == "cnccomp.hal")
+            fs::copy_file(e.path(), dir / e.path().filename(), fs::copy_options::overwrite_existing);
+    std::string tbl;
+    for (const Tool& t : tools) tbl += fmt::format("T{0} P{0} Z{1} D0 ;\n", t.number, t.length);
+    writeText((dir / "sim.tbl").string(), tbl);
+    fs::copy_file(sourcePath("tests/linuxcnc/driver.py"), dir / "driver.py", fs::copy_options::overwrite_existing);
+    fs::permissions(dir / "driver.py", fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                                           fs::perms::others_read | fs::perms::others_exec);
+    return c;
+}
+
+std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& job, double* seconds) {
+    const fs::path jobFile = c.dir / "job.txt", out = c.dir / "records.txt", log = c.dir / "linuxcnc.log";
+    std::string jobText;
+    for (const std::string& l : job) jobText += l + "\n";
+    writeText(jobFile.string(), jobText);
+    fs::remove(out);
+    std::string env = "env -u DISPLAY CNCCOMP_JOB=" + shellQuote(jobFile.string()) + " CNCCOMP_OUT=" + shellQuote(out.string());
+    if (geteuid() == 0) {
+        // rtapi_app refuses root: it runs as 'nobody' and needs a fifo folder that user can reach and write
+        // (whatever the umask made of the folders above it).
+        const auto open = fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec | fs::perms::others_read |
+                          fs::perms::others_exec;
+        fs::permissions(c.dir, open);
+        fs::permissions(c.dir.parent_path(), open);
+        const fs::path fifo = c.dir / "rtapi";
+        fs::create_directories(fifo);
+        fs::permissions(fifo, fs::perms::all | fs::perms::sticky_bit);
+        env += " RTAPI_UID=65534 RTAPI_FIFO_PATH=" + shellQuote((fifo / "rtapi_fifo").string());
+    }
+    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 120 linuxcnc -r " + shellQuote(c.ini.string()) +
+                            " > " + shellQuote(log.string()) + " 2>&1 < /dev/null";
+    const auto t0 = std::chrono::steady_clock::now();
+    const int rc = std::system(cmd.c_str());
+    if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // The linuxcnc script exits 0 even when stopped by a signal: the output file is the proof of success.
+    if (const char* keep = std::getenv("CNCCOMP_LINUXCNC_KEEP"))  // debugging: a copy of the run's folder
+        fs::copy(c.dir, keep, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+    if (rc != 0 || !fs::exists(out))
+        throw std::runtime_error(fmt::format("LinuxCNC run failed (exit {}), end of {}:\n{}", rc, log.string(), tail(readText(log.string()), 120)));
+    std::vector<Record> records;
+    std::istringstream in(readText(out.string()));
+    std::string line;
+    while (std::getline(in, line)) {
+        if (trimmed(line).empty()) continue;
+        std::istringstream ls(line);
+        Record r;
+        int settled = 0;
+        ls >> r.label >> settled >> r.toolOffset;
+        r.settled = settled != 0;
+        for (auto* v : {&r.posCmd, &r.motorPosCmd, &r.backlashCorr, &r.backlashFilt}) {
+            v->resize(c.joints);
+            for (double& x : *v) ls >> x;
+        }
+        if (!ls) throw std::runtime_error("unreadable record line: " + line);
+        records.push_back(std::move(r));
+    }
+    return records;
+}
+
+}  // namespace cnccomp::test::linuxcnc_sim

@@ -1,0 +1,62 @@
+#pragma once
+// Harness that runs the real LinuxCNC 2.9 (Debian 12 package linuxcnc-uspace) headless in simulation as a test
+// oracle: a sim configuration built from the files `cnccomp emit --controller linuxcnc` wrote, merged the way their
+// README.txt tells a user to, ideal drives (motor-pos-cmd looped back as feedback), and driver.py as the "display"
+// that executes MDI blocks and records joint pins.
+//
+// Facts it relies on (observed on 2.9, see ../shared/linuxcnc-sim/README.md): rtapi_app refuses to run as root
+// unless RTAPI_UID names another user and RTAPI_FIFO_PATH a fifo that user can create; `[EMC] VERSION = 1.1` keeps
+// the INI updater (a GUI) away; the INI folder must be writable; one LinuxCNC per machine (/tmp/linuxcnc.lock, fixed
+// shared-memory keys), so the tests that start it share a ctest RESOURCE_LOCK; a comp value is ramped in by a
+// filter whose residual is bounded by 0.5·MAX_ACCELERATION·SERVO_PERIOD², hence a 50 µs servo period here; on a
+// loaded machine (ctest -j, POSIX non-realtime threads) motion answers task late: [EMCMOT] COMM_TIMEOUT = 30 s, since
+// a timed-out command is sent again and the comp-table loader then refuses the repeated line ("compensation values
+// must increase"); a move is over when the commanded position has reached the block's words (driver.py).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cnccomp/machine.hpp"
+
+namespace cnccomp::test::linuxcnc_sim {
+
+/// Empty when the real LinuxCNC can run here, otherwise why not (for GTEST_SKIP).
+std::string unavailableReason();
+
+/// Merges an INI fragment into an INI text as the emitted README.txt tells a user: every `KEY = value` of a
+/// section of the fragment replaces the key of the same name in the same section of the base, or is added at the
+/// end of that section; sections the base lacks are appended. Comments of the fragment are dropped.
+std::string mergeIni(const std::string& base, const std::string& fragment);
+
+struct Tool {
+    int number = 1;
+    double length = 0;  ///< mm, tool table Z
+};
+
+/// A sim configuration folder: the machine's own INI (joint travel in LinuxCNC's coordinates from the machine
+/// description, BACKLASH on every joint, ideal drives) merged with cnccomp.ini; base.hal, then cnccomp.hal as a
+/// second HALFILE (its setp lines set the pins); the .comp files; a tool table; driver.py.
+struct SimConfig {
+    std::filesystem::path dir, ini;
+    int joints = 0;
+};
+
+/// Builds the configuration in `dir` from the folder `emitted` (what `cnccomp emit` wrote, read as it is).
+/// `backlash` is the BACKLASH (mm or deg) the machine's own INI gives every joint.
+SimConfig buildSimConfig(const MachineModel& m, const std::filesystem::path& emitted, const std::filesystem::path& dir,
+                         const std::vector<Tool>& tools, double backlash);
+
+/// One `record` of the job: the joint pins after a move.
+struct Record {
+    std::string label;
+    bool settled = false;  ///< every joint's comp filter had reached its target
+    double toolOffset = 0; ///< motion.tooloffset.z
+    std::vector<double> posCmd, motorPosCmd, backlashCorr, backlashFilt;
+};
+
+/// Runs LinuxCNC on the configuration with a job (lines `mdi <G-code>` / `record <label>`, see driver.py) and
+/// returns the records. Throws std::runtime_error with the end of LinuxCNC's log when the run fails. With the
+/// environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder (INI, HAL, job, log) is copied there.
+std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& job, double* seconds = nullptr);
+
+}  // namespace cnccomp::test::linuxcnc_sim
