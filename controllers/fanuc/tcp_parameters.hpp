@@ -19,7 +19,9 @@
 //         datum follows the measured table axis line as the deviation set defines it
 //
 // Machine coordinates are those of the controlled point: a point on the first tool rotary axis (types 2, 21),
-// or the tool reference point (types 0, 12); offsets in front of it move to the table side.
+// or the tool reference point (types 0, 12); offsets in front of it move to the table side. Every value is absolute,
+// in the controller's machine coordinate system at machine coordinates 0 (all axes at their Link::machineZero, rotary
+// axes at 0 deg as A-79348E defines the vectors "when the rotation axes are all at 0 degrees").
 // What the TCP parameters hold: the translation location errors (pivot positions, spindle offsets, axis
 // offsets). Orientation errors of rotary axes, squareness and component errors other than positioning have
 // no 30i TCP parameter (3-D error compensation numbers are not public) and are reported NOT compensated.
