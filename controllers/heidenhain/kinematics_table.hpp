@@ -40,7 +40,8 @@ struct ParsedKinematics {
     std::vector<ComponentTable> tables;
 };
 
-/// Reads the files back (InputError file:line).
+/// Reads the files back (InputError file:line): keys and their order as the iTNC 530 HSCI technical manual 07/2013
+/// lists them (p.671), .COM columns AXISPOS, C1..C6 (p.680); the tool-side walk and the sign of its tables are [G].
 ParsedKinematics parseFiles(const MachineModel& m, const std::vector<OutputFile>& files);
 
 /// Unit direction of a TNC axis letter: X/U/A → x, Y/V/B → y, Z/W/C → z; or zero for other names.

@@ -32,8 +32,11 @@ struct ParsedChain {
     std::vector<ChainElement> workpiece, tool;
 };
 
-/// Reads a chain data file back. InputError (file:line) on syntax errors, unknown variables or element
-/// names, missing fields, a broken chain, or axes the machine does not have.
+/// Reads a chain data file back as K7/K12 describe it: the root from MD16800, the two subchains from its $NK_NEXT and
+/// $NK_PARALLEL to the elements $NT_T_CHAIN_LAST_ELEM / $NT_P_CHAIN_LAST_ELEM name (K12 06/2019 4.2.4.7-8, pp. 285-286);
+/// ROT_CONST "rotated through the angle specified in $NK_A_OFF around the direction vector" (K7 01/2015 p.202).
+/// InputError (file:line) on syntax errors, unknown variables or element names, missing fields, a broken chain, or
+/// axes the machine does not have.
 ParsedChain parseKinematicChain(const MachineModel& m, const std::string& path, std::string_view text);
 
 inline constexpr const char* kChainIdentifier = "_N_CNCCOMP_KINCHAIN_SPF";
