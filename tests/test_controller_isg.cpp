@@ -217,6 +217,14 @@ TEST(ControllerIsg, ChainRunsFromTheWorkpieceOverTheOriginToTheTool) {
         const EmitResult r = backend("isg").emit({m, DeviationSet(m), "none", "2024-01-01"});
         EXPECT_EQ(chainLine(requireFile(r.files, "volcomp.lis", "test").content), std::make_pair(std::string(c.chain), c.workpieceAxes))
             << c.name;
+        if (std::string(c.chain) == "CBYXZ") {
+            // TF5280 "Tool length": N0 "is typically the direction of the last axis in the kinematic chain, i.e. [0, 0, -1]
+            // for the example machine CBYXZ".
+            const auto blocks = isg::parseIsgCsv(requireFile(r.files, "volcomp.csv", "test").content, "volcomp.csv");
+            const auto& cols = blocks.at(0).columns;
+            const auto at = [&](const char* n) { return blocks[0].rows[0][static_cast<size_t>(std::find(cols.begin(), cols.end(), n) - cols.begin())]; };
+            EXPECT_EQ(Vec3(at("N0X"), at("N0Y"), at("N0Z")), Vec3(0, 0, -1));
+        }
     }
     // The samples: table-table A/C (C on A, tool Y X Z), mill-turn (C work spindle, tool Z Y X B), tilting head.
     const std::map<std::string, std::pair<std::string, int>> want = {{"controllers-table-table-ac", {"CAYXZ", 2}},
