@@ -2,6 +2,7 @@
 // rules (MIN/MAX/STEP vs point count, modulo tables closing), limits, malformed files rejected with file:line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <functional>
@@ -417,6 +418,43 @@ TEST(ControllerSiemens, ChainAndTablesAreInTheMachineCoordinates) {
     const DeviationSet c0 = test::sameDeviations(c, base);
     const CompensationFigures g = evaluateCompensation(base, c0, *siemens().apply(base, r.files), test::nonSingularSamples(base, 4), 100.0);
     EXPECT_GT(g.maxAfter, 0.5);
+}
+
+
+TEST(ControllerSiemens, RotConstTurnsAboutItsDirectionAsK7Prints) {
+    // K7 (840D sl function manual special functions 01/2015, 6FC5397-2BP40-5BA2) p.202: the 9th element's direction
+    // vector is (1; 0; 0) turned by 90 deg in the X/Y plane and 10 deg in the Y/Z plane, (cos90 cos10, sin90 cos10,
+    // sin10) = (0.0, 0.985, 0.174), and "the output coordinate system ... arises from the input coordinate system,
+    // rotated through the angle specified in $NK_A_OFF around the direction vector". A chain with such an element
+    // after the slides of a three-axis machine, read back:
+    test::ScratchDir dir("k7");
+    test::writeText(dir.file("m.xml"), R"(<machine name="k7"><workpiece><fixed name="T"/></workpiece><tool direction="0 0 -1">
+<axis name="X" type="linear" direction="1 0 0" min="-100" max="100"/><axis name="Y" type="linear" direction="0 1 0" min="-100" max="100"/>
+<axis name="Z" type="linear" direction="0 0 1" min="-100" max="100"/></tool></machine>)");
+    const MachineModel m = readMachineXml(dir.file("m.xml"));
+    const double c = std::cos(90 * kDeg) * std::cos(10 * kDeg), sy = std::sin(90 * kDeg) * std::cos(10 * kDeg), sz = std::sin(10 * kDeg);
+    std::string f = "%_N_CNCCOMP_KINCHAIN_SPF\n$MN_ROOT_KIN_ELEM_NAME=\"ROOT\"\n"
+                    "$NK_NAME[0]=\"ROOT\"\n$NK_TYPE[0]=\"OFFSET\"\n$NK_OFF_DIR[0,0]=0\n$NK_OFF_DIR[0,1]=0\n$NK_OFF_DIR[0,2]=0\n"
+                    "$NK_NEXT[0]=\"X\"\n$NK_PARALLEL[0]=\"P\"\n";
+    const char* axes[3] = {"X", "Y", "Z"};
+    for (int k = 0; k < 3; ++k)
+        f += fmt::format("$NK_NAME[{0}]=\"{1}\"\n$NK_TYPE[{0}]=\"AXIS_LIN\"\n$NK_AXIS[{0}]=\"AX{0}\"\n$NK_OFF_DIR[{0},0]={2}\n"
+                         "$NK_OFF_DIR[{0},1]={3}\n$NK_OFF_DIR[{0},2]={4}\n$NK_NEXT[{0}]=\"{5}\"\n",
+                         k + 1, axes[k], int(k == 0), int(k == 1), int(k == 2), k < 2 ? axes[k + 1] : "NINTH");
+    f += fmt::format("$NK_NAME[4]=\"NINTH\"\n$NK_TYPE[4]=\"ROT_CONST\"\n$NK_OFF_DIR[4,0]={:.15f}\n$NK_OFF_DIR[4,1]={:.15f}\n"
+                     "$NK_OFF_DIR[4,2]={:.15f}\n$NK_A_OFF[4]=30\n$NK_NEXT[4]=\"\"\n",
+                     c, sy, sz);
+    f += "$NK_NAME[5]=\"P\"\n$NK_TYPE[5]=\"OFFSET\"\n$NK_OFF_DIR[5,0]=0\n$NK_OFF_DIR[5,1]=0\n$NK_OFF_DIR[5,2]=0\n$NK_NEXT[5]=\"\"\n"
+         "$NT_NAME[1]=\"K7\"\n$NT_T_CHAIN_LAST_ELEM[1]=\"NINTH\"\n$NT_P_CHAIN_LAST_ELEM[1]=\"P\"\nM17\n";
+    const siemens::ParsedChain pc = siemens::parseKinematicChain(m, "K7.SPF", f);
+    ASSERT_EQ(pc.tool.size(), 5u);  // ROOT, X, Y, Z, the ninth element
+    const ChainElement& e = pc.tool.back();
+    ASSERT_EQ(e.type, ChainElement::Type::Constant);
+    const Vec3 u(0.0, 0.985, 0.174);  // the manual's rounded components
+    EXPECT_LT((e.pose.linear() * u.normalized() - u.normalized()).norm(), 2e-3);  // the direction stays
+    const Vec3 w = u.unitOrthogonal();
+    EXPECT_NEAR(std::acos(std::clamp((e.pose.linear() * w).dot(w), -1.0, 1.0)) / kDeg, 30.0, 1e-9);  // by $NK_A_OFF
+    EXPECT_LT(((e.pose.linear() * w).cross(w)).dot(Vec3(c, sy, sz)), 0.0);  // right-handed: w turns towards u x w
 }
 
 }  // namespace
