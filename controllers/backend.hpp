@@ -60,6 +60,9 @@ public:
     /// Parses the files (InputError with file:line on syntax errors) and models how the controller uses them.
     virtual std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
                                                        const std::vector<OutputFile>& files) const = 0;
+    /// Conventions no vendor document confirmed (marked [G] in the files), each as what the user must check on the
+    /// control before loading the files. `cnccomp emit --help` lists them. Default: none.
+    virtual std::vector<std::string> checks() const { return {}; }
 };
 
 /// All registered backends, sorted by name.

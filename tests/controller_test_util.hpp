@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <set>
 #include <string>
@@ -115,6 +116,26 @@ inline DeviationSet patternedLocationErrors(const MachineModel& m) {
             ++i;
         }
     return d;
+}
+
+/// A copy of a machine whose controller counts some axes from another zero: `zeros` maps axis names to the
+/// machine-zero attribute (mm, or deg for rotary axes). Nothing else changes: the same physical machine.
+inline MachineModel withMachineZero(const MachineModel& m, const std::map<std::string, double>& zeros) {
+    MachineModel out = m;
+    for (Chain* c : {&out.workpiece, &out.tool})
+        for (Link& l : c->links)
+            if (const auto it = zeros.find(l.name); it != zeros.end() && l.axisIndex >= 0)
+                l.machineZero = l.kind == AxisKind::Rotary ? it->second * kDeg : it->second;
+    out.name = m.name + "-machine-zero";
+    return out;
+}
+
+/// The same deviation values for another model of the same machine (e.g. withMachineZero's copy).
+inline DeviationSet sameDeviations(const DeviationSet& d, const MachineModel& other) {
+    DeviationSet out(other);
+    out.values = d.values;
+    out.present = d.present;
+    return out;
 }
 
 inline void report(const std::string& label, const controllers::CompensationFigures& f) {

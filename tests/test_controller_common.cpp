@@ -106,5 +106,32 @@ TEST(ControllerCommon, HeaderListsBothCoverageListsInTheCallersSyntax) {
     EXPECT_EQ(formatCoverage(empty), "compensated:\n  (none)\nNOT compensated:\n  (none)\n");
 }
 
+
+TEST(ControllerCommon, EmitHelpListsWhatToCheckOnTheControl) {
+    const auto help = test::runCli("emit --help");
+    ASSERT_EQ(help.exitCode, 0) << help.out;
+    EXPECT_NE(help.out.find("Check on the control before loading"), std::string::npos) << help.out;
+    int withChecks = 0;
+    for (const Backend* b : backends()) {
+        const auto list = b->checks();
+        if (list.empty()) continue;
+        ++withChecks;
+        EXPECT_NE(help.out.find(std::string(b->name()) + ":"), std::string::npos) << b->name();
+        for (const std::string& item : list) EXPECT_NE(help.out.find(item.substr(0, 40)), std::string::npos) << item;
+    }
+    EXPECT_GE(withChecks, 4);  // fanuc-30i, heidenhain-tnc, isg, siemens-840d (and generic)
+}
+
+TEST(ControllerCommon, FrameNoteNamesTheMachineZeros) {
+    MachineModel m = test::multitasking();
+    EXPECT_NE(frameNote(m).find("no machine-zero"), std::string::npos);
+    for (Chain* c : {&m.workpiece, &m.tool})
+        for (Link& l : c->links) {
+            if (l.name == "X") l.machineZero = -250.0;
+            if (l.name == "C") l.machineZero = 90.0 * kDeg;
+        }
+    EXPECT_NE(frameNote(m).find("machine-zero (X -250 mm, C 90 deg)"), std::string::npos) << frameNote(m);
+}
+
 }  // namespace
 }  // namespace cnccomp::controllers

@@ -334,3 +334,166 @@ TEST(ControllerFanuc, MalformedFilesAreRejectedWithFileAndLine) {
 
 }  // namespace
 }  // namespace cnccomp::controllers
+
+namespace cnccomp::controllers {
+namespace {
+
+/// The printed compensation values of the parameter manual's example 1 (Series 0i-PB parameter manual B-63980EN/01,
+/// parameters 3620-3624, p.100): points 33..49, reference point 40, interval 50 mm.
+const std::vector<long> kExample1 = {+2, +1, +1, -2, 0, -1, 0, -1, +2, +1, 0, -1, -1, -2, 0, +1, +2};
+
+/// Absolute compensation at the section ends -400, -350, ..., +450 mm, summed by hand from kExample1 as the manual
+/// explains it (0 at the reference position; point k's value is output across the section that ends at point k).
+const std::vector<double> kExample1Absolute = {0, 2, 3, 4, 2, 2, 1, 1, 0, 2, 3, 3, 2, 1, -1, -1, 0, 2};
+
+/// The number a parameter line carries after `prefix` (e.g. "N19700Q1L1P"), read from the text without the reader.
+double rawParameter(const std::string& text, const std::string& prefix) {
+    const size_t p = text.find("\n" + prefix);
+    if (p == std::string::npos) return std::nan("");
+    const size_t start = p + 1 + prefix.size();
+    return std::stod(text.substr(start, text.find_first_of("AN\n", start) - start));
+}
+
+TEST(ControllerFanuc, PitchModelSumsTheManualsExample1) {
+    // Oracle: the parameter manual's own example and its rule for the absolute compensation.
+    fanuc::PitchTable t;
+    t.reference = 40;
+    t.negative = 33;
+    t.positive = 49;
+    t.interval = 50.0;
+    t.data = kExample1;
+    for (size_t j = 0; j < kExample1Absolute.size(); ++j) {
+        const double x = -400.0 + 50.0 * static_cast<double>(j);
+        EXPECT_NEAR(t.correction(x, 1.0), kExample1Absolute[j], 1e-12) << x;
+    }
+    EXPECT_NEAR(t.correction(-425.0, 1.0), 0.0, 1e-12);  // ends held
+    EXPECT_NEAR(t.correction(-275.0, 1.0), 3.5, 1e-12);  // halfway between +4 (-250) and +3 (-300)
+}
+
+TEST(ControllerFanuc, PitchWriterReproducesTheManualsExample1) {
+    // A linear axis of the example's stroke whose positioning error is the negated absolute compensation of the
+    // example: the writer must number the points as the manual (reference 40 -> 33..49, here from 0) and write its values.
+    test::ScratchDir dir("fanuc-example-1");
+    std::string nodes;
+    for (int j = 0; j < 18; ++j) nodes += fmt::format("{} ", -400 + 50 * j);
+    test::writeText(dir.file("m.xml"), fmt::format(R"(<machine name="fanuc-example-1">
+<workpiece><fixed name="T"/></workpiece>
+<tool direction="0 0 -1">
+<axis name="X" type="linear" direction="1 0 0" min="-400" max="450"/>
+<axis name="Y" type="linear" direction="0 1 0" min="-100" max="100"/>
+<axis name="Z" type="linear" direction="0 0 1" min="-100" max="100"/>
+<fixed name="S"/>
+</tool>
+<deviations><component name="EXX" link="X" component="x" basis="table" nodes="{}"/></deviations>
+</machine>
+)", nodes));
+    const MachineModel m = readMachineXml(dir.file("m.xml"));
+    DeviationSet d(m);
+    const int exx = m.deviationIndex("EXX");
+    for (int j = 0; j < 18; ++j) d.values[m.deviations[exx].offset + j] = -kExample1Absolute[j] * 1e-4;  // IS-C units
+    d.present[exx] = 1;
+    fanuc::PitchOptions o;
+    o.maxIntervals = 17;
+    const EmitResult r = fanuc::emitFiles({m, d, "example", "2024-01-01"}, o);
+    const std::string& text = r.files.at(0).content;
+    const int ref = static_cast<int>(rawParameter(text, "N03620Q1A1P"));
+    const int neg = static_cast<int>(rawParameter(text, "N03621Q1A1P"));
+    const int pos = static_cast<int>(rawParameter(text, "N03622Q1A1P"));
+    EXPECT_EQ(ref - neg, 40 - 33);
+    EXPECT_EQ(pos - neg, 49 - 33);
+    EXPECT_DOUBLE_EQ(rawParameter(text, "N03624Q1A1P"), 50.0);
+    EXPECT_DOUBLE_EQ(rawParameter(text, "N03623Q1A1P"), 1.0);
+    for (int k = neg; k <= pos; ++k)
+        EXPECT_EQ(rawParameter(text, fmt::format("N{}Q0P", 10000 + k)), kExample1[k - neg]) << "point " << k;
+}
+
+TEST(ControllerFanuc, RotaryReferencePointHoldsTheLastPointsValue) {
+    // B-63980EN p.100 example 2: 45 deg interval, 3621 = 3620, 3622 = 3620 + 8, the values of 3620+1..3622 sum to
+    // zero and "for compensation position 3620, set the same compensation value as for 3622".
+    const MachineModel& m = pitchMachine();
+    fanuc::PitchOptions o;
+    o.maxIntervals = 8;
+    const EmitResult r = fanuc::emitFiles({m, pitchTruth(), "x", "2024-01-01"}, o);
+    const std::string& text = r.files.at(0).content;
+    const int c = controllerAxisNumber(m, m.requireAxis("C"));
+    const auto param = [&](int n) { return static_cast<int>(rawParameter(text, fmt::format("N0{}Q1A", n))); };
+    (void)param;
+    const fanuc::ParameterFile f = fanuc::parseParameterFile("p", text);
+    const int ref = static_cast<int>(fanuc::required(f, 3620, c)), neg = static_cast<int>(fanuc::required(f, 3621, c)),
+              pos = static_cast<int>(fanuc::required(f, 3622, c));
+    EXPECT_EQ(neg, ref);
+    EXPECT_EQ(pos, ref + 8);
+    EXPECT_DOUBLE_EQ(fanuc::required(f, 3624, c), 45.0);
+    long sum = 0;
+    for (int k = ref + 1; k <= pos; ++k) sum += static_cast<long>(rawParameter(text, fmt::format("N{}Q0P", 10000 + k)));
+    EXPECT_EQ(sum, 0);
+    const double atRef = rawParameter(text, fmt::format("N{}Q0P", 10000 + ref));
+    const double atLast = rawParameter(text, fmt::format("N{}Q0P", 10000 + pos));
+    EXPECT_NE(atLast, 0.0);  // ECC = 8" sin c - 3" sin 2c changes by -2.66" over 315..360 deg
+    EXPECT_EQ(atRef, atLast);
+    // A file that breaks the rule is refused at the reference point's line.
+    const int refLine = test::lineOf(text, fmt::format("N{}Q0P", 10000 + ref));
+    const std::string broken = test::replaceLine(text, refLine, fmt::format("N{}Q0P0", 10000 + ref));
+    const std::string msg = messageOf([&] { fanuc30i().apply(m, {{fanuc::kParameterFile, broken}}); });
+    EXPECT_EQ(msg.rfind(fmt::format("CNCCOMP.PRM:{}:", refLine), 0), 0u) << msg;
+    EXPECT_NE(msg.find("must equal the value at the last point"), std::string::npos) << msg;
+}
+
+TEST(ControllerFanuc, AbsoluteValuesAreInTheControllersMachineCoordinates) {
+    // The same machine, its controller counting X from -250 mm, Z from +400 mm and C from 90 deg of the description.
+    const MachineModel& base = pitchMachine();
+    const MachineModel m = test::withMachineZero(base, {{"X", -250.0}, {"Z", 400.0}, {"C", 90.0}});
+    DeviationSet d(m);
+    d.set("EX0C", 0.015);
+    d.set("EY0C", -0.010);
+    d.set("EX0B", 0.007);
+    d.set("EZ0B", -0.004);
+    const EmitResult r = fanuc30i().emit({m, d, "x", "2024-01-01"});
+    const std::string& text = r.files.at(0).content;
+    // Oracle: by hand. At machine coordinates 0 the controlled point (on the B axis line) is at description
+    // X = -250 + EX0B, Z = 400 + EZ0B; the C axis line at X = EX0C, Y = EY0C, Z = 0 (A-79348E: 19700-19702 are the
+    // machine coordinates of a point on the table's rotary axis, rotary axes at 0).
+    EXPECT_NEAR(rawParameter(text, "N19700Q1L1P"), 0.015 + 250.0 - 0.007, 1e-4);
+    EXPECT_NEAR(rawParameter(text, "N19701Q1L1P"), -0.010, 1e-4);
+    EXPECT_NEAR(rawParameter(text, "N19702Q1L1P"), -400.0 + 0.004, 1e-4);
+    EXPECT_NE(text.find("X -250 mm, Z 400 mm, C 90 deg"), std::string::npos);
+    // The TCP on those numbers compensates the physical machine.
+    const auto samples = test::nonSingularSamples(m, 4);
+    const CompensationFigures f = test::evaluateBackend(fanuc30i(), m, d, samples, 100.0);
+    test::report("fanuc-30i machine-zero (pivots)", f);
+    EXPECT_GT(f.maxBefore, 0.01);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    // The same file read as if the description's commands were the machine coordinates is far off: the numbers are
+    // not in the description's frame.
+    const DeviationSet d0 = test::sameDeviations(d, base);
+    const auto wrong = fanuc30i().apply(base, r.files);
+    const CompensationFigures g = evaluateCompensation(base, d0, *wrong, test::nonSingularSamples(base, 4), 100.0);
+    EXPECT_GT(g.maxAfter, 1.0);
+}
+
+TEST(ControllerFanuc, PitchTablesStartAtTheMachineZero) {
+    const MachineModel m = test::withMachineZero(pitchMachine(), {{"X", -250.0}, {"C", 180.0}});
+    DeviationSet d = test::sameDeviations(pitchTruth(), m);
+    // EXX = a1 x + a2 x^2 with a1 = 250 a2 and ECC = 8" sin c - 3" sin 2c vanish at the machine zeros, where a pitch
+    // table is zero (a constant part there is reported NOT compensated; ControllerFanuc.ConstantPart... covers it).
+    const DeviationDef& exx = m.deviations[m.deviationIndex("EXX")];
+    d.values[exx.offset] = 250.0 * d.values[exx.offset + 1];
+    const EmitResult r = fanuc30i().emit({m, d, "x", "2024-01-01"});
+    const auto tables = fanuc::pitchFromFile(m, fanuc::parseParameterFile("p", r.files.at(0).content));
+    const auto e = [&](double q) { return exx.basis.evaluate(q, d.values.data() + exx.offset, false); };
+    for (const auto& t : tables) {
+        if (m.axisNames[t.axis] != "X") continue;
+        // Oracle: EXX (a polynomial of the description's command) at command = machine position - 250 mm; the
+        // reference position (zero correction) is the machine zero, not the description's X = 0.
+        for (double p : {-400.0, -130.0, 0.0, 250.0, 610.0, 900.0}) {
+            const double want = -(e(p - 250.0) - e(-250.0));
+            EXPECT_NEAR(t.correction(p, 1e-4), want, 1.5e-4) << p;
+        }
+    }
+    const CompensationFigures f = test::evaluateBackend(fanuc30i(), m, claimedOnly(d, r), test::nonSingularSamples(m, 4, 300.0), 100.0);
+    test::report("fanuc-30i machine-zero (pivots + pitch)", f);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+}
+
+}  // namespace
+}  // namespace cnccomp::controllers

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -13,6 +14,7 @@
 #include "controllers/generic/deviation_json.hpp"
 #include "controllers/generic/grid_map.hpp"
 #include "controllers/generic/json.hpp"
+#include "controller_test_util.hpp"
 #include "test_controller_common_support.hpp"
 
 namespace cnccomp::controllers {
@@ -134,6 +136,48 @@ TEST(ControllerGeneric, ReadersNameFileAndLine) {
     const int lines = static_cast<int>(std::count(csv.begin(), csv.end(), '\n'));
     EXPECT_EQ(inputErrorLine([&] { parseGridMapCsv(bad, "map.csv", m); }), lines);
     EXPECT_THROW(parseGridMapCsv(csv, "map.csv", machine("table-table-ac")), InputError);
+}
+
+
+TEST(ControllerGeneric, MapAxisColumnsAreMachineCoordinates) {
+    const Sample s{"tilting-head-b", "map-tilting-head-b"};
+    const MachineModel& base = machine(s.machine);
+    const MachineModel m = test::withMachineZero(base, {{"X", -250.0}, {"B", 30.0}});
+    const DeviationSet d = test::sameDeviations(deviations(s), m);
+    const EmitResult r = backend("generic").emit({m, d, "x", "2024-01-01"});
+    // Oracle: by hand. X travels -800..800 mm and B -120..120 deg in the description: -550..1050 mm and -150..90 deg
+    // from the controller's machine zeros. Read the columns without the reader.
+    std::istringstream in(requireFile(r.files, "map.csv", "test").content);
+    std::string line;
+    std::vector<std::string> head;
+    double xmin = 1e9, xmax = -1e9, bmin = 1e9, bmax = -1e9;
+    int ix = -1, ib = -1;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#') continue;
+        std::vector<std::string> cells;
+        std::stringstream ls(line);
+        for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+        if (head.empty()) {
+            head = cells;
+            for (size_t k = 0; k < head.size(); ++k) {
+                if (head[k].rfind("X", 0) == 0) ix = static_cast<int>(k);
+                if (head[k].rfind("B", 0) == 0) ib = static_cast<int>(k);
+            }
+            continue;
+        }
+        xmin = std::min(xmin, std::stod(cells[ix]));
+        xmax = std::max(xmax, std::stod(cells[ix]));
+        bmin = std::min(bmin, std::stod(cells[ib]));
+        bmax = std::max(bmax, std::stod(cells[ib]));
+    }
+    ASSERT_GE(ix, 0);
+    ASSERT_GE(ib, 0);
+    EXPECT_DOUBLE_EQ(xmin, -550.0);
+    EXPECT_DOUBLE_EQ(xmax, 1050.0);
+    EXPECT_DOUBLE_EQ(bmin, -150.0);
+    EXPECT_DOUBLE_EQ(bmax, 90.0);
+    const CompensationFigures f = emitApplyEvaluate(backend("generic"), m, d, workspaceSamples(m, 6), 100.0);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
 }
 
 }  // namespace

@@ -284,5 +284,67 @@ TEST(ControllerHeidenhain, MalformedFilesAreRejectedWithFileAndLine) {
     EXPECT_EQ(messageOf([&] { tnc().apply(m, {}); }), "<heidenhain-tnc files>: no kinematics description (.TAB)");
 }
 
+
+TEST(ControllerHeidenhain, MachAxisRowsCountAgainstTheCompTabEntries) {
+    // iTNC 530 HSCI technical manual 07/2013 p.686: at most 100 COMPTAB entries, the MachAxis rows counted with them.
+    const EmitRequest req{componentsMachine(), componentsTruth(), "x", "2024-01-01"};
+    const EmitResult r = tnc().emit(req);
+    const OutputFile* tab = nullptr;
+    for (const auto& f : r.files)
+        if (f.name.ends_with(".TAB")) tab = &f;
+    ASSERT_NE(tab, nullptr);
+    // Count both kinds of row in the text, before [END] (independent of the reader).
+    int comptab = 0, machAxis = 0;
+    std::istringstream in(tab->content);
+    for (std::string line; std::getline(in, line) && line != "[END]";) {
+        machAxis += line.find(" MachAxis ") != std::string::npos;
+        comptab += line.find(".COM:C") != std::string::npos;
+    }
+    EXPECT_EQ(machAxis, 5);
+    EXPECT_GT(comptab, 0);
+    heidenhain::Options exact;
+    exact.maxCompEntries = comptab + machAxis;
+    EXPECT_NO_THROW(heidenhain::emitFiles(req, exact));
+    heidenhain::Options tight;
+    tight.maxCompEntries = comptab + machAxis - 1;  // the COMPTAB rows alone would still fit
+    try {
+        heidenhain::emitFiles(req, tight);
+        FAIL() << "expected ModelError";
+    } catch (const ModelError& e) {
+        EXPECT_NE(std::string(e.what()).find(fmt::format("{} MachAxis rows", machAxis)), std::string::npos) << e.what();
+    }
+}
+
+TEST(ControllerHeidenhain, FilesSayTheyAreForTheItnc530) {
+    const EmitResult r = tnc().emit({componentsMachine(), componentsTruth(), "x", "2024-01-01"});
+    for (const auto& f : r.files) EXPECT_NE(f.content.find("for the iTNC 530"), std::string::npos) << f.name;
+    EXPECT_NE(std::string(tnc().description()).find("not for TNC 640 / TNC7"), std::string::npos);
+    EXPECT_FALSE(tnc().checks().empty());
+}
+
+TEST(ControllerHeidenhain, RowsAndTablesAreInTheMachineCoordinates) {
+    const MachineModel& base = componentsMachine();
+    const MachineModel m = test::withMachineZero(base, {{"X", -250.0}, {"Z", 350.0}, {"C", 90.0}});
+    DeviationSet d = test::sameDeviations(without(componentsTruth(), "EZC"), m);
+    const EmitResult r = tnc().emit({m, d, "x", "2024-01-01"});
+    // Oracle: EXX (a polynomial of the description's command) at the machine positions AXISPOS of X.COM: command =
+    // AXISPOS - 250 mm; X is a tool-side axis, whose columns hold -error.
+    const heidenhain::TncTable x = heidenhain::parseTncTable("X.COM", file(r, "X.COM").content, {"NR", "AXISPOS", "C1"});
+    const DeviationDef& exx = m.deviations[m.deviationIndex("EXX")];
+    ASSERT_GT(x.rows.size(), 2u);
+    EXPECT_NEAR(std::stod(x.cell(0, x.column("AXISPOS"))), -500.0 + 250.0, 1e-9);
+    for (size_t n = 0; n < x.rows.size(); n += 7) {
+        const double p = std::stod(x.cell(n, x.column("AXISPOS")));
+        EXPECT_NEAR(std::stod(x.cell(n, x.column("C1"))), -exx.basis.evaluate(p - 250.0, d.values.data() + exx.offset, false), 1e-9) << p;
+    }
+    const CompensationFigures f = test::evaluateBackend(tnc(), m, d, test::nonSingularSamples(m, 4), 100.0);
+    test::report("heidenhain-tnc machine-zero", f);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    // The same files read as if the description's commands were the machine coordinates are far off.
+    const CompensationFigures g =
+        evaluateCompensation(base, test::sameDeviations(d, base), *tnc().apply(base, r.files), test::nonSingularSamples(base, 4), 100.0);
+    EXPECT_GT(g.maxAfter, 0.5);
+}
+
 }  // namespace
 }  // namespace cnccomp::controllers

@@ -2,6 +2,7 @@
 // rules (MIN/MAX/STEP vs point count, modulo tables closing), limits, malformed files rejected with file:line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <functional>
@@ -325,15 +326,22 @@ TEST(ControllerSiemens, MalformedFilesAreRejectedWithFileAndLine) {
     EXPECT_EQ(open.rfind(fmt::format("AX_EEC.INI:{}:", last), 0), 0u) << open;
     EXPECT_NE(open.find("does not close on itself"), std::string::npos) << open;
     // Chain: a broken link and a wrong identifier.
-    const int next = test::lineOf(chain, "$NK_NEXT[0]=");
-    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, next, "$NK_NEXT[0]=\"NOWHERE\"")),
-              fmt::format("CNCCOMP_KINCHAIN.SPF:{}: $NK_NEXT of 'T_Z' names no element ('NOWHERE')", test::lineOf(chain, "$NK_NAME[0]=")));
+    const int next = test::lineOf(chain, "$NK_NEXT[1]=");
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, next, "$NK_NEXT[1]=\"NOWHERE\"")),
+              fmt::format("CNCCOMP_KINCHAIN.SPF:{}: $NK_NEXT of 'T_Z' names no element ('NOWHERE')", test::lineOf(chain, "$NK_NAME[1]=")));
     EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, 1, "%_N_OTHER_SPF")),
               "CNCCOMP_KINCHAIN.SPF:1: file identifier is %_N_OTHER_SPF, expected %_N_CNCCOMP_KINCHAIN_SPF");
-    const int type = test::lineOf(chain, "$NK_TYPE[0]=");
-    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, type, "$NK_TYPE[0]=\"AXIS_ROT\"")),
+    const int type = test::lineOf(chain, "$NK_TYPE[1]=");
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, type, "$NK_TYPE[1]=\"AXIS_ROT\"")),
               fmt::format("CNCCOMP_KINCHAIN.SPF:{}: AX3 is axis Z of machine 'controllers-siemens-components', which is linear",
-                          test::lineOf(chain, "$NK_NAME[0]=")));
+                          test::lineOf(chain, "$NK_NAME[1]=")));
+    // The root: no machine data naming it, or naming an element that does not exist.
+    const int md = test::lineOf(chain, "$MN_ROOT_KIN_ELEM_NAME=");
+    ASSERT_GT(md, 0);
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, md, "; removed")),
+              "CNCCOMP_KINCHAIN.SPF: no $MN_ROOT_KIN_ELEM_NAME naming the chain root");
+    EXPECT_EQ(withFile(siemens::kChainFile, test::replaceLine(chain, md, "$MN_ROOT_KIN_ELEM_NAME=\"BASE\"")),
+              fmt::format("CNCCOMP_KINCHAIN.SPF:{}: $MN_ROOT_KIN_ELEM_NAME names 'BASE', which no $NK_NAME has", md));
     // Missing chain file; unknown file.
     std::vector<OutputFile> noChain;
     for (const auto& f : r.files)
@@ -345,6 +353,108 @@ TEST(ControllerSiemens, MalformedFilesAreRejectedWithFileAndLine) {
     EXPECT_NE(messageOf([&] { siemens().apply(m, extra); }).find("NOTES.TXT: not a siemens-840d file"), std::string::npos);
     // Binary content.
     EXPECT_NE(withFile(siemens::kCecFile, std::string("%_N_NC_CEC_INI\n\x01\x02\n")).find("binary content"), std::string::npos);
+}
+
+
+TEST(ControllerSiemens, ChainStartsAtTheRootTheMachineDataNames) {
+    // Oracle: the archive layout of K7/K12 (element 0 "ROOT", found through MD16800 $MN_ROOT_KIN_ELEM_NAME; its
+    // $NK_NEXT starts one subchain, $NK_PARALLEL the other), read line by line without the backend's reader.
+    const MachineModel& m = test::multitasking();
+    const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/multitasking-truth.csv"), m);
+    const EmitResult r = siemens().emit({m, d, "x", "2024-01-01"});
+    std::string chain;
+    for (const auto& f : r.files)
+        if (f.name == siemens::kChainFile) chain = f.content;
+    std::istringstream in(chain);
+    std::vector<std::string> assignments;
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("$", 0) == 0) assignments.push_back(line);
+    ASSERT_GE(assignments.size(), 6u);
+    EXPECT_EQ(assignments[0], "$MN_ROOT_KIN_ELEM_NAME=\"ROOT\"");
+    EXPECT_EQ(assignments[1], "$NK_NAME[0]=\"ROOT\"");
+    EXPECT_EQ(assignments[2], "$NK_TYPE[0]=\"OFFSET\"");
+    std::string next, parallel;
+    for (const std::string& a : assignments) {
+        if (a.rfind("$NK_NEXT[0]=", 0) == 0) next = a.substr(12);
+        if (a.rfind("$NK_PARALLEL[0]=", 0) == 0) parallel = a.substr(16);
+    }
+    EXPECT_EQ(next, "\"T_Z\"");       // the tool subchain: Z first from the bed
+    EXPECT_EQ(parallel.rfind("\"P_C", 0), 0u) << parallel;  // the part subchain: the C work spindle (its offset first)
+}
+
+TEST(ControllerSiemens, ChainAndTablesAreInTheMachineCoordinates) {
+    const MachineModel& base = componentsMachine();
+    const MachineModel m = test::withMachineZero(base, {{"X", -250.0}, {"Z", 400.0}, {"B", 30.0}, {"C", 90.0}});
+    const DeviationSet d = test::sameDeviations(
+        readDeviationCsv(sourcePath("samples/deviations/controllers-siemens-components.csv"), base), m);
+    const EmitResult r = siemens().emit({m, d, "x", "2024-01-01"});
+    // Oracle: the positioning error EXX (a polynomial of the description's command) at the EEC table's positions, which
+    // are machine positions: command = position - 250 mm.
+    std::string eecText;
+    for (const auto& f : r.files)
+        if (f.name == siemens::kEecFile) eecText = f.content;
+    const DeviationDef& exx = m.deviations[m.deviationIndex("EXX")];
+    const int x = m.requireAxis("X");
+    bool seen = false;
+    for (const auto& t : siemens::parseEec(m, siemens::kEecFile, eecText)) {
+        if (t.axis != x) continue;
+        seen = true;
+        for (double p : {-450.0, -100.0, 0.0, 333.0, 900.0})
+            EXPECT_NEAR(t.table.at(p), exx.basis.evaluate(p - 250.0, d.values.data() + exx.offset, false), 2e-6) << p;
+    }
+    EXPECT_TRUE(seen);
+    // TRAORI on the chain in machine coordinates, CEC and EEC at machine positions: the physical machine is compensated.
+    const EmitResult claimed = siemens().emit({m, d, "x", "2024-01-01"});
+    DeviationSet c = d;
+    for (const auto& nc : claimed.notCompensated) {
+        const int i = m.deviationIndex(nc.deviation);
+        c.values.segment(m.deviations[i].offset, m.deviations[i].size()).setZero();
+        c.present[i] = 0;
+    }
+    const CompensationFigures f = test::evaluateBackend(siemens(), m, c, test::nonSingularSamples(m, 4), 100.0);
+    test::report("siemens-840d machine-zero (claimed)", f);
+    EXPECT_LT(f.maxAfter, 0.1 * f.maxBefore);
+    // Read as if the description's commands were the machine coordinates, the same files are far off.
+    const DeviationSet c0 = test::sameDeviations(c, base);
+    const CompensationFigures g = evaluateCompensation(base, c0, *siemens().apply(base, r.files), test::nonSingularSamples(base, 4), 100.0);
+    EXPECT_GT(g.maxAfter, 0.5);
+}
+
+
+TEST(ControllerSiemens, RotConstTurnsAboutItsDirectionAsK7Prints) {
+    // K7 (840D sl function manual special functions 01/2015, 6FC5397-2BP40-5BA2) p.202: the 9th element's direction
+    // vector is (1; 0; 0) turned by 90 deg in the X/Y plane and 10 deg in the Y/Z plane, (cos90 cos10, sin90 cos10,
+    // sin10) = (0.0, 0.985, 0.174), and "the output coordinate system ... arises from the input coordinate system,
+    // rotated through the angle specified in $NK_A_OFF around the direction vector". A chain with such an element
+    // after the slides of a three-axis machine, read back:
+    test::ScratchDir dir("k7");
+    test::writeText(dir.file("m.xml"), R"(<machine name="k7"><workpiece><fixed name="T"/></workpiece><tool direction="0 0 -1">
+<axis name="X" type="linear" direction="1 0 0" min="-100" max="100"/><axis name="Y" type="linear" direction="0 1 0" min="-100" max="100"/>
+<axis name="Z" type="linear" direction="0 0 1" min="-100" max="100"/></tool></machine>)");
+    const MachineModel m = readMachineXml(dir.file("m.xml"));
+    const double c = std::cos(90 * kDeg) * std::cos(10 * kDeg), sy = std::sin(90 * kDeg) * std::cos(10 * kDeg), sz = std::sin(10 * kDeg);
+    std::string f = "%_N_CNCCOMP_KINCHAIN_SPF\n$MN_ROOT_KIN_ELEM_NAME=\"ROOT\"\n"
+                    "$NK_NAME[0]=\"ROOT\"\n$NK_TYPE[0]=\"OFFSET\"\n$NK_OFF_DIR[0,0]=0\n$NK_OFF_DIR[0,1]=0\n$NK_OFF_DIR[0,2]=0\n"
+                    "$NK_NEXT[0]=\"X\"\n$NK_PARALLEL[0]=\"P\"\n";
+    const char* axes[3] = {"X", "Y", "Z"};
+    for (int k = 0; k < 3; ++k)
+        f += fmt::format("$NK_NAME[{0}]=\"{1}\"\n$NK_TYPE[{0}]=\"AXIS_LIN\"\n$NK_AXIS[{0}]=\"AX{0}\"\n$NK_OFF_DIR[{0},0]={2}\n"
+                         "$NK_OFF_DIR[{0},1]={3}\n$NK_OFF_DIR[{0},2]={4}\n$NK_NEXT[{0}]=\"{5}\"\n",
+                         k + 1, axes[k], int(k == 0), int(k == 1), int(k == 2), k < 2 ? axes[k + 1] : "NINTH");
+    f += fmt::format("$NK_NAME[4]=\"NINTH\"\n$NK_TYPE[4]=\"ROT_CONST\"\n$NK_OFF_DIR[4,0]={:.15f}\n$NK_OFF_DIR[4,1]={:.15f}\n"
+                     "$NK_OFF_DIR[4,2]={:.15f}\n$NK_A_OFF[4]=30\n$NK_NEXT[4]=\"\"\n",
+                     c, sy, sz);
+    f += "$NK_NAME[5]=\"P\"\n$NK_TYPE[5]=\"OFFSET\"\n$NK_OFF_DIR[5,0]=0\n$NK_OFF_DIR[5,1]=0\n$NK_OFF_DIR[5,2]=0\n$NK_NEXT[5]=\"\"\n"
+         "$NT_NAME[1]=\"K7\"\n$NT_T_CHAIN_LAST_ELEM[1]=\"NINTH\"\n$NT_P_CHAIN_LAST_ELEM[1]=\"P\"\nM17\n";
+    const siemens::ParsedChain pc = siemens::parseKinematicChain(m, "K7.SPF", f);
+    ASSERT_EQ(pc.tool.size(), 5u);  // ROOT, X, Y, Z, the ninth element
+    const ChainElement& e = pc.tool.back();
+    ASSERT_EQ(e.type, ChainElement::Type::Constant);
+    const Vec3 u(0.0, 0.985, 0.174);  // the manual's rounded components
+    EXPECT_LT((e.pose.linear() * u.normalized() - u.normalized()).norm(), 2e-3);  // the direction stays
+    const Vec3 w = u.unitOrthogonal();
+    EXPECT_NEAR(std::acos(std::clamp((e.pose.linear() * w).dot(w), -1.0, 1.0)) / kDeg, 30.0, 1e-9);  // by $NK_A_OFF
+    EXPECT_LT(((e.pose.linear() * w).cross(w)).dot(Vec3(c, sy, sz)), 0.0);  // right-handed: w turns towards u x w
 }
 
 }  // namespace

@@ -37,6 +37,8 @@ double niceStepAtLeast(double x) {
 
 double positionScale(const Link& axis) { return axis.kind == AxisKind::Rotary ? 1.0 / kDeg : 1.0; }
 
+double commandOf(const Link& axis, double filePosition) { return filePosition / positionScale(axis) + axis.machineZero; }
+
 EquidistantTable gridOverTravel(const Link& axis, int maxPoints) {
     if (maxPoints < 2) throw ModelError("a compensation table needs at least two points");
     EquidistantTable t;
@@ -55,7 +57,8 @@ EquidistantTable gridOverTravel(const Link& axis, int maxPoints) {
         throw ModelError(fmt::format("a table over modulo axis {} needs more than {} points", axis.name, maxPoints));
     }
     const double scale = positionScale(axis);
-    const double lo = std::min(axis.min * scale, 0.0), hi = std::max(axis.max * scale, 0.0);
+    const double lo = std::min((axis.min - axis.machineZero) * scale, 0.0);
+    const double hi = std::max((axis.max - axis.machineZero) * scale, 0.0);
     if (!std::isfinite(lo) || !std::isfinite(hi))
         throw ModelError(fmt::format("axis {} has no finite travel; a compensation table needs one (set min and max)",
                                      axis.name));

@@ -57,6 +57,10 @@ void buildChain(const MachineModel& machine, const std::vector<ChainElement>& el
                                          machine.axisNames[e.axis]));
         const Link& real = machine.axisLink(e.axis);
         Link l = real;
+        // The controller counts the axis from its own machine zero: same travel, other numbers.
+        l.min = real.min - real.machineZero;
+        l.max = real.max - real.machineZero;
+        l.machineZero = 0.0;
         l.direction = e.direction;
         l.placement = pending;
         chain.links.push_back(l);
@@ -156,8 +160,9 @@ void TcpTransform::setToolLength(double length) {
 
 AxisVector TcpTransform::solve(const AxisVector& programmed) const {
     const ToolPose target = toolPose(nominal_, programmed, tip_);
-    const IkResult r = solveToolPose(controller_->kinematics(), target, tip_, programmed);
-    return r.q;
+    const MachineModel& m = nominal_.machine();
+    const IkResult r = solveToolPose(controller_->kinematics(), target, tip_, m.toController(programmed));
+    return m.fromController(r.q);
 }
 
 Vec6 linkLocationError(const MachineModel& m, const Eigen::VectorXd& values, Side side, int link) {

@@ -52,8 +52,9 @@ struct ComponentTable {
     std::vector<double> values;  ///< mm or rad
 };
 
-/// The controller's corrected kinematic model. Throws ModelError when the chains do not hold exactly the
-/// machine's axes in the machine's order (workpiece chain first, each chain from the bed outwards).
+/// The controller's corrected kinematic model, in the controller's own axis coordinates (machine coordinates:
+/// command − Link::machineZero; the links' travel is shifted to match). Throws ModelError when the chains do not hold
+/// exactly the machine's axes in the machine's order (workpiece chain first, each chain from the bed outwards).
 class ControllerModel {
 public:
     ControllerModel(const MachineModel& machine, const std::vector<ChainElement>& workpiece,
@@ -67,9 +68,10 @@ private:
     std::unique_ptr<Kinematics> kinematics_;
 };
 
-/// The TCP of a controller: programmed commands (meant for the nominal machine) → nominal tool pose →
-/// commands at which the controller's model reaches that pose (Newton, solveToolPose). The machine must
-/// outlive the transform.
+/// The TCP of a controller: programmed commands (meant for the nominal machine, in the description's frame) →
+/// nominal tool pose → the controller's machine coordinates at which its model (ControllerModel, controller
+/// coordinates) reaches that pose (Newton, solveToolPose) → back to the description's frame
+/// (MachineModel::fromController). The machine must outlive the transform.
 class TcpTransform {
 public:
     TcpTransform(const MachineModel& machine, std::unique_ptr<const ControllerModel> controller,

@@ -1,5 +1,7 @@
 #include "controllers/common/header.hpp"
 
+#include "controllers/common/controller_model.hpp"
+
 #include <algorithm>
 #include <filesystem>
 
@@ -64,6 +66,22 @@ std::string formatHeader(const HeaderInfo& h, std::string_view prefix, std::stri
     list(out, prefix, suffix, eol, h.notCompensated);
     for (const std::string& n : h.notes) line(out, prefix, suffix, eol, n);
     return out;
+}
+
+std::string frameNote(const MachineModel& m) {
+    std::string zeros;
+    for (int a : controllerAxisOrder(m)) {
+        const Link& l = m.axisLink(a);
+        if (l.machineZero == 0.0) continue;
+        const bool rotary = l.kind == AxisKind::Rotary;
+        zeros += fmt::format("{}{} {:g} {}", zeros.empty() ? "" : ", ", l.name, rotary ? l.machineZero / kDeg : l.machineZero,
+                             rotary ? "deg" : "mm");
+    }
+    if (zeros.empty())
+        return "frame: positions in the controller's machine coordinates; the machine description gives no machine-zero, "
+               "so its commands are taken as the machine coordinates (check: its zeros are the control's)";
+    return fmt::format("frame: positions in the controller's machine coordinates = description commands - machine-zero ({})",
+                       zeros);
 }
 
 std::string formatCoverage(const EmitResult& r) {

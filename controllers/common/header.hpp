@@ -31,6 +31,11 @@ HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controlle
 std::string formatHeader(const HeaderInfo& info, std::string_view prefix, std::string_view suffix = "",
                          std::string_view eol = "\n");
 
+/// One header line saying in which frame the file's positions are: the controller's machine coordinates, and the
+/// machine-zero of each axis that has one ("X -250 mm, C 90 deg"), or that the description's commands are taken as
+/// the controller's machine coordinates (no machine-zero given).
+std::string frameNote(const MachineModel& m);
+
 /// The coverage report as printed by `cnccomp emit` (two indented lists).
 std::string formatCoverage(const EmitResult& result);
 

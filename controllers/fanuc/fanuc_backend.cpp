@@ -55,10 +55,15 @@ EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
     for (int a : controllerAxisOrder(m)) axes += fmt::format("{}A{} = {}", axes.empty() ? "" : ", ", controllerAxisNumber(m, a), m.axisNames[a]);
     const std::vector<std::string> notes = {
         "controlled axes: " + axes + "; path 1; increment system IS-C (0.0001 mm / 0.0001 deg) [G]",
+        frameNote(m),
+        "absolute values: 19680-19714 and 1220 replace the control's values (machine coordinates at all axes 0, A-79348E); "
+        "they are not deltas to add",
         fmt::format("machine type 19680 = {}; 1220 moves the workpiece datum onto the measured axis lines (leave it out if "
                     "the datum is probed again)",
                     tcp.type),
-        "pitch data: correction added to the command (= -error) per interval, reference position at machine 0 [G]",
+        "pitch data (B-63980EN p.100): point k holds the increment of the section ending at (k - 3620) x 3624 from the "
+        "reference position (machine 0); rotary: 3621 = 3620 and point 3620 = point 3622",
+        "pitch data sign: correction added to the command (= -error) [G]; linear inside a section [G]",
         "line format N<number>Q1L1P (path), N<number>Q1A<n>P (axis), N1<point>Q0P (pitch data) [G: confirm on the control]",
         "power off/on and a reference return after loading",
     };
@@ -83,9 +88,11 @@ FanucCompensation::FanucCompensation(const MachineModel& m, std::unique_ptr<cons
 AxisVector FanucCompensation::driveCommands(const AxisVector& programmed) const {
     const AxisVector q = tcp_.solve(programmed);
     AxisVector out = q;
+    // Pitch error compensation acts on the machine position of each axis (the controller's coordinates).
+    const AxisVector p = machine_->toController(q);
     for (const PitchTable& t : pitch_) {
         const double scale = positionScale(machine_->axisLink(t.axis));
-        out[t.axis] += t.correction(q[t.axis] * scale, unit_) / scale;
+        out[t.axis] += t.correction(p[t.axis] * scale, unit_) / scale;
     }
     return out;
 }
@@ -126,6 +133,16 @@ public:
                "stored pitch error compensation (3620-3625 + data)";
     }
     EmitResult emit(const EmitRequest& request) const override { return emitFiles(request, PitchOptions{}); }
+    std::vector<std::string> checks() const override {
+        return {"increment system IS-C (0.0001 mm / deg): the P values of 19700-19714 and the pitch data are written for it",
+                "pitch data sign: a positive value moves the axis positive (cnccomp writes -error); check one point with "
+                "a laser before loading all",
+                "pitch error output is interpolated inside a section by cnccomp's model; a control that outputs it as a "
+                "step at the point leaves up to half a section's change",
+                "pitch limits: 128 intervals per axis, 1024 points in all, data within +-127 (3623 magnification <= 100)",
+                "the parameter tape format (N....Q1L1P / A<n>P / Q0P lines) reads in on your control's I/O settings",
+                "axis numbers A1.. in the order X Y Z A B C are the control's controlled-axis numbers"};
+    }
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
                                                const std::vector<OutputFile>& files) const override {
         return readFiles(machine, files);

@@ -14,23 +14,27 @@
 namespace cnccomp::controllers::fanuc {
 
 double PitchTable::correction(double x, double unit) const {
-    const int n = static_cast<int>(data.size());
-    if (n < 2) return 0.0;
-    std::vector<double> cum(n, 0.0);
-    const int r = reference - negative;
-    for (int k = r + 1; k < n; ++k) cum[k] = cum[k - 1] + data[k] * unit * magnification;
-    for (int k = r - 1; k >= 0; --k) cum[k] = cum[k + 1] - data[k + 1] * unit * magnification;
-    const double lo = positionOf(negative), hi = positionOf(positive);
-    if (rotaryType) {
-        x = std::fmod(x - lo, hi - lo);
-        if (x < 0) x += hi - lo;
-        x += lo;
+    // Section boundaries j = 0..n at machine positions (negative - 1 - reference + j) x interval; the section that ends
+    // at boundary j belongs to point negative - 1 + j. The absolute correction is 0 at the reference position and
+    // changes by that point's data across its section (B-63980EN p.100).
+    const int n = positive - negative + 1;
+    if (n < 1 || static_cast<int>(data.size()) != n || !(interval > 0)) return 0.0;
+    const int r = reference - negative + 1;  // boundary at machine position 0
+    if (r < 0 || r > n) return 0.0;
+    std::vector<double> a(static_cast<size_t>(n) + 1, 0.0);
+    const double u = unit * magnification;
+    for (int j = r + 1; j <= n; ++j) a[j] = a[j - 1] + static_cast<double>(data[j - 1]) * u;
+    for (int j = r - 1; j >= 0; --j) a[j] = a[j + 1] - static_cast<double>(data[j]) * u;
+    const double lo = (negative - 1 - reference) * interval, hi = (positive - reference) * interval;
+    if (rotaryType) {  // one revolution from the reference position
+        x = std::fmod(x, 360.0);
+        if (x < 0) x += 360.0;
     }
-    if (x <= lo) return cum.front();
-    if (x >= hi) return cum.back();
-    const double u = (x - lo) / interval;
-    const int i = std::min(static_cast<int>(std::floor(u)), n - 2);
-    return cum[i] + (cum[i + 1] - cum[i]) * (u - i);
+    if (x <= lo) return a.front();
+    if (x >= hi) return a.back();
+    const double t = (x - lo) / interval;
+    const int j = std::min(static_cast<int>(std::floor(t)), n - 1);
+    return a[j] + (a[j + 1] - a[j]) * (t - j);
 }
 
 namespace {
@@ -79,13 +83,12 @@ PitchPlan pitchFromDeviations(const MachineModel& m, const DeviationSet& d, cons
             reject(e.what());
             continue;
         }
-        const double scale = positionScale(l);
         const double toFile = l.kind == AxisKind::Rotary ? 1.0 / kDeg : 1.0;
         const auto err = [&](double pos) {
             double e = 0;
             for (int di : it->second) {
                 const DeviationDef& def = m.deviations[di];
-                e += ownAxis(def, l) * def.basis.evaluate(pos / scale, d.values.data() + def.offset, l.modulo);
+                e += ownAxis(def, l) * def.basis.evaluate(commandOf(l, pos), d.values.data() + def.offset, l.modulo);
             }
             return e * toFile;
         };
@@ -93,35 +96,47 @@ PitchPlan pitchFromDeviations(const MachineModel& m, const DeviationSet& d, cons
             reject("not periodic over one revolution: a rotary-axis pitch table must sum to zero");
             continue;
         }
-        const int n = static_cast<int>(grid.values.size());
+        // Boundaries of the sections (grid positions, machine coordinates); point numbers as the parameter manual
+        // derives them: 3621 = 3620 - (negative stroke / interval) + 1, 3622 = 3620 + positive stroke / interval.
+        const int nb = static_cast<int>(grid.values.size());
         const int r = static_cast<int>(std::lround(-grid.min / grid.step));
         const double e0 = err(0.0);
-        std::vector<double> c(n);
-        for (int k = 0; k < n; ++k) c[k] = -(err(grid.min + grid.step * k) - e0);
+        std::vector<double> c(nb);
+        for (int k = 0; k < nb; ++k) c[k] = -(err(grid.min + grid.step * k) - e0);
         double maxStep = 0;
-        for (int k = 1; k < n; ++k) maxStep = std::max(maxStep, std::abs(c[k] - c[k - 1]) / o.unit);
+        for (int k = 1; k < nb; ++k) maxStep = std::max(maxStep, std::abs(c[k] - c[k - 1]) / o.unit);
         PitchTable t;
         t.axis = a;
         t.interval = grid.step;
         t.rotaryType = grid.modulo;
-        t.negative = base;
-        t.reference = base + r;
-        t.positive = base + n - 1;
+        if (t.rotaryType) {
+            t.reference = t.negative = base;
+            t.positive = base + nb - 1;
+        } else {
+            t.reference = base + std::max(r - 1, 0);
+            t.negative = t.reference - r + 1;
+            t.positive = t.negative + nb - 2;
+        }
         for (t.magnification = std::max(1, static_cast<int>(std::ceil(maxStep / o.maxData)));; ++t.magnification) {
             if (t.magnification > o.maxMagnification)
                 throw ModelError(fmt::format("fanuc-30i: pitch error of axis {} changes by {:.1f} detection units per "
                                              "interval; even magnification {} exceeds the data range +-{}",
                                              l.name, maxStep, o.maxMagnification, o.maxData));
             const double u = o.unit * t.magnification;
-            t.data.assign(n, 0);
+            // Point negative + s holds the section from boundary s (rotary: s - 1) to the next; rounding the absolute
+            // values keeps the sum exact (a revolution sums to zero).
+            t.data.assign(static_cast<size_t>(t.positive - t.negative + 1), 0);
             bool fits = true;
-            for (int k = 1; k < n; ++k) {
-                t.data[k] = std::lround(c[k] / u) - std::lround(c[k - 1] / u);
-                fits = fits && std::abs(t.data[k]) <= o.maxData;
+            const int first = t.rotaryType ? 1 : 0;
+            for (int s = 0; s + 1 < nb; ++s) {
+                const long v = std::lround(c[s + 1] / u) - std::lround(c[s] / u);
+                t.data[static_cast<size_t>(s + first)] = v;
+                fits = fits && std::abs(v) <= o.maxData;
             }
+            if (t.rotaryType) t.data.front() = t.data.back();  // 3620 holds the value of 3622 (B-63980EN p.100)
             if (fits) break;
         }
-        base += n;
+        base = t.positive + 1;
         if (base > o.maxPoints)
             throw ModelError(fmt::format("fanuc-30i: the pitch error tables need {} compensation points; the control holds {}",
                                          base, o.maxPoints));
@@ -203,9 +218,10 @@ std::vector<PitchTable> pitchFromFile(const MachineModel& m, const ParameterFile
             const double rev = value(f, 3625, number, 0.0);
             const int line = p3620->line;
             if (!(t.interval > 0)) throw InputError(f.path, f.find(3624)->line, fmt::format("parameter 3624 of axis A{} must be positive", number));
-            if (!(t.negative <= t.reference && t.reference <= t.positive && t.negative < t.positive))
-                throw InputError(f.path, line, fmt::format("axis A{}: points must satisfy 3621 <= 3620 <= 3622 (got {}, {}, {})", number,
-                                                           t.negative, t.reference, t.positive));
+            if (!(t.negative - 1 <= t.reference && t.reference <= t.positive && t.negative <= t.positive))
+                throw InputError(f.path, line, fmt::format("axis A{}: points must satisfy 3621 - 1 <= 3620 <= 3622 and 3621 <= 3622 "
+                                                           "(got 3620 = {}, 3621 = {}, 3622 = {})",
+                                                           number, t.reference, t.negative, t.positive));
             if (rev != 0.0 && rev != 360.0)
                 throw InputError(f.path, f.find(3625)->line, fmt::format("parameter 3625 of axis A{}: only 0 or 360 is modelled", number));
             t.rotaryType = rev == 360.0;
@@ -229,6 +245,10 @@ std::vector<PitchTable> pitchFromFile(const MachineModel& m, const ParameterFile
             }
             if (t.rotaryType && sum != 0)
                 throw InputError(f.path, lastLine, fmt::format("axis A{}: rotary-axis pitch data sum to {} over one revolution, not 0", number, sum));
+            if (t.rotaryType && t.data.front() != t.data.back())
+                throw InputError(f.path, f.find(10000 + t.reference, 0)->line,
+                                 fmt::format("axis A{}: the value at the reference point {} ({}) must equal the value at the last point {} ({})",
+                                             number, t.reference, t.data.front(), t.positive, t.data.back()));
             out.push_back(std::move(t));
         }
     }

@@ -1,14 +1,22 @@
 #pragma once
-// Fanuc stored pitch error compensation (parameters 3620-3625 and the compensation data):
-//   3620 number of the compensation point at the reference position (machine coordinate 0 [G])
-//   3621 number of the point at the most negative end, 3622 at the most positive end
+// Fanuc stored pitch error compensation (parameters 3620-3625 and the compensation data), as the parameter manual
+// describes it (Series 0i-PB parameter manual B-63980EN/01, 4. "Description of parameters", 3620-3625, pp. 99-100;
+// the 30i manual B-63950EN has the same text):
+//   3620 number of the compensation point at the reference position (machine coordinate 0)
+//   3621 number of the farthest point on the negative side = 3620 - (negative stroke / interval) + 1
+//   3622 number of the farthest point on the positive side = 3620 + (positive stroke / interval)
 //   3623 magnification (data x magnification x detection unit), 3624 interval between points (mm / deg)
-//   3625 travel per revolution of a rotary axis (360 = rotary-axis type: one revolution, data sum to zero)
-//   data N(10000 + point)Q0P<integer>: the compensation added over the interval that ends at that point
-//   (incremental), in detection units (IS-C: 0.0001 mm / 0.0001 deg [G]).
-// The compensation is the correction added to the command (= -positioning error) [G: sign]; it is zero at the
-// reference position, so the error's own value there is reported as not compensated. The apply model
-// interpolates linearly inside an interval [G: the control may output it as a step at the point].
+//   3625 travel per revolution of a rotary axis (360: rotary-axis type)
+//   data N(10000 + k)Q0P<integer>: the compensation output for the section that ends at point k, i.e. for the move
+//   from machine position (k - 3620 - 1) x interval to (k - 3620) x interval (incremental values; B-63980EN p.100
+//   example 1: points 33..49 around reference 40 at 50 mm).
+//   Rotary-axis type (p.100 example 2): 3621 = 3620, 3622 = 3620 + 360 / interval; the data of 3620+1 .. 3622 sum to
+//   zero over the revolution, and "for compensation position 3620, set the same compensation value as for 3622"
+//   (point 3620's section, the last interval before 0 deg, is the one that ends at 360 deg).
+// Positions are the controller's machine coordinates (Link::machineZero). Values are in detection units
+// (IS-C: 0.0001 mm / 0.0001 deg [G]). The compensation is the correction added to the command (= -positioning error)
+// [G: sign]; it is zero at the reference position, so the error's own value there is reported as not compensated.
+// The apply model interpolates linearly inside a section [G: the control may output it as a step at the point].
 #include <string>
 #include <vector>
 
@@ -33,10 +41,10 @@ struct PitchTable {
     double interval = 1;      ///< mm / deg
     bool rotaryType = false;  ///< 3625 = 360
     std::vector<long> data;   ///< points negative..positive
-    /// Cumulative correction (mm / deg) at a position (mm / deg), linear between points, ends held,
-    /// a rotary-type table wraps.
+    /// Absolute correction (mm / deg) at a machine position (mm / deg), summed from the reference position as the
+    /// parameter manual explains: 0 at the reference, + data[k] across the section ending at point k; linear inside a
+    /// section, ends held; a rotary-type table wraps.
     double correction(double position, double unit) const;
-    double positionOf(int point) const { return (point - reference) * interval; }
 };
 
 struct PitchPlan {
@@ -51,7 +59,7 @@ PitchPlan pitchFromDeviations(const MachineModel& m, const DeviationSet& d, cons
 std::vector<Parameter> pitchLines(const MachineModel& m, const std::vector<PitchTable>& tables);
 
 /// InputError (file:line) on inconsistent point numbers, missing data, data of a rotary-type table that do not
-/// sum to zero over the revolution.
+/// sum to zero over the revolution or whose reference point's value differs from the last point's.
 std::vector<PitchTable> pitchFromFile(const MachineModel& m, const ParameterFile& f);
 
 }  // namespace cnccomp::controllers::fanuc

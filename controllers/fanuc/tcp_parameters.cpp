@@ -18,7 +18,8 @@ struct Walk {
     Mat3 endRot = Mat3::Identity();
 };
 
-/// Chain at zero commands with the translation part of the location errors only.
+/// Chain at the controller's zero (every axis at its machine zero: the description's command Link::machineZero), with
+/// the translation part of the location errors only. Points and directions are those of each axis line.
 Walk walk(const MachineModel& m, const Eigen::VectorXd& values, Side side) {
     const Chain& c = m.chain(side);
     Walk w;
@@ -32,6 +33,8 @@ Walk walk(const MachineModel& m, const Eigen::VectorXd& values, Side side) {
         p = p * l.placement * t;
         w.point[i] = p.translation();
         w.dir[i] = p.linear() * l.direction;
+        if (l.kind == AxisKind::Linear) p.translation() += p.linear() * l.direction * l.machineZero;
+        if (l.kind == AxisKind::Rotary) p.linear() = p.linear() * axisRotation(l.direction, l.machineZero);
     }
     w.end = p.translation();
     w.endRot = p.linear();
@@ -98,7 +101,7 @@ TcpParameters tcpFromMachine(const MachineModel& m, const Eigen::VectorXd& value
     for (int k = 0; k < 3; ++k)
         if ((tool + Vec3::Unit(k)).norm() < 1e-9) p.toolAxis = k + 1;
     if (p.toolAxis == 0)
-        throw ModelError("fanuc-30i: at zero commands the tool must point to -X, -Y or -Z (reference tool axis direction 19697)");
+        throw ModelError("fanuc-30i: at the controller's zero the tool must point to -X, -Y or -Z (reference tool axis direction 19697)");
     RotaryParameter hypothetical;
     hypothetical.axis = -1;
     const Vec3 D = tw.end;
@@ -246,8 +249,9 @@ TcpParameters tcpFromFile(const MachineModel& m, const ParameterFile& f) {
 
 void tcpChains(const MachineModel& m, const TcpParameters& p, std::vector<ChainElement>& workpiece,
                std::vector<ChainElement>& tool) {
+    // The controller's zero: machine coordinates 0, i.e. the description's commands at the machine zeros.
     const Kinematics nominal(m);
-    const AxisVector zero = AxisVector::Zero(m.axisCount());
+    const AxisVector zero = m.fromController(AxisVector::Zero(m.axisCount()));
     const auto rotation = [](const Mat3& r) {
         Pose q = Pose::Identity();
         q.linear() = r;

@@ -19,7 +19,9 @@
 //         datum follows the measured table axis line as the deviation set defines it
 //
 // Machine coordinates are those of the controlled point: a point on the first tool rotary axis (types 2, 21),
-// or the tool reference point (types 0, 12); offsets in front of it move to the table side.
+// or the tool reference point (types 0, 12); offsets in front of it move to the table side. Every value is absolute,
+// in the controller's machine coordinate system at machine coordinates 0 (all axes at their Link::machineZero, rotary
+// axes at 0 deg as A-79348E defines the vectors "when the rotation axes are all at 0 degrees").
 // What the TCP parameters hold: the translation location errors (pivot positions, spindle offsets, axis
 // offsets). Orientation errors of rotary axes, squareness and component errors other than positioning have
 // no 30i TCP parameter (3-D error compensation numbers are not public) and are reported NOT compensated.
@@ -59,7 +61,13 @@ std::vector<Parameter> tcpLines(const MachineModel& m, const TcpParameters& p);
 /// Reads them back (InputError with the parameter's line).
 TcpParameters tcpFromFile(const MachineModel& m, const ParameterFile& f);
 
-/// The controller's kinematic chains described by the parameters (machine axes and travel from `m`).
+/// The controller's kinematic chains described by the parameters (machine axes and travel from `m`), in machine
+/// coordinates, as the 30i-A TCP manual defines them (A-79348E pp. 72-85): 19680 mechanical unit type (p.72),
+/// 19682/19687 axis direction and 19684/19689 rotation direction "as a mechanical motion when a positive move command is
+/// issued" (p.75), 19696 hypothetical axes (p.78), 19700-19705 rotary table position and the A -> B intersection offset
+/// vector "in the machine coordinate system" with the rotation axes at 0 deg (p.82), 19709-19714 the D -> E and E -> F
+/// vectors of the tool axes (16i-MB A-78712E pp. 61-62). No parameter holds the tool's roll about its axis or the
+/// turn of the workpiece frame: those are taken from the description at machine coordinates 0.
 void tcpChains(const MachineModel& m, const TcpParameters& p, std::vector<ChainElement>& workpiece,
                std::vector<ChainElement>& tool);
 

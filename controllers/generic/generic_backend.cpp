@@ -84,7 +84,9 @@ public:
             grid += fmt::format("{}{} {} nodes {}..{} {}", grid.empty() ? "" : "; ", m.axisNames[ax.axis], ax.nodes.size(),
                                 ax.nodes.front() / (ax.rotary ? kDeg : 1.0), ax.nodes.back() / (ax.rotary ? kDeg : 1.0), ax.rotary ? "deg" : "mm");
         const HeaderInfo h = makeHeaderInfo(r, "generic controller (cnccomp CSV + JSON)", out,
-                                            {"grid map: " + grid,
+                                            {"grid map: " + grid + " (description commands)", frameNote(m),
+                                             "map.csv / map.json axis columns: machine coordinates; errors absolute (what the "
+                                             "machine does wrong there), not corrections",
                                              "apply model: multilinear interpolation of the map, linear axes moved against the tip error"});
         const std::string text = formatHeader(h, "");
         out.files.push_back({kDevCsv, formatHeader(h, "# ") + formatDeviationCsv(r.deviations)});
@@ -92,6 +94,13 @@ public:
         out.files.push_back({kMapCsv, formatGridMapCsv(g, m, formatHeader(h, "# "))});
         out.files.push_back({kMapJson, formatGridMapJson(g, m, headerLines(text))});
         return out;
+    }
+
+    std::vector<std::string> checks() const override {
+        return {"the map's axis columns are the controller's machine coordinates: compare one node with the machine "
+                "position display before feeding a lookup table with it",
+                "the tip error is the machine's error (actual - nominal, workpiece frame); a controller table usually wants "
+                "the correction, its negative"};
     }
 
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& m, const std::vector<OutputFile>& files) const override {

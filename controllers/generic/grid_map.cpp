@@ -146,7 +146,8 @@ std::string formatGridMapCsv(const GridMap& g, const MachineModel& m, const std:
     for (size_t i = 0; i < std::size(kValueColumns); ++i) s += std::string(kValueColumns[i]) + (i + 1 < std::size(kValueColumns) ? "," : "\n");
     std::vector<size_t> idx(g.axes.size(), 0);
     for (size_t i = 0; i < g.tip.size(); ++i) {
-        for (size_t a = 0; a < g.axes.size(); ++a) s += fixed(g.axes[a].nodes[idx[a]] / unitOf(g.axes[a].rotary), 6) + ",";
+        for (size_t a = 0; a < g.axes.size(); ++a)  // machine coordinates: command - machine-zero
+            s += fixed((g.axes[a].nodes[idx[a]] - m.axisLink(g.axes[a].axis).machineZero) / unitOf(g.axes[a].rotary), 6) + ",";
         const Vec3 &t = g.tip[i], &k = g.toolAxis[i];
         s += fmt::format("{},{},{},{},{},{}\n", fixed(t.x() / kUm, 6), fixed(t.y() / kUm, 6), fixed(t.z() / kUm, 6),
                          fixed(k.x() * 1e6, 6), fixed(k.y() * 1e6, 6), fixed(k.z() * 1e6, 6));
@@ -165,7 +166,8 @@ std::string formatGridMapJson(const GridMap& g, const MachineModel& m, const std
     s += "  \"order\": \"row-major over grid, last axis fastest; error at tool length L = tip + L * toolAxis\",\n  \"grid\": [\n";
     for (size_t a = 0; a < g.axes.size(); ++a) {
         std::vector<double> nodes;
-        for (double v : g.axes[a].nodes) nodes.push_back(std::stod(fixed(v / unitOf(g.axes[a].rotary), 6)));
+        const double zero = m.axisLink(g.axes[a].axis).machineZero;
+        for (double v : g.axes[a].nodes) nodes.push_back(std::stod(fixed((v - zero) / unitOf(g.axes[a].rotary), 6)));
         s += fmt::format("    {{\"axis\": {}, \"unit\": \"{}\", \"wraps\": {}, \"nodes\": {}}}{}\n", jsonString(m.axisNames[g.axes[a].axis]),
                          g.axes[a].rotary ? "deg" : "mm", g.axes[a].wraps ? "true" : "false", jsonNumbers(nodes),
                          a + 1 < g.axes.size() ? "," : "");
@@ -222,7 +224,7 @@ GridMap parseGridMapCsv(const std::string& text, const std::string& file, const 
         std::set<double> values;
         for (const auto& r : rows) values.insert(r[a]);
         fileNodes[a].assign(values.begin(), values.end());
-        for (double v : values) ax.nodes.push_back(v * unitOf(ax.rotary));
+        for (double v : values) ax.nodes.push_back(v * unitOf(ax.rotary) + l.machineZero);  // file: machine coordinates
         ax.wraps = l.modulo && ax.nodes.size() > 1 && std::abs(ax.nodes.back() - ax.nodes.front() - 2 * kPi) < 1e-9;
         total *= static_cast<long>(ax.nodes.size());
         g.axes.push_back(std::move(ax));

@@ -2,7 +2,8 @@
 // The generic backend's grid map: over a tensor grid of axis commands, the tool-tip position error at tool length 0
 // (workpiece frame) and the error of the unit tool-axis vector, so that the error at any tool length L is
 // e0 + L·dk. Exact model (Kinematics); the reader interpolates multilinearly (a modulo axis spanning one turn
-// wraps), as a controller with an N-dimensional lookup table would.
+// wraps), as a controller with an N-dimensional lookup table would. The files give the axis positions in the
+// controller's machine coordinates (command − Link::machineZero); GridMap holds the description's commands.
 #include <string>
 #include <vector>
 

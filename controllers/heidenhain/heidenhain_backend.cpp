@@ -24,8 +24,16 @@ class HeidenhainBackend final : public Backend {
 public:
     std::string_view name() const override { return "heidenhain-tnc"; }
     std::string_view description() const override {
-        return "HEIDENHAIN TNC: kinematics description (Trans rows for the location errors) and KinematicsComp "
-               ".COM tables for the component errors";
+        return "HEIDENHAIN iTNC 530: kinematics description (Trans rows for the location errors) and KinematicsComp "
+               ".COM tables for the component errors (not for TNC 640 / TNC7, whose kinematics live in the machine "
+               "configuration)";
+    }
+    std::vector<std::string> checks() const override {
+        return {"the control is an iTNC 530 with KinematicsComp (option); a TNC 640 or TNC7 does not read .TAB kinematics",
+                "tool-side rows are read from the tool to MachBase with their motion inverted, and their .COM columns hold "
+                "-error (cnccomp's reading of KinematicsDesign); check one axis in KinematicsDesign before loading",
+                "the MachAxis letters are the TNC's axis names and each axis moves along +X/+Y/+Z or turns about them",
+                "100 COMPTAB entries including the MachAxis rows, 50 Trans+MachAxis rows, 256 rows per .COM table"};
     }
     EmitResult emit(const EmitRequest& request) const override { return emitFiles(request, Options{}); }
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,

@@ -45,11 +45,12 @@ struct ComFile {
 
 struct RowWriter {
     TncTable& t;
-    int transforms = 0, comptabs = 0;
+    int transforms = 0, comptabs = 0, axes = 0;
     void add(const std::string& key, const std::string& axis, const std::string& coord, const std::string& doc,
              const std::string& comptab = "") {
         t.rows.push_back({std::to_string(t.rows.size()), key, axis, coord, "", doc, comptab});
         if (key == "Trans" || key == "MachAxis") ++transforms;
+        if (key == "MachAxis") ++axes;
         if (!comptab.empty()) ++comptabs;
     }
     /// Rows for T(t)·Rx(a)·Ry(b)·Rz(c); components listed in `forced` are written even when zero.
@@ -115,7 +116,7 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
                                      m.deviations[di].basis.nodes == first.nodes;
         const int capacity = o.maxCompRows - (l.modulo ? 1 : 0);
         if (shared && static_cast<int>(first.nodes.size()) <= capacity) {
-            for (double n : first.nodes) pos.push_back(n * scale);
+            for (double n : first.nodes) pos.push_back((n - l.machineZero) * scale);  // machine positions
             if (l.modulo) pos.push_back(pos.front() + 360.0);
         } else {
             try {
@@ -134,13 +135,13 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
             const DeviationDef& def = m.deviations[di];
             const double* coef = d.values.data() + def.offset;
             const auto err = [&](double q) { return def.basis.evaluate(q, coef, l.modulo); };
-            if (l.modulo && std::abs(err(pos.front() / scale) - err(pos.back() / scale)) > 1e-9) {
+            if (l.modulo && std::abs(err(commandOf(l, pos.front())) - err(commandOf(l, pos.back()))) > 1e-9) {
                 why[di] = "not periodic over one revolution: a modulo table must close on itself";
                 continue;
             }
             auto& col = f.columns[def.component];
             col.resize(pos.size(), 0.0);
-            for (size_t n = 0; n < pos.size(); ++n) col[n] += err(pos[n] / scale) / (def.isAngle() ? kDeg : 1.0);
+            for (size_t n = 0; n < pos.size(); ++n) col[n] += err(commandOf(l, pos[n])) / (def.isAngle() ? kDeg : 1.0);
             if (l.modulo) col.back() = col.front();  // exact closure
             f.sources[def.component].push_back(def.name);
         }
@@ -191,12 +192,23 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
         for (int c : comps)
             w.add("Trans", kLetters[c], fixed(0.0, 9), names(it->second.sources[c]), fmt::format("{}:C{}", it->second.name, c + 1));
     };
+    // The TNC counts an axis from its machine datum: a Trans row along the axis' own letter carries the description's
+    // motion up to there (inverted on the tool side, which the rows walk from the tool to the base).
+    const auto machineZero = [&](const Link& l, bool tool) {
+        if (l.machineZero == 0.0) return;
+        const double v = (tool ? -1.0 : 1.0) * l.machineZero;
+        int k = 0;
+        letterDirection(l.name).cwiseAbs().maxCoeff(&k);
+        if (l.kind == AxisKind::Linear) w.add("Trans", kLetters[k], fixed(v, 9), "machine datum");
+        else w.add("Trans", kLetters[3 + k], fixed(v / kDeg, 10), "machine datum");
+    };
     const Chain& tc = m.tool;
     for (int i = static_cast<int>(tc.links.size()) - 1; i >= 0; --i) {
         const Link& l = tc.links[i];
         if (l.axisIndex >= 0) {
             compRows(l, true);
             w.add("MachAxis", l.name, "", "axis");
+            machineZero(l, true);
         }
         const auto [forced, doc] = locationInfo(Side::Tool, i);
         w.pose(errorTransform(linkLocationError(m, d.values, Side::Tool, i)).inverse(Eigen::Isometry), forced,
@@ -211,6 +223,7 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
         const auto [forced, doc] = locationInfo(Side::Workpiece, i);
         w.pose(errorTransform(linkLocationError(m, d.values, Side::Workpiece, i)), forced, doc);
         if (l.axisIndex >= 0) {
+            machineZero(l, false);
             w.add("MachAxis", l.name, "", "axis");
             compRows(l, false);
         }
@@ -219,12 +232,20 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
         throw ModelError(fmt::format("heidenhain-tnc: the kinematics description needs {} Trans/MachAxis rows; the TNC "
                                      "takes {}",
                                      w.transforms, o.maxTransformRows));
-    if (w.comptabs > o.maxCompEntries)
-        throw ModelError(fmt::format("heidenhain-tnc: {} COMPTAB entries needed; the TNC takes {}", w.comptabs,
-                                     o.maxCompEntries));
+    // iTNC 530 HSCI technical manual 07/2013 p.686: the MachAxis rows count against the COMPTAB entries.
+    if (w.comptabs + w.axes > o.maxCompEntries)
+        throw ModelError(fmt::format("heidenhain-tnc: {} COMPTAB entries and {} MachAxis rows need {} entries; the TNC takes {}",
+                                     w.comptabs, w.axes, w.comptabs + w.axes, o.maxCompEntries));
 
     std::vector<std::string> notes = {
+        "for the iTNC 530 (HSCI technical manual 07/2013, KinematicsComp): the TNC 640 and TNC7 keep the kinematics in "
+        "the machine configuration (kinematics editor), not in a .TAB description: these files do not load there",
         "units: mm and degrees; KinematicsComp tables interpolated linearly between AXISPOS rows",
+        frameNote(m),
+        "absolute values: the description replaces the machine's kinematics (Trans rows in machine coordinates, a "
+        "'machine datum' row where an axis counts from elsewhere); AXISPOS are machine positions; nothing is a delta",
+        fmt::format("{} Trans+MachAxis rows (50 allowed), {} COMPTAB entries + {} MachAxis rows (100 allowed, p.686)",
+                    w.transforms, w.comptabs, w.axes),
         "rows are a transformation chain from the tool reference point to the table: tool-side rows (before "
         "MachBase) are the inverse transforms, so their .COM columns hold -error [G: confirm with KinematicsDesign]",
         "location errors are not wrapped back after their MachAxis: the workpiece datum follows the measured axis "

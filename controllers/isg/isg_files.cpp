@@ -17,7 +17,7 @@ std::string formatIsgConfig(const IsgConfig& c, const std::string& header) {
     for (const auto& [letter, n] : c.axisNumber) order.emplace_back(n, letter);
     std::sort(order.begin(), order.end());
     for (const auto& [n, letter] : order) s += fmt::format("{:<24} {}\n", std::string(1, letter), n);
-    s += "# kinematic chain, tool -> bed -> workpiece [G], and the number of workpiece axes\n";
+    s += "# kinematic chain from the workpiece over the machine origin to the tool tip (TF5240), and the number of\n# workpiece axes (the first letters of the chain)\n";
     s += fmt::format("{:<24} {}\n", "chain", c.chain);
     s += fmt::format("{:<24} {}\n", "workpiece_axes", c.workpieceAxes);
     for (size_t i = 0; i < c.files.size(); ++i) {

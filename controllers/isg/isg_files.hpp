@@ -2,7 +2,7 @@
 // ISG / Beckhoff TwinCAT CNC TF5280 volumetric compensation files (Beckhoff infosys, TF5280 "ISG CSV format",
 // "List of parameters supported", P-VOLC parameters):
 // - the compensation list (volcomp.lis): logical axis numbers of the participating axes ("X 1"), the kinematic
-//   chain ("chain ZXYAC"), the number of workpiece axes, the parameter files and their format; '#' comments;
+//   chain ("chain CAYXZ": from the workpiece over the machine origin to the tool tip), the number of workpiece axes, the parameter files and their format; '#' comments;
 // - the ISG_CSV parameter file: a header line naming the columns (arguments such as X, and error parameters such
 //   as X0C or EXX), data rows below, "//" line comments, and '#' starting a new block with its own header.
 //   Values in mm and rad, arguments in mm and degrees.
@@ -14,7 +14,7 @@ namespace cnccomp::controllers::isg {
 
 struct IsgConfig {
     std::map<char, int> axisNumber;   ///< axis letter → logical axis number
-    std::string chain;                ///< axis letters, tool → bed → workpiece
+    std::string chain;                ///< axis letters, workpiece → machine origin → tool tip (TF5240)
     int workpieceAxes = 0;
     std::vector<std::pair<std::string, std::string>> files;  ///< file name, format
 };

@@ -50,7 +50,14 @@ std::string formatKinematicChain(const MachineModel& m, const Plan& plan, const 
         const std::string prefix = side == Side::Tool ? "T_" : "P_";
         const Chain& c = m.chain(side);
         const int s = sideIndex(side);
-        for (size_t i = 0; i < c.links.size(); ++i) linkElements(m, c.links[i], plan.placed[s][i], prefix, out);
+        for (size_t i = 0; i < c.links.size(); ++i) {
+            // The NCK counts the axis from its machine zero: the chain holds the description's motion up to there.
+            const Link& l = c.links[i];
+            Pose zero = Pose::Identity();
+            if (l.kind == AxisKind::Linear) zero.translation() = l.direction * l.machineZero;
+            if (l.kind == AxisKind::Rotary) zero.linear() = axisRotation(l.direction, l.machineZero);
+            linkElements(m, l, plan.placed[s][i] * zero, prefix, out);
+        }
         const Pose& end = plan.end[s];
         if ((end.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() > 1e-15) {
             Link l;
@@ -66,16 +73,22 @@ std::string formatKinematicChain(const MachineModel& m, const Plan& plan, const 
             e.name = n;
         }
     }
-    const size_t total = branch[0].size() + branch[1].size();
+    const size_t total = branch[0].size() + branch[1].size() + 1;
     if (static_cast<int>(total) > o.chainMaxElements)
         throw ModelError(fmt::format("siemens-840d: the kinematic chain needs {} elements, more than {}", total,
                                      o.chainMaxElements));
     std::string s = fmt::format("%{}\n;$PATH=/_N_SPF_DIR\n", kChainIdentifier);
     s += header;
-    int index = 0;
+    s += fmt::format("; the chain root, named by MD16800 $MN_ROOT_KIN_ELEM_NAME (K7 kinematic chain); NewConfig after loading\n"
+                     "{}=\"{}\"\n",
+                     kRootMachineData, kRootName);
+    s += fmt::format("$NK_NAME[0]=\"{}\"\n$NK_TYPE[0]=\"OFFSET\"\n", kRootName);
+    for (int k = 0; k < 3; ++k) s += fmt::format("$NK_OFF_DIR[0,{}]=0\n", k);
+    s += fmt::format("$NK_NEXT[0]=\"{}\"\n$NK_PARALLEL[0]=\"{}\"\n", branch[0].front().name, branch[1].front().name);
+    int index = 1;
     for (int b = 0; b < 2; ++b) {
-        s += b == 0 ? "; tool chain, from the machine zero (ROOT) to the tool reference point\n"
-                    : "; part chain, from the machine zero (ROOT) to the workpiece (table) reference\n";
+        s += b == 0 ? "; tool chain, from ROOT ($NK_NEXT) to the tool reference point\n"
+                    : "; part chain, beside it from ROOT ($NK_PARALLEL) to the workpiece (table) reference\n";
         const auto& br = branch[b];
         for (size_t i = 0; i < br.size(); ++i, ++index) {
             const Element& e = br[i];
@@ -86,7 +99,6 @@ std::string formatKinematicChain(const MachineModel& m, const Plan& plan, const 
             for (int k = 0; k < 3; ++k) s += fmt::format("$NK_OFF_DIR[{},{}]={}\n", index, k, fixed(e.dir[k], decimals));
             if (e.type != "OFFSET" && e.type != "AXIS_LIN") s += fmt::format("$NK_A_OFF[{}]={}\n", index, fixed(e.aOffDeg, 12));
             s += fmt::format("$NK_NEXT[{}]=\"{}\"\n", index, i + 1 < br.size() ? br[i + 1].name : "");
-            if (index == 0) s += fmt::format("$NK_PARALLEL[0]=\"{}\"\n", branch[1].front().name);
         }
     }
     s += "; transformation record (TRAORI on the chains above)\n";
@@ -130,8 +142,16 @@ ParsedChain parseKinematicChain(const MachineModel& m, const std::string& path, 
     std::map<int, Raw> raw;
     std::optional<std::string> toolLast, partLast;
     int ntLine = 0;
+    std::optional<std::string> rootName;
+    int rootLine = 0;
     for (const Assignment& a : f.assignments) {
         const std::string& v = a.variable;
+        if (v == kRootMachineData) {
+            if (!a.indices.empty()) throw InputError(path, a.line, fmt::format("{} takes no index", v));
+            setOnce(rootName, stringValue(f, a), f, a);
+            rootLine = a.line;
+            continue;
+        }
         if (v.starts_with("$NT_")) {
             if (indexNumber(f, a, 0) != 1)
                 throw InputError(path, a.line, "only transformation record 1 is written by cnccomp");
@@ -169,7 +189,13 @@ ParsedChain parseKinematicChain(const MachineModel& m, const std::string& path, 
         for (int k = 0; k < 3; ++k)
             if (!r.dir[k]) throw InputError(path, r.line, fmt::format("element '{}' lacks $NK_OFF_DIR[{},{}]", *r.name, e, k));
     }
-    if (!raw.count(0)) throw InputError(path, 0, "no element 0 (the start of the tool chain)");
+    // The chain starts at the element MD16800 $MN_ROOT_KIN_ELEM_NAME names (K7).
+    if (!rootName || rootName->empty())
+        throw InputError(path, rootLine, fmt::format("no {} naming the chain root", kRootMachineData));
+    const auto rootIt = byName.find(*rootName);
+    if (rootIt == byName.end())
+        throw InputError(path, rootLine, fmt::format("{} names '{}', which no $NK_NAME has", kRootMachineData, *rootName));
+    const int root = rootIt->second;
     if (!toolLast || !partLast)
         throw InputError(path, ntLine, "missing $NT_T_CHAIN_LAST_ELEM[1] or $NT_P_CHAIN_LAST_ELEM[1]");
 
@@ -188,11 +214,13 @@ ParsedChain parseKinematicChain(const MachineModel& m, const std::string& path, 
         }
         return out;
     };
-    const auto& par = raw[0].parallel;
-    if (!par || par->empty()) throw InputError(path, raw[0].line, "element 0 needs $NK_PARALLEL naming the start of the part chain");
+    const auto& par = raw[root].parallel;
+    if (!par || par->empty())
+        throw InputError(path, raw[root].line, fmt::format("the root '{}' needs $NK_PARALLEL naming the start of the second chain", *rootName));
     const auto pit = byName.find(*par);
-    if (pit == byName.end()) throw InputError(path, raw[0].line, fmt::format("$NK_PARALLEL[0] names no element ('{}')", *par));
-    std::vector<int> a = follow(0), b = follow(pit->second);
+    if (pit == byName.end())
+        throw InputError(path, raw[root].line, fmt::format("$NK_PARALLEL of the root names no element ('{}')", *par));
+    std::vector<int> a = follow(root), b = follow(pit->second);
     const auto lastName = [&](const std::vector<int>& br) { return *raw[br.back()].name; };
     if (lastName(a) == *partLast && lastName(b) == *toolLast) std::swap(a, b);
     if (lastName(a) != *toolLast || lastName(b) != *partLast)

@@ -20,6 +20,11 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
     std::vector<std::string> notes = {
         "machine axes: " + axes + " (MD10000 names as written; rename if yours differ)",
         "units: mm and degrees",
+        frameNote(m),
+        "absolute values: the kinematic chain ($NK_OFF_DIR offsets, $NK_A_OFF) replaces the NCK's chain and the CEC/EEC "
+        "tables replace its tables, positions in machine coordinates; nothing is a delta to add",
+        "kinematic chain: root element \"ROOT\" named by MD16800 $MN_ROOT_KIN_ELEM_NAME (set in the file [G: needs the "
+        "access level]); MD18880 $MN_MM_MAXNUM_KIN_CHAIN_ELEM >= the elements written",
         "CEC: the table value is added to the output axis (correction = -error) [G: sign not confirmed]",
         "CEC: enable with MD18342 MM_CEC_MAX_POINTS[t] >= points, SD41300 CEC_TABLE_ENABLE[t]=1, "
         "MD32710 CEC_ENABLE=1 [G]",
@@ -43,14 +48,16 @@ SiemensCompensation::SiemensCompensation(const MachineModel& m, std::unique_ptr<
 
 AxisVector SiemensCompensation::driveCommands(const AxisVector& programmed) const {
     const AxisVector q = tcp_.solve(programmed);
+    // CEC and EEC tables are looked up at the machine positions (the NCK's machine coordinates, K3).
+    const AxisVector p = machine_->toController(q);
     AxisVector out = q;
     for (const CecTable& c : cec_) {
-        const double in = q[c.input] * positionScale(machine_->axisLink(c.input));
+        const double in = p[c.input] * positionScale(machine_->axisLink(c.input));
         out[c.output] += c.table.at(in) / positionScale(machine_->axisLink(c.output));
     }
     for (const EecTable& e : eec_) {
         const double scale = positionScale(machine_->axisLink(e.axis));
-        out[e.axis] -= e.table.at(q[e.axis] * scale) / scale;
+        out[e.axis] -= e.table.at(p[e.axis] * scale) / scale;
     }
     return out;
 }
@@ -86,6 +93,16 @@ public:
                "($NK_) with the rotary-axis locations for TRAORI";
     }
     EmitResult emit(const EmitRequest& request) const override { return emitFiles(request, Options{}); }
+    std::vector<std::string> checks() const override {
+        return {"CEC sign: cnccomp writes the correction to add to the output axis (-error); move the input axis with "
+                "one table loaded and watch the output axis go the right way",
+                "kinematic chain element meanings (OFFSET, ROT_CONST, AXIS_LIN/AXIS_ROT with $NK_A_OFF) as cnccomp reads "
+                "K7/K12; check the chain in the HMI's kinematic view before activating TRAORI",
+                "MD16800 $MN_ROOT_KIN_ELEM_NAME = \"ROOT\" is set by the file; if the access level refuses it, set it "
+                "by hand, then NewConfig",
+                "machine axis names AX1.. in the order X Y Z A B C; rename to your MD10000 names",
+                "CEC limits: MD18342 MM_CEC_MAX_POINTS per table, 62 tables [G]; EEC: MD38000 MM_ENC_COMP_MAX_POINTS"};
+    }
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
                                                const std::vector<OutputFile>& files) const override {
         return readFiles(machine, files);

@@ -102,11 +102,13 @@ struct Builder {
             if (lastLinear[s] < 0) continue;
             // Fold what the slides' rotations do to everything they carry (exact pose, at zero commands).
             Pose preal0 = Pose::Identity(), pctl0 = Pose::Identity();
+            // At the controller's zero: every slide at its machine zero (the chain's axis elements carry that offset).
             for (int i = 0; i <= lastLinear[s]; ++i) {
                 const Link& l = c.links[i];
                 const Vec6 e = linkLocationError(m, d.values, side, i);
-                preal0 = preal0 * l.placement * errorTransform(e);
-                pctl0 = pctl0 * l.placement * translation(e.head<3>());
+                const Pose zero = translation(l.direction * (l.kind == AxisKind::Linear ? l.machineZero : 0.0));
+                preal0 = preal0 * l.placement * errorTransform(e) * zero;
+                pctl0 = pctl0 * l.placement * translation(e.head<3>()) * zero;
             }
             const Pose fold = pctl0.inverse(Eigen::Isometry) * preal0;
             const int p = lastLinear[s] + 1;
@@ -197,8 +199,7 @@ struct Builder {
             why = e.what();
             return {};
         }
-        const double scale = positionScale(l);
-        if (grid.modulo && std::abs(err(0.0) - err(2 * kPi)) > 1e-9) {
+        if (grid.modulo && std::abs(err(l.machineZero) - err(l.machineZero + 2 * kPi)) > 1e-9) {
             why = "not periodic over one revolution: a modulo table must close on itself";
             return {};
         }
@@ -211,7 +212,7 @@ struct Builder {
             if (l.kind == AxisKind::Rotary && std::abs(std::abs(along) - 1.0) < 1e-9) {
                 EquidistantTable& t = eec(j, grid, def.name);
                 for (size_t n = 0; n < t.values.size(); ++n)
-                    t.values[n] += along * err((grid.min + grid.step * n) / scale) / kDeg;
+                    t.values[n] += along * err(commandOf(l, grid.min + grid.step * n)) / kDeg;
                 return fmt::format("EEC table of {} (positioning error of the rotary axis)", axisName(m, j));
             }
             why = l.kind == AxisKind::Linear
@@ -229,8 +230,7 @@ struct Builder {
             std::vector<double> vals(grid.values.size());
             double peak = 0;
             for (size_t n = 0; n < vals.size(); ++n) {
-                const double pos = grid.min + grid.step * n;
-                const double q = pos / scale;
+                const double q = commandOf(l, grid.min + grid.step * n);
                 const Mat3 r = l.kind == AxisKind::Rotary ? Mat3(frame[j] * axisRotation(l.direction, q)) : frame[j];
                 const Vec3 rel = sigma[j] * (r * unitLocal) * err(q);  // tool relative to workpiece, bed frame
                 const double trim = -sigma[k] * ctl[k].dot(rel);

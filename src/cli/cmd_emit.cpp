@@ -51,6 +51,15 @@ const RegisterCommand reg([](CLI::App& app) {
     for (const controllers::Backend* b : controllers::backends()) known += fmt::format("\n  {:<16} {}", b->name(), b->description());
     auto* c = app.add_subcommand("emit", "Write compensation files for a controller; lists what is and is NOT compensated."
                                          "\nControllers:" + known);
+    // What no vendor document confirmed ([G] in the files), per backend: the user checks it on the control first.
+    std::string checks = "Check on the control before loading (conventions no vendor document confirmed, [G] in the files):";
+    for (const controllers::Backend* b : controllers::backends()) {
+        const auto list = b->checks();
+        if (list.empty()) continue;
+        checks += fmt::format("\n  {}:", b->name());
+        for (const std::string& item : list) checks += fmt::format("\n    - {}", item);
+    }
+    c->footer(checks);
     c->add_option("--controller", o->controller, "controller backend (see the list above)")->required();
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--deviations", o->deviations, "deviation set CSV")->required()->check(CLI::ExistingFile);
