@@ -11,7 +11,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/lsq.hpp"
-#include "cnccomp/identification/seed003_dbb5.hpp"
+#include "cnccomp/identification/dbb5_location_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -69,9 +69,9 @@ void run(const Options& o) {
                    r.report.unknowns, r.report.termination);
         for (const std::string& w : r.report.warnings) fmt::print("warning: {}\n", w);
     } else {
-        const Seed003Result r = seed003Formulas(m, plan.dbb5Runs, traces, {o.outer, o.inner, o.refine});
+        const Dbb5LocationResult r = dbb5LocationErrors(m, plan.dbb5Runs, traces, {o.outer, o.inner, o.refine});
         d = r.deviations;
-        const Seed003Numbers& n = r.numbers;
+        const Dbb5LocationNumbers& n = r.numbers;
         fmt::print("eq. (1)-(3): Z1 = {:g} mm, Z2 = {:g} mm, betaZ = {:.4f} um/mm, alphaZ = {:.4f} um/mm, dx = {:.4f} um, "
                    "dy = {:.4f} um; {} refinement steps on the exact model\n",
                    n.Z1, n.Z2, n.betaZ * 1e3, n.alphaZ * 1e3, n.dx / kUm, n.dy / kUm, r.refine);

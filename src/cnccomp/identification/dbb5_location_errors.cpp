@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed003_dbb5.hpp"
+#include "cnccomp/identification/dbb5_location_errors.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -42,7 +42,7 @@ struct Roles {
     Pair cx, cy, ay, az;
 };
 
-Roles findRoles(const MachineModel& m, const std::vector<Dbb5Run>& runs, const Seed003Options& o) {
+Roles findRoles(const MachineModel& m, const std::vector<Dbb5Run>& runs, const Dbb5LocationOptions& o) {
     Roles r;
     r.cx.axisOfBar = 0;
     r.cy.axisOfBar = 1;
@@ -86,7 +86,7 @@ Roles findRoles(const MachineModel& m, const std::vector<Dbb5Run>& runs, const S
 /// The plain formulas on one data set; readings in the order EC0Y EA0Z EB0Z, outer axis (EY0 EZ0 EB0 EC0), inner
 /// axis (EX0 EY0 EA0 EB0).
 Eigen::VectorXd readings(const MachineModel& m, const std::vector<Dbb5Run>& runs, const std::vector<BallbarTrace>& traces,
-                         const Roles& r, const Seed003Options& o, const std::vector<int>& devs, Seed003Numbers& n) {
+                         const Roles& r, const Dbb5LocationOptions& o, const std::vector<int>& devs, Dbb5LocationNumbers& n) {
     const auto run = [&](int i) -> const Dbb5Run& { return runs[static_cast<size_t>(i)]; };
     const auto iso = [&](int i) { return evaluateCircularTest(traces[static_cast<size_t>(i)], run(i).LB); };
     // Centre shift along the bar's main axis: c = −r/(u·e).
@@ -132,8 +132,8 @@ Eigen::VectorXd readings(const MachineModel& m, const std::vector<Dbb5Run>& runs
 
 }  // namespace
 
-Seed003Result seed003Formulas(const MachineModel& m, const std::vector<Dbb5Run>& runs,
-                              const std::vector<BallbarTrace>& traces, const Seed003Options& o) {
+Dbb5LocationResult dbb5LocationErrors(const MachineModel& m, const std::vector<Dbb5Run>& runs,
+                              const std::vector<BallbarTrace>& traces, const Dbb5LocationOptions& o) {
     if (runs.size() != traces.size()) throw ModelError(fmt::format("{} DBB5 runs but {} traces", runs.size(), traces.size()));
     if (o.refine < 0) throw ModelError("seed 003: the number of refinement steps must not be negative");
     const Roles r = findRoles(m, runs, o);
@@ -145,14 +145,14 @@ Seed003Result seed003Formulas(const MachineModel& m, const std::vector<Dbb5Run>&
         if (i < 0) throw ModelError(fmt::format("machine '{}' has no deviation '{}' (seed 003 identifies it)", m.name, n));
         devs.push_back(i);
     }
-    Seed003Result res{DeviationSet(m), DeviationSet(m), {}, {}, o.refine};
+    Dbb5LocationResult res{DeviationSet(m), DeviationSet(m), {}, {}, o.refine};
     for (size_t i = 0; i < runs.size(); ++i) res.runs.push_back({runs[i].name, evaluateCircularTest(traces[i], runs[i].LB)});
     const Eigen::VectorXd measured = readings(m, runs, traces, r, o, devs, res.numbers);
     const auto simulated = [&](const DeviationSet& s) {
         const Kinematics k(m, s);
         std::vector<BallbarTrace> t;
         for (const Dbb5Run& run : runs) t.push_back(simulateDbb5(k, run));
-        Seed003Numbers scratch;
+        Dbb5LocationNumbers scratch;
         return readings(m, runs, t, r, o, devs, scratch);
     };
     res.plain = refineReadings(m, devs, simulated, measured, 0);

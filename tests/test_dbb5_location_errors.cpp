@@ -8,7 +8,7 @@
 #include "cnccomp/identification/dbb5_circular.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/lsq.hpp"
-#include "cnccomp/identification/seed003_dbb5.hpp"
+#include "cnccomp/identification/dbb5_location_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "test_support.hpp"
@@ -86,10 +86,10 @@ TEST(Dbb5Circular, NominalMachineGivesZeroAndSquarenessGivesTheEllipse) {
     EXPECT_NEAR(r.circularity, 10 * kArcsec * xy.LB, 0.001 * kUm);
 }
 
-TEST(Seed003Dbb5, FormulasRecoverTheElevenErrors) {
+TEST(Dbb5LocationErrors, FormulasRecoverTheElevenErrors) {
     const MachineModel& m = tableTable();
     const Fixture& f = dbb5();
-    const Seed003Result r = seed003Formulas(m, f.plan.dbb5Runs, f.traces);
+    const Dbb5LocationResult r = dbb5LocationErrors(m, f.plan.dbb5Runs, f.traces);
     const auto [um1, as1] = worst(r.plain, f.truth);
     const auto [um, as] = worst(r.deviations, f.truth);
     std::printf("[ seed 003 ] plain formulas: %.4f um, %.4f arcsec; after %d refinement steps: %.2e um, %.2e arcsec\n",
@@ -110,7 +110,7 @@ TEST(Seed003Dbb5, FormulasRecoverTheElevenErrors) {
     EXPECT_NEAR(r.numbers.cx1, r.runs[3].iso.meanRadialError, 1e-12);
 }
 
-TEST(Seed003Dbb5, LeastSquaresOnRawSamples) {
+TEST(Dbb5LocationErrors, LeastSquaresOnRawSamples) {
     const MachineModel& m = tableTable();
     const Fixture& f = dbb5();
     const Observations obs = dbb5Observations(m, f.plan.dbb5Runs, f.traces);
@@ -125,13 +125,13 @@ TEST(Seed003Dbb5, LeastSquaresOnRawSamples) {
     EXPECT_LT(as, 0.001);
 }
 
-TEST(Seed003Dbb5, MissingRunsAreNamed) {
+TEST(Dbb5LocationErrors, MissingRunsAreNamed) {
     const MachineModel& m = tableTable();
     const Fixture& f = dbb5();
     std::vector<Dbb5Run> runs(f.plan.dbb5Runs.begin(), f.plan.dbb5Runs.end() - 1);
     std::vector<BallbarTrace> traces(f.traces.begin(), f.traces.end() - 1);
     try {
-        seed003Formulas(m, runs, traces);
+        dbb5LocationErrors(m, runs, traces);
         ADD_FAILURE() << "expected a ModelError";
     } catch (const ModelError& e) {
         EXPECT_NE(std::string(e.what()).find("bar along Z"), std::string::npos) << e.what();

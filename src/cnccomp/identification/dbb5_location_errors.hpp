@@ -26,7 +26,7 @@
 
 namespace cnccomp {
 
-struct Seed003Options {
+struct Dbb5LocationOptions {
     std::string outerAxis = "A", innerAxis = "C";
     int refine = 4;  ///< Gauss–Newton steps on the formula readings (0 = the plain formulas)
 };
@@ -37,24 +37,24 @@ struct Dbb5RunReport {
 };
 
 /// The paper's intermediate numbers for the measured data, mm and rad.
-struct Seed003Numbers {
+struct Dbb5LocationNumbers {
     double Z1 = 0, Z2 = 0, cx1 = 0, cx2 = 0, cy1 = 0, cy2 = 0;   ///< inner-axis runs
     double betaZ = 0, alphaZ = 0, dx = 0, dy = 0;                ///< eq. (1)–(3)
     double x1 = 0, x2 = 0, cyA1 = 0, cyA2 = 0, czA1 = 0, czA2 = 0;  ///< outer-axis runs
     double b2XY = 0, b2YZ = 0, b2ZX = 0;                         ///< elliptic terms of the linear circles
 };
 
-struct Seed003Result {
+struct Dbb5LocationResult {
     DeviationSet deviations;          ///< the 11 errors, present (after refinement)
     DeviationSet plain;               ///< the plain formulas
     std::vector<Dbb5RunReport> runs;  ///< every run of the plan, in order
-    Seed003Numbers numbers;
+    Dbb5LocationNumbers numbers;
     int refine = 0;
 };
 
 /// Throws ModelError naming the missing runs (a linear circle per plane, two heights per bar direction …) or
 /// deviations the machine lacks.
-Seed003Result seed003Formulas(const MachineModel& m, const std::vector<Dbb5Run>& runs,
-                              const std::vector<BallbarTrace>& traces, const Seed003Options& options = {});
+Dbb5LocationResult dbb5LocationErrors(const MachineModel& m, const std::vector<Dbb5Run>& runs,
+                              const std::vector<BallbarTrace>& traces, const Dbb5LocationOptions& options = {});
 
 }  // namespace cnccomp
