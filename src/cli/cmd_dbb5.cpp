@@ -1,4 +1,4 @@
-// cnccomp dbb5: seed 003 — ISO 230-4 circularity and mean radial error of every DBB5 run, and the location errors of
+// cnccomp dbb5: DBB5 ball-bar runs (Ibaraki et al.) — ISO 230-4 circularity and mean radial error of every DBB5 run, and the location errors of
 // the rotary axes and squareness of the linear axes by the paper's formulas or their least-squares equivalent (--lsq).
 #include <algorithm>
 #include <filesystem>
@@ -22,7 +22,7 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, plan, traces, out, isoOut, truth, outer = "A", inner = "C";
+    std::string machine, plan, traces, out, isoOut, truth, outer, inner;
     bool lsq = false;
     int refine = 4;
 };
@@ -56,25 +56,26 @@ void run(const Options& o) {
     const std::optional<DeviationSet> truth =
         o.truth.empty() ? std::nullopt : std::optional<DeviationSet>(readDeviationCsv(o.truth, m));
     DeviationSet d(m);
+    const Dbb5LocationOptions lo{o.outer, o.inner, o.refine};
     if (o.lsq) {
         IdentifyOptions io;
-        for (const std::string& n : {std::string("EC0Y"), std::string("EB0Z"), std::string("EA0Z"), "EY0" + o.outer,
-                                     "EZ0" + o.outer, "EB0" + o.outer, "EC0" + o.outer, "EX0" + o.inner, "EY0" + o.inner,
-                                     "EA0" + o.inner, "EB0" + o.inner})
-            io.deviations.push_back(d.require(n));
+        io.deviations = dbb5LocationDeviations(m, lo);
         std::sort(io.deviations.begin(), io.deviations.end());
         const IdentificationResult r = identify(m, dbb5Observations(m, plan.dbb5Runs, traces), io);
         d = r.deviations;
-        fmt::print("seed 003, least squares on {} samples: rank {} of {}, {}\n", r.report.observations, r.report.rank,
+        fmt::print("DBB5, least squares on {} samples: rank {} of {}, {}\n", r.report.observations, r.report.rank,
                    r.report.unknowns, r.report.termination);
         for (const std::string& w : r.report.warnings) fmt::print("warning: {}\n", w);
     } else {
-        const Dbb5LocationResult r = dbb5LocationErrors(m, plan.dbb5Runs, traces, {o.outer, o.inner, o.refine});
+        const Dbb5LocationResult r = dbb5LocationErrors(m, plan.dbb5Runs, traces, lo);
         d = r.deviations;
-        const Dbb5LocationNumbers& n = r.numbers;
-        fmt::print("eq. (1)-(3): Z1 = {:g} mm, Z2 = {:g} mm, betaZ = {:.4f} um/mm, alphaZ = {:.4f} um/mm, dx = {:.4f} um, "
-                   "dy = {:.4f} um; {} refinement steps on the exact model\n",
-                   n.Z1, n.Z2, n.betaZ * 1e3, n.alphaZ * 1e3, n.dx / kUm, n.dy / kUm, r.refine);
+        fmt::print("plain formulas, the paper's definitions (relative to the machine axes):\n");
+        for (const Dbb5FormulaValue& v : r.formulas)
+            fmt::print("  {:<18} {:>10.4f} {:<6}  {}\n", v.name, v.value / (v.angle ? kArcsec : kUm),
+                       v.angle ? "arcsec" : "um", v.definition);
+        fmt::print("{}: {} refinement steps on the exact model\n",
+                   r.refine > 0 ? "deviations" : "deviations (plain formulas converted to the model's definitions)",
+                   r.refine);
     }
     writeDeviationCsv(o.out, d);
     printDeviations(d, truth ? &*truth : nullptr);
@@ -83,7 +84,7 @@ void run(const Options& o) {
 
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
-    auto* c = app.add_subcommand("dbb5", "Seed 003: ISO 230-4 figures of DBB5 runs and the location/squareness errors");
+    auto* c = app.add_subcommand("dbb5", "DBB5 ball bar: ISO 230-4 figures of every run, location errors of the rotary axes and squareness");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "plan with <dbb5> runs")->required()->check(CLI::ExistingFile);
     c->add_option("--traces", o->traces, "folder of trace CSVs, one <run>.csv per run")->required()->check(CLI::ExistingDirectory);
@@ -91,8 +92,8 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--iso-out", o->isoOut, "CSV of the ISO 230-4 figures per run");
     c->add_flag("--lsq", o->lsq, "least-squares equivalent on the raw samples instead of the paper's formulas");
     c->add_option("--refine", o->refine, "Gauss-Newton steps on the formula readings (0 = plain formulas)")->capture_default_str();
-    c->add_option("--outer", o->outer, "tilting (outer) rotary axis")->capture_default_str();
-    c->add_option("--inner", o->inner, "rotary table (inner) axis")->capture_default_str();
+    c->add_option("--outer", o->outer, "tilting (outer) rotary axis (default: the first rotary axis of the workpiece chain)");
+    c->add_option("--inner", o->inner, "rotary table (inner) axis (default: the second)");
     c->add_option("--truth", o->truth, "deviation CSV to compare with")->check(CLI::ExistingFile);
     c->callback([o] { run(*o); });
 });
