@@ -4,7 +4,9 @@
 // identified from the same runs; seeded noise against a stated bound; what the runs cannot see is left alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
 
 #include <Eigen/LU>
@@ -192,6 +194,40 @@ TEST(Dbb5ComponentErrors, NoisyProfilesStayWithinTheStatedBound) {
     std::printf("[ dbb5 components ] noise 0.1 um: worst node %.3f um, %.3f arcsec\n", um, as);
     EXPECT_LT(um, 0.8);
     EXPECT_LT(as, 1.5);
+}
+
+TEST(Dbb5ComponentErrors, CommandLineEndToEnd) {
+    // simulate-runs with the truth (location + C tables) → dbb5 --components → the deviation file holds both; the
+    // profile CSV has one row per sample angle. Outputs never overwrite inputs.
+    test::ScratchDir dir("dbb5-components-cli");
+    const DeviationSet truth = truthWithComponents();
+    writeDeviationCsv(dir.file("truth.csv"), truth);
+    const std::string m = test::sourcePath("samples/machines/table-table-bc.xml");
+    const std::string p = test::sourcePath("samples/plans/dbb5-table-table-bc.xml");
+    auto r = test::runCli("simulate-runs --machine " + m + " --plan " + p + " --deviations " + dir.file("truth.csv") +
+                          " --out " + dir.file("traces"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+                     dir.file("d.csv") + " --components --profile-out " + dir.file("profile.csv"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("XYC test C-XY"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("cone frustum cone"), std::string::npos) << r.out;
+    const DeviationSet got = readDeviationCsv(dir.file("d.csv"), bc());
+    const auto [um, as] = worstNode(got, truth);
+    EXPECT_LT(um, 0.005);
+    EXPECT_LT(as, 0.005);
+    EXPECT_NEAR(got.get("EX0C"), truth.get("EX0C"), 0.002 * kUm);
+    const std::string profile = test::readText(dir.file("profile.csv"));
+    EXPECT_EQ(std::count(profile.begin(), profile.end(), '\n'), 73);
+    EXPECT_EQ(profile.rfind("angle_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec,ez_arcsec\n", 0), 0u);
+    r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+                     dir.file("d2.csv") + " --components --profile-out " + p);
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+                     dir.file("d3.csv") + " --profile-out " + dir.file("p3.csv"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("--profile-out needs --components"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("d3.csv")));
 }
 
 TEST(Dbb5ComponentErrors, MissingOrMismatchedRunsAreNamed) {

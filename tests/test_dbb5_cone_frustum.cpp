@@ -133,5 +133,41 @@ TEST(Dbb5ConeFrustum, ChecksTheIdentifiedErrors) {
     EXPECT_THROW(evaluateDbb5ConeRun(m, plan().dbb5Runs[0], measured), ModelError);
 }
 
+TEST(Dbb5ConeFrustum, PlanRoundTripAndErrors) {
+    // The B/C plan written and read back keeps every run (kinds, cone angles); bad cone attributes name file and line.
+    test::ScratchDir dir("dbb5-cone-plan");
+    writePlanXml(dir.file("p.xml"), plan());
+    const MeasurementPlan back = readPlanXml(dir.file("p.xml"));
+    ASSERT_EQ(back.dbb5Runs.size(), plan().dbb5Runs.size());
+    for (size_t i = 0; i < back.dbb5Runs.size(); ++i) {
+        const Dbb5Run &a = back.dbb5Runs[i], &b = plan().dbb5Runs[i];
+        EXPECT_EQ(a.name, b.name);
+        EXPECT_EQ(a.kind, b.kind);
+        EXPECT_EQ(a.ball, b.ball);
+        EXPECT_EQ(a.coneTiltDeg, b.coneTiltDeg);
+        EXPECT_EQ(a.toolAngleDeg, b.toolAngleDeg);
+        EXPECT_EQ(a.barAngleDeg, b.barAngleDeg);
+        EXPECT_EQ(a.anglesDeg(), b.anglesDeg());
+    }
+    EXPECT_EQ(cone().coneTiltDeg, 10);
+    EXPECT_EQ(cone().toolAngleDeg, 15);
+    EXPECT_EQ(cone().barAngleDeg, 45);
+    const std::string f = dir.file("bad.xml");
+    const auto expectError = [&](const std::string& run, const std::string& text) {
+        test::writeText(f, "<plan>\n" + run + "\n</plan>\n");
+        try {
+            readPlanXml(f);
+            ADD_FAILURE() << "expected an InputError for " << run;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(f + ":2"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+        }
+    };
+    expectError("<dbb5 name=\"c\" kind=\"cone\" LB=\"100\" ball=\"0 0 0\" tool-angle=\"95\"/>", "tool angle");
+    expectError("<dbb5 name=\"c\" kind=\"cone\" LB=\"100\" ball=\"0 0 0\" bar-angle=\"0\"/>", "bar angle");
+    expectError("<dbb5 name=\"c\" kind=\"cone\" LB=\"100\" ball=\"0 0 0\" cone-tilt=\"nan\"/>", "cone-tilt");
+    expectError("<dbb5 name=\"c\" kind=\"conic\" LB=\"100\" ball=\"0 0 0\"/>", "linear, rotary or cone");
+}
+
 }  // namespace
 }  // namespace cnccomp

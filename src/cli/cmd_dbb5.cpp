@@ -5,13 +5,17 @@
 #include <ostream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cli/command.hpp"
 #include "cli/print.hpp"
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/lsq.hpp"
+#include "cnccomp/identification/dbb5_component_errors.hpp"
+#include "cnccomp/identification/dbb5_cone_frustum.hpp"
 #include "cnccomp/identification/dbb5_location_errors.hpp"
+#include "cnccomp/identification/dbb5_xyc_test.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -22,8 +26,8 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, plan, traces, out, isoOut, truth, outer, inner;
-    bool lsq = false;
+    std::string machine, plan, traces, out, isoOut, truth, outer, inner, profileOut;
+    bool lsq = false, components = false;
     int refine = 4;
 };
 
@@ -31,6 +35,8 @@ void run(const Options& o) {
     const MachineModel m = readMachineXml(o.machine);
     if (!o.out.empty()) refuseToOverwrite(o.out, {o.machine, o.plan, o.truth});
     if (!o.isoOut.empty()) refuseToOverwrite(o.isoOut, {o.machine, o.plan, o.truth, o.out});
+    if (!o.profileOut.empty()) refuseToOverwrite(o.profileOut, {o.machine, o.plan, o.truth, o.out, o.isoOut});
+    if (!o.profileOut.empty() && !o.components) throw ModelError("--profile-out needs --components");
     const MeasurementPlan plan = readPlanXml(o.plan);
     if (plan.dbb5Runs.empty()) throw ModelError(fmt::format("plan '{}' has no <dbb5> runs", o.plan));
     std::vector<BallbarTrace> traces;
@@ -77,6 +83,38 @@ void run(const Options& o) {
                    r.refine > 0 ? "deviations" : "deviations (plain formulas converted to the model's definitions)",
                    r.refine);
     }
+    if (o.components) {
+        const std::string inner = dbb5TableAxes(m, lo).second;
+        const Dbb5ComponentProfile p = dbb5ComponentProfile(m, plan.dbb5Runs, traces, d, inner);
+        d = dbb5ComponentTables(m, p, d);
+        fmt::print("component errors of {} from {} (bed frame, relative to the average line; tilts: {}, axial: {}) "
+                   "-> the model's tables\n",
+                   inner, fmt::join(p.runs, ", "), p.tilts ? "yes" : "no", p.axial ? "yes" : "no");
+        if (!o.profileOut.empty())
+            writeFileAtomically(o.profileOut, [&](std::ostream& out) {
+                out << "angle_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec,ez_arcsec\n";
+                for (size_t i = 0; i < p.angleDeg.size(); ++i)
+                    out << fmt::format("{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f}\n", p.angleDeg[i],
+                                       p.translation[i].x() / kUm, p.translation[i].y() / kUm, p.translation[i].z() / kUm,
+                                       p.tilt[i].x() / kArcsec, p.tilt[i].y() / kArcsec, p.tilt[i].z() / kArcsec);
+            });
+    }
+    for (size_t i = 0; i < plan.dbb5Runs.size(); ++i) {
+        const Dbb5Run& r = plan.dbb5Runs[i];
+        if (isDbb5XycTest(m, r)) {
+            const Dbb5XycResult x = evaluateDbb5XycTest(m, r, traces[i]);
+            fmt::print("XYC test {}: centre offset ({:.4f}, {:.4f}) um at R = {:g} mm -> {} {:.4f} arcsec, {} {:.4f} arcsec "
+                       "(eq. (4)-(5), relative to the plane of motion)\n",
+                       r.name, x.centre[0] / kUm, x.centre[1] / kUm, x.radius, fmt::format("E{}0{}", "ABC"[x.second], r.axis),
+                       x.rotation[x.second] / kArcsec, fmt::format("E{}0{}", "ABC"[x.first], r.axis),
+                       x.rotation[x.first] / kArcsec);
+        } else if (r.kind == Dbb5Run::Kind::ConeFrustum) {
+            const Dbb5ConeEvaluation c = evaluateDbb5ConeRun(m, r, traces[i], &d);
+            fmt::print("cone frustum {}: circularity {:.4f} um; measured - predicted by the identified errors: rms {:.4f} "
+                       "um, max {:.4f} um\n",
+                       r.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm);
+        }
+    }
     writeDeviationCsv(o.out, d);
     printDeviations(d, truth ? &*truth : nullptr);
     fmt::print("-> {}\n", o.out);
@@ -94,6 +132,9 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--refine", o->refine, "Gauss-Newton steps on the formula readings (0 = plain formulas)")->capture_default_str();
     c->add_option("--outer", o->outer, "tilting (outer) rotary axis (default: the first rotary axis of the workpiece chain)");
     c->add_option("--inner", o->inner, "rotary table (inner) axis (default: the second)");
+    c->add_flag("--components", o->components,
+                "also the component errors (error motions) of the rotary table axis from its on-axis runs, as tables");
+    c->add_option("--profile-out", o->profileOut, "CSV of the component profiles over angle (bed frame, um / arcsec)");
     c->add_option("--truth", o->truth, "deviation CSV to compare with")->check(CLI::ExistingFile);
     c->callback([o] { run(*o); });
 });
