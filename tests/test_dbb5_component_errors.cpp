@@ -16,20 +16,13 @@
 #include "cnccomp/identification/dbb5_location_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "test_support.hpp"
+#include "test_dbb5_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-const MachineModel& bc() {
-    static const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-bc.xml"));
-    return m;
-}
-
-const MeasurementPlan& plan() {
-    static const MeasurementPlan p = readPlanXml(test::sourcePath("samples/plans/dbb5-table-table-bc.xml"));
-    return p;
-}
+const MachineModel& bc() { return test::tableTableBc(); }
+const MeasurementPlan& plan() { return test::dbb5PlanBc(); }
 
 /// Value of table `name` at angle q (rad), as the model interpolates it.
 double table(const DeviationSet& s, const std::string& name, double q) {
@@ -71,7 +64,7 @@ void gauge(DeviationSet& s, const char* x, const char* y, const std::vector<doub
 
 /// Location truth of the sample plus component tables of C (twelve nodes, zero at 0°), in the method's gauge.
 DeviationSet truthWithComponents() {
-    DeviationSet s = readDeviationCsv(test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), bc());
+    DeviationSet s = test::dbb5TruthBc();
     const double tx[12] = {0, 1.2, 2.0, 1.1, -0.5, -1.8, -2.2, -1.0, 0.4, 1.5, 0.9, 0.3};
     const double ty[12] = {0, -0.7, 0.3, 1.6, 2.1, 0.8, -0.6, -1.9, -1.2, 0.2, 0.5, -0.4};
     const double tz[12] = {0, 0.5, 0.9, 0.4, -0.3, -0.8, -0.5, 0.1, 0.6, 0.7, 0.2, -0.2};
@@ -164,7 +157,7 @@ TEST(Dbb5ComponentErrors, OneHeightGivesTranslationsOnly) {
             traces.push_back(all[i]);
         }
     // The location errors of the truth stand in for the identified ones (the C line needs both heights).
-    const DeviationSet location = readDeviationCsv(test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), m);
+    const DeviationSet location = test::dbb5TruthBc();
     const Dbb5ComponentProfile p = dbb5ComponentProfile(m, runs, traces, location, "C");
     EXPECT_FALSE(p.tilts);
     EXPECT_EQ(p.reference, 50.0);

@@ -16,26 +16,14 @@
 #include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "test_support.hpp"
+#include "test_dbb5_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-const MachineModel& bc() {
-    static const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-bc.xml"));
-    return m;
-}
-
-const MeasurementPlan& plan() {
-    static const MeasurementPlan p = readPlanXml(test::sourcePath("samples/plans/dbb5-table-table-bc.xml"));
-    return p;
-}
-
-const Dbb5Run& cone() {
-    for (const Dbb5Run& r : plan().dbb5Runs)
-        if (r.kind == Dbb5Run::Kind::ConeFrustum) return r;
-    throw ModelError("no cone run");
-}
+const MachineModel& bc() { return test::tableTableBc(); }
+const MeasurementPlan& plan() { return test::dbb5PlanBc(); }
+const Dbb5Run& cone() { return test::dbb5RunBc("cone"); }
 
 TEST(Dbb5ConeFrustum, CommandsPutToolAndBallOnTheCone) {
     static const MachineModel ac = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
@@ -71,7 +59,7 @@ TEST(Dbb5ConeFrustum, CommandsPutToolAndBallOnTheCone) {
 
 TEST(Dbb5ConeFrustum, JacobianMatchesFiniteDifferences) {
     const MachineModel& m = bc();
-    const DeviationSet at = readDeviationCsv(test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), m);
+    const DeviationSet at = test::dbb5TruthBc();
     Dbb5Run r = cone();
     r.stepDeg = 30;
     const Observations obs = dbb5Observations(m, {r}, {simulateDbb5(Kinematics(m, at), r)});
@@ -91,7 +79,7 @@ TEST(Dbb5ConeFrustum, ChecksTheIdentifiedErrors) {
     // on-axis C runs cannot see. Identified from every run but the cone (location refined, C component tables): the
     // cone's profile predicted from them misses exactly ECC's share, which the cone run shows.
     const MachineModel& m = bc();
-    DeviationSet truth = readDeviationCsv(test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), m);
+    DeviationSet truth = test::dbb5TruthBc();
     const DeviationDef& ecc = m.deviations[static_cast<size_t>(m.deviationIndex("ECC"))];
     const double c[12] = {0, 3, 4, 2, -1, -3, -4, -2, 1, 3, 2, 1};
     for (int k = 0; k < 12; ++k) truth.values[ecc.offset + k] = c[k] * kArcsec;
@@ -127,7 +115,7 @@ TEST(Dbb5ConeFrustum, ChecksTheIdentifiedErrors) {
     EXPECT_LT(worstMismatch, 0.002 * kUm);
     // Without ECC the prediction matches the measurement.
     const Dbb5ConeEvaluation ok = evaluateDbb5ConeRun(
-        m, cone(), simulateDbb5(Kinematics(m, readDeviationCsv(test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), m)), cone()),
+        m, cone(), simulateDbb5(Kinematics(m, test::dbb5TruthBc()), cone()),
         &identified);
     EXPECT_LT(ok.maxDifference, 0.003 * kUm);
     EXPECT_THROW(evaluateDbb5ConeRun(m, plan().dbb5Runs[0], measured), ModelError);

@@ -224,7 +224,7 @@ TEST(Dbb5LocationErrors, MissingRunsAndMachinesAreNamed) {
 
 TEST(Dbb5LocationErrors, NoisyRoundTripOnTheTiltingTable) {
     // Seeded Gaussian noise σ = 0.2 µm on every ΔL sample of the B/C plan. Least squares: the reported 95 % intervals
-    // cover the truth in about 95 % of 30 trials × 11 deviations. Refined formulas (two trials): within a stated
+    // cover the truth in about 95 % of 20 trials × 11 deviations. Refined formulas (two trials): within a stated
     // bound of 0.5 µm and 1 arcsec. The formulas use only the mean radial errors (≈ σ/√N each) and the B arcs span
     // 145°/190°, so their spread is a few 0.1 µm / 0.1″.
     const Case& c = bcCase();
@@ -242,7 +242,7 @@ TEST(Dbb5LocationErrors, NoisyRoundTripOnTheTiltingTable) {
     o.deviations = dbb5LocationDeviations(m);
     std::sort(o.deviations.begin(), o.deviations.end());
     int covered = 0, total = 0;
-    for (int trial = 0; trial < 30; ++trial) {
+    for (int trial = 0; trial < 20; ++trial) {
         const IdentificationResult r = identify(m, dbb5Observations(m, c.plan.dbb5Runs, noisy()), o);
         ASSERT_TRUE(r.report.converged) << r.report.termination;
         for (const ParameterEstimate& p : r.report.parameters) {

@@ -11,26 +11,13 @@
 #include "cnccomp/identification/dbb5_axis_line.hpp"
 #include "cnccomp/identification/dbb5_xyc_test.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "test_support.hpp"
+#include "test_dbb5_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-const MachineModel& bc() {
-    static const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-bc.xml"));
-    return m;
-}
-
-const std::vector<Dbb5Run>& bcRuns() {
-    static const std::vector<Dbb5Run> r = readPlanXml(test::sourcePath("samples/plans/dbb5-table-table-bc.xml")).dbb5Runs;
-    return r;
-}
-
-const Dbb5Run& run(const std::string& name) {
-    for (const Dbb5Run& r : bcRuns())
-        if (r.name == name) return r;
-    throw ModelError("no run " + name);
-}
+const MachineModel& bc() { return test::tableTableBc(); }
+const Dbb5Run& run(const std::string& name) { return test::dbb5RunBc(name); }
 
 double meanRadialError(const Kinematics& k, const std::string& name) {
     const Dbb5Run& r = run(name);

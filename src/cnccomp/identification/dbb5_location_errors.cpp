@@ -1,10 +1,12 @@
 #include "cnccomp/identification/dbb5_location_errors.hpp"
 
 #include <cmath>
+#include <memory>
 
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/seed001_refine.hpp"
 #include "cnccomp/kinematics.hpp"
 
@@ -282,18 +284,27 @@ Dbb5LocationResult dbb5LocationErrors(const MachineModel& m, const std::vector<D
         res.deviations = res.plain;
         return res;
     }
-    // Refinement: the model deviations whose simulated runs give the measured readings.
+    // Refinement: the model deviations whose simulated runs give the measured readings. The runs' nominal commands
+    // are solved once (Dbb5Observation), each simulation only evaluates the erroneous machine at them.
     std::vector<int> used;
     for (const AxisRoles* a : {&roles.outer, &roles.inner})
         for (int i : {a->pairFirst.lo, a->pairFirst.hi, a->pairSecond.lo, a->pairSecond.hi}) used.push_back(i);
     for (int i : {roles.xy, roles.yz, roles.zx}) used.push_back(i);
+    std::vector<std::unique_ptr<Dbb5Observation>> observations(runs.size());
+    for (int i : used)
+        if (!observations[static_cast<size_t>(i)])
+            observations[static_cast<size_t>(i)] =
+                std::make_unique<Dbb5Observation>(m, runs[static_cast<size_t>(i)], traces[static_cast<size_t>(i)]);
     const auto simulated = [&](const DeviationSet& s) {
         const Kinematics k(m, s);
         std::vector<BallbarTrace> t(runs.size());
         std::vector<const BallbarTrace*> p(runs.size(), nullptr);
-        for (int i : used) {
-            t[static_cast<size_t>(i)] = simulateDbb5(k, runs[static_cast<size_t>(i)]);
-            p[static_cast<size_t>(i)] = &t[static_cast<size_t>(i)];
+        for (size_t i = 0; i < runs.size(); ++i) {
+            if (!observations[i]) continue;
+            t[i].angleDeg = traces[i].angleDeg;
+            t[i].dL.resize(traces[i].dL.size());
+            observations[i]->predict(k, nullptr, t[i].dL.data());
+            p[i] = &t[i];
         }
         const Readings r = readings(runs, p, roles);
         return Eigen::VectorXd(pack(r.squareness, r.outer, r.inner));
