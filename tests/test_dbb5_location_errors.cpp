@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <random>
 
 #include "cnccomp/error.hpp"
@@ -220,6 +221,32 @@ TEST(Dbb5LocationErrors, MissingRunsAndMachinesAreNamed) {
     EXPECT_THROW(dbb5TableAxes(test::multitasking()), ModelError);  // rotary head and table: not a tilting table
     EXPECT_THROW(dbb5LocationErrors(*bcCase().machine, bcCase().plan.dbb5Runs, bcCase().traces, {"B", "B", 4}),
                  ModelError);
+}
+
+TEST(Dbb5LocationErrors, CommandLineOnTheBcTable) {
+    // The paths that failed on B/C before ("needs two B runs with the bar along Y"; --lsq: "no deviation named
+    // 'EY0B'"): formulas (refined) and least squares through `cnccomp dbb5`, read back against the truth.
+    test::ScratchDir dir("dbb5-bc-cli");
+    const std::string m = test::sourcePath("samples/machines/table-table-bc.xml");
+    const std::string p = test::sourcePath("samples/plans/dbb5-table-table-bc.xml");
+    const std::string truth = test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv");
+    auto r = test::runCli("simulate-runs --machine " + m + " --plan " + p + " --deviations " + truth + " --out " +
+                          dir.file("traces"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    for (const std::string extra : {"", " --lsq"}) {
+        r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+                         dir.file("d.csv") + extra);
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+        if (extra.empty()) {
+            EXPECT_NE(r.out.find("relative to the machine axes (B at 0)"), std::string::npos) << r.out;
+        }
+        const DeviationSet got = readDeviationCsv(dir.file("d.csv"), *bcCase().machine);
+        const auto [um, as] = worst(got, bcCase().truth, dbb5LocationErrors(*bcCase().machine, bcCase().plan.dbb5Runs,
+                                                                           bcCase().traces, {"", "", 0}).identified);
+        EXPECT_LT(um, 0.001) << extra;  // file rounding 1e-6 µm
+        EXPECT_LT(as, 0.001) << extra;
+        std::filesystem::remove(dir.file("d.csv"));
+    }
 }
 
 TEST(Dbb5LocationErrors, NoisyRoundTripOnTheTiltingTable) {

@@ -4,7 +4,7 @@
 //  <run>          ball-bar run of seed 000 Table 2 (W-side ball set on the T-side ball at the setup commands);
 //  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute (seed 002);
 //  <rtest>        R-test run (seed 001/004): ball on the table, nest on the spindle, rotary sweeps;
-//  <dbb5>         DBB5 run (seed 003): linear circle in a plane, rotary-axis circle, or cone frustum.
+//  <dbb5>         DBB5 run (ball bar held at 45°): linear circle in a plane, rotary-axis circle, or cone frustum.
 #include <string>
 #include <vector>
 
