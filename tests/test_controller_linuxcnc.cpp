@@ -31,7 +31,7 @@ using namespace testing;
 const std::vector<Sample> kSamples = {{"multitasking", "multitasking-truth"},
                                       {"controllers-table-table-ac", "controllers-table-table-ac"},
                                       {"controllers-tilting-head-b", "controllers-tilting-head-b"},
-                                      {"table-table-bc", "table-table-bc-truth"}};
+                                      {"table-table-bc-offsets", "table-table-bc-offsets-truth"}};
 
 EmitResult emitSample(const Sample& s, const DeviationSet& d) { return testing::emitSample("linuxcnc", s, d); }
 
@@ -61,20 +61,20 @@ TEST(ControllerLinuxcnc, TrtFormulasInvertAndPinsReproduceTheExactTable) {
                 for (int k = 0; k < 3; ++k) EXPECT_NEAR(back.xyz[k], j.xyz[k], 1e-10);
             }
     EXPECT_EQ(matchTrt(machine("table-table-ac")), TrtType::AC);
-    EXPECT_EQ(matchTrt(machine("table-table-bc")), TrtType::BC);
+    EXPECT_EQ(matchTrt(machine("table-table-bc-offsets")), TrtType::BC);
     EXPECT_FALSE(matchTrt(machine("multitasking")));
     EXPECT_FALSE(matchTrt(machine("tilting-head-b")));
     // Oracle: the exact kinematics. With the pins in LinuxCNC's frame, trtfuncs' forward of the joint positions
     // (machine coordinates from machine zero, tool-offset = tool length) is the tool tip in the erroneous workpiece
     // frame plus the G54 of cnccomp-g54.ngc plus the tool offset (0, 0, L), for every pose and tool length: so the
-    // module turns about the real axis lines, the tool-side offsets and machine-zero included (table-table-bc has
+    // module turns about the real axis lines, the tool-side offsets and machine-zero included (table-table-bc-offsets has
     // a spindle offset of 10 20 30 mm and machine-zero 50 410 560 mm).
     struct Case {
         std::string machine, tilt;
         std::vector<std::pair<std::string, double>> errors;
     };
     for (const Case& cs : {Case{"table-table-ac", "A", {{"EY0A", 0.03}, {"EZ0A", -0.02}, {"EX0C", 0.015}, {"EY0C", -0.025}}},
-                           Case{"table-table-bc", "B", {{"EX0B", 0.03}, {"EZ0B", -0.02}, {"EX0C", 0.015}, {"EY0C", -0.025}}}}) {
+                           Case{"table-table-bc-offsets", "B", {{"EX0B", 0.03}, {"EZ0B", -0.02}, {"EX0C", 0.015}, {"EY0C", -0.025}}}}) {
         const MachineModel& m = machine(cs.machine);
         const TrtType type = *matchTrt(m);
         DeviationSet d(m);
@@ -102,9 +102,9 @@ TEST(ControllerLinuxcnc, TrtFormulasInvertAndPinsReproduceTheExactTable) {
                     EXPECT_NEAR(w.xyz[2], tip.z() + g54.z() + length, 1e-10) << cs.machine;
                 }
     }
-    // The nominal pins of table-table-bc in LinuxCNC's frame, by hand from its description: C line through
+    // The nominal pins of table-table-bc-offsets in LinuxCNC's frame, by hand from its description: C line through
     // (250 + 15, 100 + 0, 180 − 60) of the bed, tool reference point at joint 0: (10, 20, 30) + (50, 410, 560).
-    const TrtPins n = trtPins(machine("table-table-bc"), TrtType::BC, nullptr);
+    const TrtPins n = trtPins(machine("table-table-bc-offsets"), TrtType::BC, nullptr);
     EXPECT_NEAR(n.xRotPoint, 205, 1e-12);
     EXPECT_NEAR(n.yRotPoint, -330, 1e-12);
     EXPECT_NEAR(n.zRotPoint, -470, 1e-12);

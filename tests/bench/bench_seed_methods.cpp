@@ -4,7 +4,7 @@
 
 #include "cnccomp/identification/seed001_rtest.hpp"
 #include "cnccomp/identification/seed002_tilting_head.hpp"
-#include "cnccomp/identification/seed003_dbb5.hpp"
+#include "cnccomp/identification/dbb5_location_errors.hpp"
 #include "cnccomp/identification/seed004_cradle.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
@@ -70,11 +70,11 @@ void BM_Seed002LeastSquares(benchmark::State& state) {
 }
 BENCHMARK(BM_Seed002LeastSquares)->Unit(benchmark::kMillisecond);
 
-void BM_Seed003Dbb5Refined(benchmark::State& state) {
+void BM_Dbb5LocationErrorsRefined(benchmark::State& state) {
     TableTable& f = tableTable();
-    for (auto _ : state) benchmark::DoNotOptimize(seed003Formulas(f.machine, f.dbb5.dbb5Runs, f.dbb5Traces));
+    for (auto _ : state) benchmark::DoNotOptimize(dbb5LocationErrors(f.machine, f.dbb5.dbb5Runs, f.dbb5Traces));
 }
-BENCHMARK(BM_Seed003Dbb5Refined)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Dbb5LocationErrorsRefined)->Unit(benchmark::kMillisecond);
 
 void BM_Seed004PerAngle(benchmark::State& state) {
     TableTable& f = tableTable();

@@ -225,7 +225,7 @@ void oracle(const std::string& machine, const std::string& deviations, const std
 
 TEST(LinuxcncOracle, TableTableACMatchesTheRealLinuxcnc) { oracle("controllers-table-table-ac", "controllers-table-table-ac", "A"); }
 
-TEST(LinuxcncOracle, TableTableBCWithToolSideOffsetsMatchesTheRealLinuxcnc) { oracle("table-table-bc", "table-table-bc-truth", "B"); }
+TEST(LinuxcncOracle, TableTableBCWithToolSideOffsetsMatchesTheRealLinuxcnc) { oracle("table-table-bc-offsets", "table-table-bc-offsets-truth", "B"); }
 
 TEST(LinuxcncOracle, IniMergeReplacesKeysAndAddsSections) {
     const std::string merged = sim::mergeIni("[KINS]\nKINEMATICS = trivkins\nJOINTS = 3\n\n[JOINT_0]\nTYPE = LINEAR\n",

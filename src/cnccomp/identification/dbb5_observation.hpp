@@ -1,6 +1,7 @@
 #pragma once
-// Observation model of a DBB5 run (seed 003) for the least-squares engine: raw ΔL samples, predicted exactly as
-// simulateDbb5() does (table ball set on the spindle ball at the setup pose, then ΔL along the sweep).
+// Observation model of a DBB5 run (Ibaraki et al., dbb5_run.hpp) for the least-squares engine: raw ΔL samples,
+// predicted exactly as simulateDbb5() does (table ball set on the spindle ball at the setup pose, then ΔL along the
+// sweep).
 #include "cnccomp/identification/dbb5_run.hpp"
 #include "cnccomp/identification/observation.hpp"
 

@@ -5,13 +5,14 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/identification/dbb5_cone_frustum.hpp"
 #include "cnccomp/identification/rtest_run.hpp"
 
 namespace cnccomp {
 
 void Dbb5Run::validate() const {
     const auto bad = [&](const std::string& what) { throw ModelError(fmt::format("DBB5 run '{}': {}", name, what)); };
-    for (double v : {LB, toolLength, startDeg, endDeg, stepDeg, setupDeg})
+    for (double v : {LB, toolLength, startDeg, endDeg, stepDeg, setupDeg, coneTiltDeg, toolAngleDeg, barAngleDeg})
         if (!std::isfinite(v)) bad("geometry values must be finite numbers");
     if (!ball.allFinite()) bad("the ball position must be finite");
     if (!(LB > 0)) bad("bar length LB must be positive");
@@ -23,9 +24,13 @@ void Dbb5Run::validate() const {
     if (kind == Kind::LinearCircle) {
         if (plane != "XY" && plane != "YZ" && plane != "ZX" && plane != "YX" && plane != "ZY" && plane != "XZ")
             bad(fmt::format("plane '{}' is not XY, YZ or ZX", plane));
-    } else {
+    } else if (kind == Kind::RotaryCircle) {
         if (!barDirection.allFinite() || barDirection.norm() < 1e-9) bad("bar direction must be a non-zero vector");
         if (axis.empty()) bad("a rotary circle needs the turning axis");
+    } else {
+        if (!(toolAngleDeg >= 0 && toolAngleDeg < 90)) bad("tool angle must be in [0, 90) deg");
+        if (!(barAngleDeg > 0 && barAngleDeg < 180)) bad("bar angle must be in (0, 180) deg");
+        if (!(std::abs(coneTiltDeg) < 90)) bad("cone tilt must be within ±90 deg");
     }
 }
 
@@ -78,6 +83,9 @@ AxisVector commandsAt(const Kinematics& nominal, const Dbb5Run& run, double angl
         const Pose bMw = nominal.baseToWorkpiece(q);
         const Vec3 bed = bMw * run.ball + run.LB * (std::cos(a) * e1 + std::sin(a) * e2);
         target = bMw.inverse(Eigen::Isometry) * bed;
+    } else if (run.kind == Dbb5Run::Kind::ConeFrustum) {
+        q = dbb5TableOrientation(m, dbb5ConeToolAxis(run, angleDeg), dbb5ConeBranch(m, run), q);
+        target = run.ball + run.LB * dbb5ConeBarDirection(run, angleDeg);
     } else {
         q[turningAxis(m, run)] = a;
         const Pose bMw = nominal.baseToWorkpiece(q);
@@ -90,6 +98,8 @@ AxisVector setupAt(const Kinematics& nominal, const Dbb5Run& run) {
     const MachineModel& m = nominal.machine();
     AxisVector q = heldPose(m, run);
     if (run.kind == Dbb5Run::Kind::RotaryCircle) q[turningAxis(m, run)] = run.setupDeg * kDeg;
+    if (run.kind == Dbb5Run::Kind::ConeFrustum)
+        q = dbb5TableOrientation(m, dbb5ConeToolAxis(run, run.setupDeg), dbb5ConeBranch(m, run), q);
     return followPoint(nominal, q, nominal.toolPoint(run.toolLength), run.ball);
 }
 

@@ -1,11 +1,15 @@
 #pragma once
-// DBB5 runs (seed 003): a double ball bar whose balls are held from 45° to the spindle axis, so that circles in
+// DBB5 runs (Ibaraki et al., "Identification of motion error sources on five-axis machine tools by ball-bar
+// measurements", 1st report): a double ball bar whose balls are held from 45° to the spindle axis, so that circles in
 // the XY, YZ and ZX planes and rotary-axis circles can all be measured from one setup.
 //  - linear circle: the rotary axes hold still, the linear axes move the spindle ball on a circle of radius LB
 //    around the table ball (ISO 230-4 circular test) in the plane XY, YZ or ZX (angle 0 along the first letter,
 //    90° towards the second);
 //  - rotary circle: one rotary axis turns (full turn or arc), the table ball turns with it, and the linear axes
-//    keep the spindle ball at LB along a fixed bed-frame direction from the table ball (seed 003 "C-X (−Z)" etc.).
+//    keep the spindle ball at LB along a fixed bed-frame direction from the table ball ("C-X (−Z)" etc.; with the bar
+//    along the turning axis and the ball off it, the ISO 10791-6 XYC test, dbb5_xyc_test.hpp);
+//  - cone frustum: both rotary axes of a tilting table and the linear axes move as when a NAS 979 cone frustum is
+//    cut; the spindle ball circles the table ball on a cone (dbb5_cone_frustum.hpp).
 // The table ball is set where the spindle ball stands at the setup pose (sweep angle `setupDeg`, spindle ball on
 // the table ball), as for the seed-000 ball bar; ΔL = L − LB.
 #include <string>
@@ -17,7 +21,7 @@
 namespace cnccomp {
 
 struct Dbb5Run {
-    enum class Kind { LinearCircle, RotaryCircle };
+    enum class Kind { LinearCircle, RotaryCircle, ConeFrustum };
     std::string name;
     Kind kind = Kind::LinearCircle;
     double LB = 100.0;                 ///< bar length, mm
@@ -29,6 +33,9 @@ struct Dbb5Run {
     std::string plane = "XY";          ///< linear circle: XY, YZ or ZX
     std::string axis = "C";            ///< rotary circle: the turning axis
     Vec3 barDirection = -Vec3::UnitX();  ///< rotary circle: table ball → spindle ball, bed frame (unit)
+    /// Cone frustum (sweep angle = azimuth φ about the cone axis, workpiece frame): cone axis tilted about the
+    /// workpiece Y, tool axis leaning towards it along the generatrix, bar inclined from it; degrees.
+    double coneTiltDeg = 10.0, toolAngleDeg = 15.0, barAngleDeg = 45.0;
 
     /// Throws ModelError for impossible geometry (non-positive LB, zero step, unknown plane, zero direction …).
     void validate() const;
@@ -40,7 +47,8 @@ struct Dbb5Run {
 
 /// Axis commands at sweep angle `angleDeg` (nominal machine): spindle ball on its target.
 AxisVector dbb5Commands(const MachineModel& m, const Dbb5Run& run, double angleDeg);
-/// Setup commands: spindle ball on the nominal table ball (at the sweep angle setupDeg for rotary circles).
+/// Setup commands: spindle ball on the nominal table ball (at the sweep angle setupDeg for rotary circles and cone
+/// frustums).
 AxisVector dbb5SetupCommands(const MachineModel& m, const Dbb5Run& run);
 
 /// Simulates ΔL along the sweep on machine `k` (angle_deg, ΔL as for a ball-bar trace). Throws ModelError naming

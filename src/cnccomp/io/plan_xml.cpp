@@ -102,7 +102,8 @@ Dbb5Run readDbb5Run(const XMLElement& e, const std::string& path) {
     const std::string kind = xml::text(e, path, "kind");
     if (kind == "linear") r.kind = Dbb5Run::Kind::LinearCircle;
     else if (kind == "rotary") r.kind = Dbb5Run::Kind::RotaryCircle;
-    else xml::fail(e, path, fmt::format("kind '{}' is not linear or rotary", kind));
+    else if (kind == "cone") r.kind = Dbb5Run::Kind::ConeFrustum;
+    else xml::fail(e, path, fmt::format("kind '{}' is not linear, rotary or cone", kind));
     r.LB = xml::number(e, path, "LB");
     r.toolLength = xml::number(e, path, "tool-length", 100.0);
     if (!xml::has(e, "ball")) xml::fail(e, path, "missing attribute 'ball'");
@@ -112,6 +113,11 @@ Dbb5Run readDbb5Run(const XMLElement& e, const std::string& path) {
     r.stepDeg = xml::number(e, path, "step", 5.0);
     if (r.kind == Dbb5Run::Kind::LinearCircle) {
         r.plane = xml::text(e, path, "plane");
+    } else if (r.kind == Dbb5Run::Kind::ConeFrustum) {
+        r.coneTiltDeg = xml::number(e, path, "cone-tilt", 10.0);
+        r.toolAngleDeg = xml::number(e, path, "tool-angle", 15.0);
+        r.barAngleDeg = xml::number(e, path, "bar-angle", 45.0);
+        r.setupDeg = xml::number(e, path, "setup", 0.0);
     } else {
         r.axis = xml::text(e, path, "axis");
         if (!xml::has(e, "direction")) xml::fail(e, path, "missing attribute 'direction' (table ball → spindle ball)");
@@ -206,12 +212,15 @@ std::string formatPlanXml(const MeasurementPlan& plan) {
         o << "  </rtest>\n";
     }
     for (const auto& r : plan.dbb5Runs) {
-        const bool linear = r.kind == Dbb5Run::Kind::LinearCircle;
+        const bool linear = r.kind == Dbb5Run::Kind::LinearCircle, cone = r.kind == Dbb5Run::Kind::ConeFrustum;
         o << fmt::format("  <dbb5 name=\"{}\" kind=\"{}\" LB=\"{:g}\" tool-length=\"{:g}\" ball=\"{}\" start=\"{:g}\" "
                          "end=\"{:g}\" step=\"{:g}\"",
-                         r.name, linear ? "linear" : "rotary", r.LB, r.toolLength, vec(r.ball), r.startDeg, r.endDeg,
-                         r.stepDeg);
+                         r.name, linear ? "linear" : cone ? "cone" : "rotary", r.LB, r.toolLength, vec(r.ball), r.startDeg,
+                         r.endDeg, r.stepDeg);
         if (linear) o << fmt::format(" plane=\"{}\"", r.plane);
+        else if (cone)
+            o << fmt::format(" cone-tilt=\"{:g}\" tool-angle=\"{:g}\" bar-angle=\"{:g}\" setup=\"{:g}\"", r.coneTiltDeg,
+                             r.toolAngleDeg, r.barAngleDeg, r.setupDeg);
         else o << fmt::format(" axis=\"{}\" direction=\"{}\" setup=\"{:g}\"", r.axis, vec(r.barDirection), r.setupDeg);
         if (r.hold.empty()) {
             o << "/>\n";

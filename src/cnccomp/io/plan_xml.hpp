@@ -4,7 +4,7 @@
 //  <run>          ball-bar run of seed 000 Table 2 (W-side ball set on the T-side ball at the setup commands);
 //  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute (seed 002);
 //  <rtest>        R-test run (seed 001/004): ball on the table, nest on the spindle, rotary sweeps;
-//  <dbb5>         DBB5 run (seed 003): linear circle in a plane or rotary-axis circle.
+//  <dbb5>         DBB5 run (ball bar held at 45°): linear circle in a plane, rotary-axis circle, or cone frustum.
 #include <string>
 #include <vector>
 
@@ -30,8 +30,9 @@ struct MeasurementPlan {
 /// nuisance parameters; an absolute run takes none|work), head-axis / table-axis (default B / C).
 /// <rtest name ball="x y z" [nest-length=100] [steps=36] [ball-offset="x y z"] [estimate-ball=false]> with children
 /// <sweep axis start end/> (deg, linear in the pose index) and <hold axis deg/>.
-/// <dbb5 name kind="linear|rotary" LB [tool-length=100] ball="x y z" [start=0 end=360 step=5] (linear: plane="XY|YZ|ZX";
-/// rotary: axis direction="x y z" [setup=0]) > with children <hold axis deg/>.
+/// <dbb5 name kind="linear|rotary|cone" LB [tool-length=100] ball="x y z" [start=0 end=360 step=5] (linear:
+/// plane="XY|YZ|ZX"; rotary: axis direction="x y z" [setup=0]; cone: [cone-tilt=10 tool-angle=15 bar-angle=45 setup=0],
+/// deg) > with children <hold axis deg/>.
 MeasurementPlan readPlanXml(const std::string& path);
 void writePlanXml(const std::string& path, const MeasurementPlan& plan);
 std::string formatPlanXml(const MeasurementPlan& plan);
