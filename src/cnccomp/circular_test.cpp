@@ -1,10 +1,12 @@
-#include "cnccomp/identification/dbb5_circular.hpp"
+#include "cnccomp/circular_test.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include <Eigen/QR>
+#include <fmt/format.h>
 
 #include "cnccomp/circle_fit.hpp"
 #include "cnccomp/error.hpp"
@@ -33,6 +35,7 @@ CircularTestResult evaluateCircularTest(const BallbarTrace& trace, double LB) {
     const CircleFit c = fitCircle(pts);
     r.center = c.center;
     r.meanRadialError = c.radius - LB;
+    r.meanRadius = c.radius;
     double lo = HUGE_VAL, hi = -HUGE_VAL;
     for (const auto& p : pts) {
         const double d = (p - c.center).norm();
@@ -56,6 +59,86 @@ CircularTestResult evaluateCircularTest(const BallbarTrace& trace, double LB) {
     } else {
         r.a0 = r.a1 = r.b1 = r.a2 = r.b2 = std::numeric_limits<double>::quiet_NaN();
     }
+    return r;
+}
+
+namespace {
+
+/// ΔL of `t` interpolated linearly at `angle` (deg); `order` sorts t by angle. False outside its range.
+bool interpolate(const BallbarTrace& t, const std::vector<size_t>& order, double angle, double& out) {
+    const double lo = t.angleDeg[order.front()], hi = t.angleDeg[order.back()];
+    if (angle < lo || angle > hi) return false;
+    const auto it = std::lower_bound(order.begin(), order.end(), angle,
+                                     [&](size_t i, double a) { return t.angleDeg[i] < a; });
+    const size_t k = static_cast<size_t>(it - order.begin());
+    if (k == 0) {
+        out = t.dL[order[0]];
+        return true;
+    }
+    const size_t i0 = order[k - 1], i1 = order[k];
+    const double a0 = t.angleDeg[i0], a1 = t.angleDeg[i1];
+    const double f = a1 > a0 ? (angle - a0) / (a1 - a0) : 1.0;
+    out = t.dL[i0] + f * (t.dL[i1] - t.dL[i0]);
+    return true;
+}
+
+std::vector<size_t> byAngle(const BallbarTrace& t) {
+    std::vector<size_t> order(t.angleDeg.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](size_t i, size_t j) { return t.angleDeg[i] < t.angleDeg[j]; });
+    return order;
+}
+
+}  // namespace
+
+double circularHysteresis(const BallbarTrace& a, const BallbarTrace& b, int* compared) {
+    if (compared) *compared = 0;
+    if (a.dL.empty() || b.dL.empty() || a.dL.size() != a.angleDeg.size() || b.dL.size() != b.angleDeg.size())
+        return std::numeric_limits<double>::quiet_NaN();
+    const std::vector<size_t> oa = byAngle(a), ob = byAngle(b);
+    double h = -1;
+    int n = 0;
+    const auto scan = [&](const BallbarTrace& from, const BallbarTrace& other, const std::vector<size_t>& oOther) {
+        for (size_t i = 0; i < from.dL.size(); ++i) {
+            double v = 0;
+            if (!interpolate(other, oOther, from.angleDeg[i], v)) continue;
+            h = std::max(h, std::abs(from.dL[i] - v));
+            ++n;
+        }
+    };
+    scan(a, b, ob);
+    scan(b, a, oa);
+    if (compared) *compared = n;
+    return n > 0 ? h : std::numeric_limits<double>::quiet_NaN();
+}
+
+CircularRunResult evaluateCircularRun(const std::vector<DirectedTrace>& passes, double LB) {
+    if (passes.empty()) throw ModelError("circular test: a run needs at least one pass");
+    CircularRunResult r;
+    double radii = 0;
+    for (const DirectedTrace& p : passes) {
+        if (p.direction != 1 && p.direction != -1)
+            throw ModelError(fmt::format("circular test: pass direction {} is not +1 (CCW) or -1 (CW)", p.direction));
+        const CircularTestResult e = evaluateCircularTest(p.trace, LB);
+        if (r.passes.empty()) {
+            r.radialMax = e.radialMax;
+            r.radialMin = e.radialMin;
+        }
+        r.circularDeviation = std::max(r.circularDeviation, e.circularity);
+        r.radialMax = std::max(r.radialMax, e.radialMax);
+        r.radialMin = std::min(r.radialMin, e.radialMin);
+        radii += e.meanRadius;
+        r.passes.push_back(e);
+        r.directions.push_back(p.direction);
+    }
+    r.meanRadius = radii / static_cast<double>(passes.size());
+    // H from the first CCW and the first CW pass.
+    const DirectedTrace *ccw = nullptr, *cw = nullptr;
+    for (const DirectedTrace& p : passes) {
+        if (p.direction > 0 && !ccw) ccw = &p;
+        if (p.direction < 0 && !cw) cw = &p;
+    }
+    if (ccw && cw) r.hysteresis = circularHysteresis(ccw->trace, cw->trace, &r.hysteresisSamples);
     return r;
 }
 
