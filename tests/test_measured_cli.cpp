@@ -15,6 +15,7 @@
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/trace_import.hpp"
 #include "cnccomp/version.hpp"
 #include "test_support.hpp"
@@ -80,8 +81,8 @@ TEST(MeasuredCli, TimeSampledBothDirectionsRelativeInstrumentRecoverTheTruth) {
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("ISO 230-4"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("C-radial.dL0"), std::string::npos) << r.out;
-    // The per-run offsets take the constant part of ΔL: the deviations that only shift a run's mean are confounded
-    // with them and must be named, never reported as values.
+    // The per-run offsets take the constant part of ΔL: a deviation that only shifted a run's mean would be confounded
+    // with them and would have to be named, never reported as a value.
     const MachineModel& mm = test::multitasking();
     const DeviationSet id = readDeviationCsv(dir.file("d.csv"), mm), t = readDeviationCsv(kTruth, mm);
     int compared = 0;
@@ -94,7 +95,19 @@ TEST(MeasuredCli, TimeSampledBothDirectionsRelativeInstrumentRecoverTheTruth) {
         ++compared;
         EXPECT_NEAR(id.values[d.offset], t.values[d.offset], d.isAngle() ? 1e-3 * kArcsec : 1e-3 * kUm) << d.name;
     }
-    EXPECT_GE(compared, 9) << r.out;
+    EXPECT_EQ(compared, 13) << r.out;  // here the runs tell every offset from every deviation
+    // The offsets added to the files come back as the runs' dL0 (12 + 7·i µm).
+    const JsonValue j = readJsonFile(dir.file("r.json"));
+    int offsets = 0;
+    for (const JsonValue& p : j["parameters"].array) {
+        const std::string& n = p["name"].string;
+        for (size_t i = 0; i < plan.runs.size(); ++i)
+            if (n == plan.runs[i].name + ".dL0") {
+                EXPECT_NEAR(p["value"].num(), 12.0 + 7.0 * static_cast<double>(i), 1e-3) << n;
+                ++offsets;
+            }
+    }
+    EXPECT_EQ(offsets, 6);
 }
 
 TEST(MeasuredCli, SwappedTraceFilesAreRefusedNotFitted) {

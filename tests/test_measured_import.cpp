@@ -246,6 +246,37 @@ TEST(MeasuredImport, LinearDriftIsRemovedFromAClosedSweep) {
     expectInputError([&] { importRunTrace(dir.file("h.csv"), run); }, {"h.csv:1", "drift removal needs"});
 }
 
+TEST(MeasuredImport, PartialArcInBothDirectionsWithDriftAndHysteresis) {
+    test::ScratchDir dir("imp-arc");
+    BallbarRun run = cRadial();
+    run.name = "B-X";
+    run.test = BallbarTest::BX;
+    run.startDeg = -110;  // a 220° arc, as ball-bar software records a partial test
+    run.endDeg = 110;
+    run.capture.passes = {+1, -1};
+    run.capture.removeDrift = true;
+    const BallbarTrace ccw = simulate(run, -110, 110, 1), cw = simulate(run, 110, -110, 1);
+    // The file: CCW then CW, a drift of 0.01 µm per sample, and 2 µm more on the CW pass (backlash-like hysteresis).
+    std::string csv = "angle_deg,dL_um\n";
+    int row = 0;
+    for (const BallbarTrace* t : {&ccw, &cw})
+        for (size_t i = 0; i < t->dL.size(); ++i, ++row)
+            csv += fmt::format("{:g},{}\n", t->angleDeg[i], um(t->dL[i] + (t == &cw ? 2 * kUm : 0.0) + 0.01 * kUm * row));
+    test::writeText(dir.file("arc.csv"), csv);
+    const MeasuredTrace m = importRunTrace(dir.file("arc.csv"), run);
+    ASSERT_EQ(m.passes.size(), 2u);
+    // Drift from both ends: at −110° rows 0 and 441 differ by 2 µm + 4.41 µm, at +110° rows 220 and 221 by 2 µm + 0.01 µm:
+    // 4.40 µm over 440 rows. The hysteresis stays.
+    EXPECT_NEAR(m.summary.driftRemoved, 0.01 * kUm * 441, 1e-9);
+    for (size_t i = 0; i < ccw.dL.size(); ++i) EXPECT_NEAR(m.passes[0].trace.dL[i], ccw.dL[i], 1e-9);
+    for (size_t i = 0; i < cw.dL.size(); ++i) EXPECT_NEAR(m.passes[1].trace.dL[i], cw.dL[i] + 2 * kUm, 1e-9);
+    EXPECT_NEAR(evaluateCircularRun(m.passes, run.LB).hysteresis, 2 * kUm, 1e-9);
+    // Without drift removal the hysteresis is the 2 µm plus the drift between the passes at each angle.
+    run.capture.removeDrift = false;
+    const MeasuredTrace raw = importRunTrace(dir.file("arc.csv"), run);
+    EXPECT_NEAR(evaluateCircularRun(raw.passes, run.LB).hysteresis, 2 * kUm + 0.01 * kUm * 441, 1e-6);  // rows 0 and 441 at −110°
+}
+
 TEST(MeasuredImport, LinearPathRadiusIsTheRadiusOfTheCommandedCircle) {
     // Independent check of the Table 2 radii: the speed of the commanded (X, Y, Z) along the sweep angle.
     const MachineModel& m = machine();

@@ -358,10 +358,17 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         for (size_t p = 0; p < passes.size(); ++p)
             for (const Row& r : passes[p].rows) ang[p].push_back(r.x), val[p].push_back(*r.dL);
         double v1 = 0, t1 = 0, v2 = 0, t2 = 0;
-        if (passes.size() == 2) {  // start of the first pass = end of the second
-            const double s = passes[0].direction > 0 ? lo : hi;
+        if (passes.size() == 2) {
+            // Both ends of the sweep are seen by both passes: at the first pass's start long apart, at its end just
+            // apart. The difference of the two differences is drift alone (a constant CCW/CW hysteresis cancels).
+            const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
+            double v3 = 0, t3 = 0, v4 = 0, t4 = 0;
             sampleAt(ang[0], val[0], tau[0], s, v1, t1);
             sampleAt(ang[1], val[1], tau[1], s, v2, t2);
+            sampleAt(ang[0], val[0], tau[0], e, v3, t3);
+            sampleAt(ang[1], val[1], tau[1], e, v4, t4);
+            v2 -= v4 - v3;
+            t2 -= t4 - t3;
         } else if (fullTurn) {
             const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
             sampleAt(ang[0], val[0], tau[0], s, v1, t1);
@@ -370,7 +377,8 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
             throw InputError(path, t.headerLine, fmt::format("drift removal needs a full turn or a CCW and a CW pass; run "
                                                              "'{}' sweeps {:g}° in one pass", run->name, hi - lo));
         }
-        if (!(t2 > t1)) throw InputError(path, t.headerLine, "drift removal: the file's samples are not in time order");
+        if (!(t2 > t1 + 1e-12))
+            throw InputError(path, t.headerLine, "drift removal: the samples at the sweep's ends are not apart in time");
         const double rate = (v2 - v1) / (t2 - t1);
         const double tFirst = tau[0].front();
         double tLast = tFirst;
