@@ -104,13 +104,37 @@ std::vector<DeviationRow> deviationRows(const IdentificationReport& r) {
 
 namespace {
 
-/// X and Y over their travel (≤ ±200 mm, 21 points), every other axis at 0 or the nearest end of its travel.
+/// True where the tool axis is (nearly) parallel to a rotary axis: there a TCP controller has no unique answer (any
+/// angle of that axis gives the same tool axis) and its model is not a prediction of the machine.
+bool singularPose(const Kinematics& k, const AxisVector& q) {
+    const Vec3 axis = k.baseToTool(q).linear() * k.machine().toolDirection;
+    for (const JointFrame& j : k.jointFrames(q))
+        if (j.rotary && j.direction.cross(axis).norm() < 0.1) return true;
+    return false;
+}
+
+/// X and Y over their travel (≤ ±200 mm, 21 points); the other linear axes at 0 (or the nearest end of their travel);
+/// the rotary axes at 0, or, where that pose is singular, at the first of 30°, 45°, −30°, 60° that is not (and lies in
+/// the axis's travel).
 std::string defaultGrid(const MachineModel& m) {
+    const Kinematics k(m);
+    AxisVector q = AxisVector::Zero(m.axisCount());
+    for (int a = 0; a < m.axisCount(); ++a) q[a] = std::clamp(0.0, m.axisLink(a).min, m.axisLink(a).max);
+    for (int a = 0; a < m.axisCount() && singularPose(k, q); ++a) {
+        const Link& l = m.axisLink(a);
+        if (l.kind != AxisKind::Rotary) continue;
+        for (double deg : {30.0, 45.0, -30.0, 60.0}) {
+            AxisVector t = q;
+            t[a] = deg * kDeg;
+            if (t[a] < l.min || t[a] > l.max || singularPose(k, t)) continue;
+            q = t;
+            break;
+        }
+    }
     std::string g;
     for (int a = 0; a < m.axisCount(); ++a) {
         const Link& l = m.axisLink(a);
         const std::string& n = m.axisNames[a];
-        const double unit = l.kind == AxisKind::Rotary ? kDeg : 1.0;
         if ((n == "X" || n == "Y") && l.kind == AxisKind::Linear) {
             const double lo = std::max(l.min, -200.0), hi = std::min(l.max, 200.0);
             if (hi - lo > 1e-6) {
@@ -118,7 +142,7 @@ std::string defaultGrid(const MachineModel& m) {
                 continue;
             }
         }
-        g += fmt::format("{}{}={:g}", g.empty() ? "" : " ", n, std::clamp(0.0, l.min, l.max) / unit);
+        g += fmt::format("{}{}={:g}", g.empty() ? "" : " ", n, q[a] / (l.kind == AxisKind::Rotary ? kDeg : 1.0));
     }
     return g;
 }
@@ -158,7 +182,10 @@ void addCompensationSections(ReportData& data, const MachineModel& m, const Devi
     data.machineModel = &m;
     data.maps.push_back({fmt::format("before compensation: the identified machine, tool length {:g} mm", o.toolLength), before, plane});
     if (names.empty()) return;
-    const std::vector<AxisVector> samples = controllers::workspaceSamples(m, 5);
+    std::vector<AxisVector> samples;
+    const Kinematics nominal(m);
+    for (const AxisVector& q : controllers::workspaceSamples(m, 5))
+        if (!singularPose(nominal, q)) samples.push_back(q);
     for (const std::string& name : names) {
         const controllers::Backend& b = controllers::backend(name);
         const controllers::EmitResult emitted = b.emit({m, identified, "identified deviations", "2000-01-01"});
@@ -174,8 +201,8 @@ void addCompensationSections(ReportData& data, const MachineModel& m, const Devi
         c.afterMax = f.maxAfter;
         c.afterRms = f.rmsAfter;
         c.points = f.points;
-        c.basis = fmt::format("predicted: {} read back and applied to the identified machine, {} workspace poses, tool length "
-                              "{:g} mm (files not written: cnccomp emit --controller {})",
+        c.basis = fmt::format("predicted: {} read back and applied to the identified machine, {} workspace poses (tool axis "
+                              "not parallel to a rotary axis), tool length {:g} mm (files not written: cnccomp emit --controller {})",
                               name, f.points, o.toolLength, name);
         data.controllers.push_back(std::move(c));
         data.maps.push_back({fmt::format("after compensation by {} (predicted)", name),

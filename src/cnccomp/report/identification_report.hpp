@@ -26,15 +26,17 @@ std::vector<RunSection> measuredRunSections(const MachineModel& machine, const M
 std::vector<DeviationRow> deviationRows(const IdentificationReport& report);
 
 struct MapOptions {
-    /// Grid as for `cnccomp map`; empty = X and Y over their travel (at most ±200 mm, 21 × 21 points), the other axes
-    /// at 0 (or the nearest end of their travel).
+    /// Grid as for `cnccomp map`; empty = X and Y over their travel (at most ±200 mm, 21 × 21 points), the other linear
+    /// axes at 0 (or the nearest end of their travel), the rotary axes at 0 unless the tool axis would be parallel to a
+    /// rotary axis there (then 30°, 45°, −30° or 60°: a TCP controller has no unique answer at such a pose).
     std::string grid;
     std::string plane = "XY";  ///< as `cnccomp map --plane`
     double toolLength = 0;     ///< mm
 };
 
 /// Map of the identified machine ("before") and, per controller backend name, the coverage and the residual of that
-/// controller compensating the identified deviations (figures over workspaceSamples(machine, 5)) with its "after" map.
+/// controller compensating the identified deviations (figures over workspaceSamples(machine, 5) less the poses whose
+/// tool axis is parallel to a rotary axis) with its "after" map.
 void addCompensationSections(ReportData& data, const MachineModel& machine, const DeviationSet& identified,
                              const std::vector<std::string>& controllers, const MapOptions& options);
 
