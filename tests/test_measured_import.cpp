@@ -368,6 +368,9 @@ TEST(MeasuredImport, PlanCaptureAttributesReadBackAndAreChecked) {
     bad("length-unit=\"furlong\"", "length-unit 'furlong'");
     bad("length=\"maybe\"", "length 'maybe'");
     bad("angle-column=\"a,b\"", "angle-column");
+    test::writeText(f, "<plan>\n<instrument length=\"relative\"/>\n<absolute-run name=\"a\" test=\"B-Y\" LB=\"100\" "
+                       "RB=\"200\" ZC=\"1\"/>\n</plan>\n");
+    expectInputError([&] { readPlanXml(f); }, {f + ":3", "absolute run"});
     // A run name must be a plain file name: never DIR/../x.csv.
     for (const char* name : {"../x", "a/b", "..", ".hidden", ""}) {
         test::writeText(f, fmt::format("<plan>\n<run name=\"{}\" test=\"B-X\" LB=\"100\" RB=\"200\" ZC=\"1\"/>\n</plan>\n", name));

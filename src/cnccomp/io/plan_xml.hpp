@@ -33,7 +33,7 @@ struct MeasurementPlan {
 /// overshoot (deg) and directions ("ccw", "cw", "ccw cw", "cw ccw"); one optional <instrument> element gives, for every
 /// run, angle-column, time-column, length-column, pass-column, length-unit (um|mm|nm|in), angle-unit (deg|rad),
 /// time-unit (s|ms), decimal (auto|point|comma), length (absolute|relative), drift (keep|remove); a run may override
-/// each of them with the same attribute.
+/// each of them with the same attribute. <dbb5> and <rtest> runs keep their own layouts.
 /// <rtest name ball="x y z" [nest-length=100] [steps=36] [ball-offset="x y z"] [estimate-ball=false]> with children
 /// <sweep axis start end/> (deg, linear in the pose index) and <hold axis deg/>.
 /// <dbb5 name kind="linear|rotary" LB [tool-length=100] ball="x y z" [start=0 end=360 step=5] (linear: plane="XY|YZ|ZX";
