@@ -1,7 +1,9 @@
 // cnccomp identify: deviations from ball-bar measurements — general least squares on the raw traces (default,
 // issue 3) or the closed-form formulas of seed 000 (--method closed-form).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include <fmt/format.h>
 
@@ -130,8 +132,10 @@ void printReport(const IdentificationReport& r) {
     for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
 }
 
+/// --report R.html / R.htm: the HTML report; anything else: the JSON solver report.
 bool htmlReport(const std::string& path) {
-    const std::string ext = path.size() >= 5 ? path.substr(path.rfind('.') == std::string::npos ? 0 : path.rfind('.')) : "";
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return ext == ".html" || ext == ".htm";
 }
 
@@ -168,6 +172,8 @@ void runLeastSquares(const Options& o, const MachineModel& m) {
         throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (eccentricities are "
                          "for --method closed-form)");
     if (o.traces.empty() || o.plan.empty()) throw ModelError("least squares needs --traces DIR and --plan P.xml");
+    if ((!o.reportControllers.empty() || !o.reportGrid.empty()) && !htmlReport(o.report))
+        throw ModelError("--report-controllers and --report-grid belong to an HTML report: give --report R.html");
     refuseToOverwrite(o.out, {o.machine, o.plan, o.start});
     if (!o.report.empty()) {
         refuseToOverwrite(o.report, {o.machine, o.plan, o.start, o.out});

@@ -151,6 +151,9 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
 }
 
 std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, const std::vector<std::string>& plots) {
+    if (plots.size() != d.runs.size() + d.maps.size() || files.plots.size() != plots.size())
+        throw ModelError(fmt::format("report: {} plots and {} plot files for {} runs and {} maps", plots.size(),
+                                     files.plots.size(), d.runs.size(), d.maps.size()));
     std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
     h += fmt::format("<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n", esc(d.title), kStyle);
     h += fmt::format("<h1>{}</h1>\n<table class=\"facts\">\n<tr><td>machine</td><td>{}</td></tr>\n", esc(d.title), esc(d.machine));
