@@ -14,6 +14,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/trace_csv.hpp"
+#include "cnccomp/io/trace_export.hpp"
 #include "cnccomp/io/trace_import.hpp"
 #include "test_support.hpp"
 
@@ -275,6 +276,41 @@ TEST(MeasuredImport, PartialArcInBothDirectionsWithDriftAndHysteresis) {
     run.capture.removeDrift = false;
     const MeasuredTrace raw = importRunTrace(dir.file("arc.csv"), run);
     EXPECT_NEAR(evaluateCircularRun(raw.passes, run.LB).hysteresis, 2 * kUm + 0.01 * kUm * 441, 1e-6);  // rows 0 and 441 at −110°
+}
+
+TEST(MeasuredImport, InstrumentStyleExportReadsBackAsTheSweep) {
+    // Writer and reader are both ours here (a round trip); the oracle is simulateRun over the plan's sweep.
+    test::ScratchDir dir("imp-export");
+    const Kinematics k(machine(), truth());
+    for (const bool time : {false, true})
+        for (const char decimal : {'.', ','}) {
+            BallbarRun run = cRadial();
+            run.capture.feed = 1500;
+            run.capture.overshootDeg = 12;
+            run.capture.passes = {-1, +1};
+            run.capture.decimal = decimal;
+            run.capture.lengthColumn = "dL_mm";
+            run.capture.lengthUnit = 1.0;
+            run.capture.timeUnit = 1e-3;
+            const auto passes = simulateCapturedPasses(k, run);
+            ASSERT_EQ(passes.size(), 2u);
+            EXPECT_EQ(passes[0].trace.dL.size(), 385u);  // 360° + 2 × 12° at 1°, both ends
+            test::writeText(dir.file("e.csv"), formatCapturedTrace(run, passes, time, "multitasking"));
+            const MeasuredTrace m = importRunTrace(dir.file("e.csv"), run, "multitasking");
+            EXPECT_EQ(m.summary.layout, time ? "time" : "angle");
+            EXPECT_EQ(m.summary.trimmed, 48);
+            EXPECT_EQ(m.summary.metadataChecked, 11);
+            ASSERT_EQ(m.passes.size(), 2u);
+            expectSamples(m.passes[0].trace, simulate(run, 360, 0, 1), 1e-6, 1e-9);
+            expectSamples(m.passes[1].trace, simulate(run, 0, 360, 1), 1e-6, 1e-9);
+        }
+    // An overshoot the axis cannot travel.
+    BallbarRun bx = cRadial();
+    bx.test = BallbarTest::BX;
+    bx.startDeg = -180;
+    bx.endDeg = 180;
+    bx.capture.overshootDeg = 10;  // B travels ±185°
+    EXPECT_THROW(simulateCapturedPasses(k, bx), ModelError);
 }
 
 TEST(MeasuredImport, LinearPathRadiusIsTheRadiusOfTheCommandedCircle) {
