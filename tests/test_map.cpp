@@ -187,8 +187,8 @@ TEST(Map, CsvRoundTripAndSvgPicture) {
     const std::string svg = renderMapSvg(map, m, parseMapPlane("XY@C=90"), {"test"});
     EXPECT_EQ(svg.rfind("<svg", 0), 0u);
     EXPECT_NE(svg.find("C=90 deg"), std::string::npos);
-    EXPECT_NE(svg.find("|e| (um)"), std::string::npos);
-    EXPECT_NE(svg.find("X (mm)"), std::string::npos);
+    EXPECT_NE(svg.find("|e| (µm)"), std::string::npos);
+    EXPECT_NE(svg.find("X axis position (mm)"), std::string::npos);
     EXPECT_NE(svg.find("marker-end"), std::string::npos);
     EXPECT_EQ(svg.find("nan"), std::string::npos);
     EXPECT_EQ(std::count(svg.begin(), svg.end(), '<') , std::count(svg.begin(), svg.end(), '>'));

@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages cnccomp needs, only those missing (apt-get; run as root).
 set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config libeigen3-dev libnlopt-cxx-dev libtinyxml2-dev libfmt-dev libcli11-dev
-          libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev)
+          libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+          chromium)  # chromium: the HTML report's browser test (skipped without it)
 # Installed without their recommends: linuxcnc-uspace (the real LinuxCNC 2.9, the oracle of tests/linuxcnc) recommends
 # a real-time kernel, Qt and its documentation; the tests run only its simulator (34 MB download).
 lean=(linuxcnc-uspace)

@@ -1,5 +1,10 @@
 // cnccomp compare: an identified deviation set next to a reference (truth) set.
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cli/command.hpp"
 #include "cli/print.hpp"
@@ -18,7 +23,24 @@ void run(const Options& o) {
     const DeviationSet truth = readDeviationCsv(o.truth, m);
     const DeviationSet est = readDeviationCsv(o.estimate, m);
     const auto [len, ang] = printDeviations(est, &truth);
-    fmt::print("largest difference: {:.4f} um, {:.4f} arcsec\n", len, ang);
+    // Deviations on one side only: never drop them silently.
+    std::vector<std::string> missing, extra;
+    for (size_t i = 0; i < m.deviations.size(); ++i) {
+        const DeviationDef& d = m.deviations[i];
+        const std::string label = d.alias.empty() ? d.name : fmt::format("{} ({})", d.name, d.alias);
+        if (truth.present[i] && !est.present[i]) missing.push_back(label);
+        if (!truth.present[i] && est.present[i]) extra.push_back(label);
+    }
+    fmt::print("largest difference: {:.4f} um, {:.4f} arcsec (over the {} deviations in both sets)\n", len, ang,
+               std::count_if(m.deviations.begin(), m.deviations.end(), [&](const DeviationDef& d) {
+                   const int i = static_cast<int>(&d - m.deviations.data());
+                   return truth.present[i] && est.present[i];
+               }));
+    if (!missing.empty())
+        fmt::print("missing from the estimate ({} of the truth's deviations, not compared): {}\n", missing.size(),
+                   fmt::join(missing, ", "));
+    if (!extra.empty())
+        fmt::print("in the estimate but not in the truth (not compared): {}\n", fmt::join(extra, ", "));
 }
 
 const RegisterCommand reg([](CLI::App& app) {

@@ -1,7 +1,9 @@
 // cnccomp identify: deviations from ball-bar measurements — general least squares on the raw traces (default,
 // issue 3) or the closed-form formulas of seed 000 (--method closed-form).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #include <fmt/format.h>
 
@@ -11,15 +13,19 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/eccentricity_observation.hpp"
 #include "cnccomp/identification/lsq.hpp"
+#include "cnccomp/identification/measured_observations.hpp"
 #include "cnccomp/identification/parameters.hpp"
 #include "cnccomp/identification/plan_observations.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/eccentricity_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_csv.hpp"
+#include "cnccomp/report/html_report.hpp"
+#include "cnccomp/report/identification_report.hpp"
 
 namespace cnccomp::cli {
 namespace {
@@ -30,6 +36,7 @@ struct Options {
     int refine = 3;
     // least squares
     std::string params = "all", report, solver = "lm", bounds, start, observe = "traces";
+    std::string reportControllers, reportGrid, reportPlane = "XY";
     int monteCarlo = 0, maxIterations = 50;
     unsigned long seed = 1;
     double rankTolerance = 1e-7;
@@ -45,6 +52,7 @@ void runClosedForm(const Options& o, const MachineModel& m) {
         if (o.traces.empty() || o.plan.empty())
             throw ModelError("closed form needs --eccentricities E.csv, or --traces DIR with --plan P.xml");
         const MeasurementPlan plan = readPlanXml(o.plan);
+        checkPlanMachine(plan, o.plan, m.name);
         rows = eccentricitiesFromTraces(m, plan.runs, readRunTraces(o.traces, plan.runs));
     }
     if (o.refine < 0 || o.refine > 20) throw ModelError("--refine takes 0..20 passes");
@@ -124,23 +132,63 @@ void printReport(const IdentificationReport& r) {
     for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
 }
 
+/// --report R.html / R.htm: the HTML report; anything else: the JSON solver report.
+bool htmlReport(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".html" || ext == ".htm";
+}
+
+/// ISO 230-4 figures of every ball-bar run, as measured and with the identified deviations compensated.
+void printCircularTests(const std::vector<report::RunSection>& runs) {
+    if (runs.empty()) return;
+    fmt::print("ISO 230-4 circular test figures (um; after = identified deviations compensated):\n");
+    fmt::print("{:<18} {:<7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9}\n", "run", "passes", "G before",
+               "G after", "Fmax bef", "Fmin bef", "Fmax aft", "Fmin aft", "mean R mm", "H before", "H after");
+    const auto um = [](double v) { return std::isfinite(v) ? fmt::format("{:9.3f}", v / kUm) : fmt::format("{:>9}", "-"); };
+    for (const report::RunSection& r : runs) {
+        std::string passes;
+        for (const report::PolarPass& p : r.passes) passes += p.direction > 0 ? "+" : "-";
+        fmt::print("{:<18} {:<7} {} {} {} {} {} {} {:12.5f} {} {}\n", r.name, passes, um(r.before.G), um(r.after.G),
+                   um(r.before.Fmax), um(r.before.Fmin), um(r.after.Fmax), um(r.after.Fmin), r.before.meanRadius, um(r.before.H),
+                   um(r.after.H));
+    }
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+    std::vector<std::string> out;
+    size_t pos = 0;
+    while (pos <= text.size()) {
+        const size_t end = std::min(text.find(',', pos), text.size());
+        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
+        if (!item.empty()) out.push_back(item);
+        pos = end + 1;
+    }
+    return out;
+}
+
 void runLeastSquares(const Options& o, const MachineModel& m) {
     if (!o.eccentricities.empty())
         throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (eccentricities are "
                          "for --method closed-form)");
     if (o.traces.empty() || o.plan.empty()) throw ModelError("least squares needs --traces DIR and --plan P.xml");
+    if ((!o.reportControllers.empty() || !o.reportGrid.empty()) && !htmlReport(o.report))
+        throw ModelError("--report-controllers and --report-grid belong to an HTML report: give --report R.html");
     refuseToOverwrite(o.out, {o.machine, o.plan, o.start});
     if (!o.report.empty()) {
         refuseToOverwrite(o.report, {o.machine, o.plan, o.start, o.out});
     }
     const MeasurementPlan plan = readPlanXml(o.plan);
+    checkPlanMachine(plan, o.plan, m.name);
     Observations obs;
+    MeasuredRuns measured;
     if (o.observe == "eccentricity") {
         if (plan.runCount() != plan.runs.size())
             throw ModelError("--observe eccentricity works on ball-bar <run> elements only");
         obs = eccentricityObservations(m, plan.runs, readRunTraces(o.traces, plan.runs));
     } else if (o.observe == "traces") {
-        obs = planObservations(m, plan, o.traces);
+        measured = measuredObservations(m, plan, o.traces);
+        obs = std::move(measured.observations);
     } else {
         throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", o.observe));
     }
@@ -154,14 +202,43 @@ void runLeastSquares(const Options& o, const MachineModel& m) {
     io.bounds = parseBounds(m, o.bounds);
     if (!o.start.empty()) io.start = readDeviationCsv(o.start, m);
     const IdentificationResult r = identify(m, obs, io);
-    writeDeviationCsv(o.out, r.deviations);
-    if (!o.report.empty()) writeReportJson(o.report, r.report);
+    // All outputs or none.
+    OutputSet outputs({o.machine, o.plan, o.start});
+    outputs.add(o.out, formatDeviationCsv(r.deviations));
+    std::vector<report::RunSection> runs;
+    if (o.observe == "traces") {
+        measured.observations = std::move(obs);
+        runs = report::measuredRunSections(m, plan, measured, r);
+    }
+    if (!o.report.empty() && htmlReport(o.report)) {
+        report::ReportData d;
+        d.title = fmt::format("Identification of {}", m.name);
+        d.machine = m.name;
+        d.facts = {{"machine file", o.machine}, {"plan", o.plan}, {"traces", o.traces}, {"deviations written", o.out},
+                   {"solver", fmt::format("{}: {} after {} iteration(s)", r.report.solver, r.report.termination, r.report.iterations)},
+                   {"fit", fmt::format("{} samples, rank {}/{}, condition number {:.4g}, sigma {:.4f} µm", r.report.observations,
+                                       r.report.rank, r.report.unknowns, r.report.conditionNumber, r.report.sigma / kUm)}};
+        d.warnings = r.report.warnings;
+        d.runs = runs;
+        d.deviations = report::deviationRows(r.report);
+        for (const Combination& c : r.report.identifiable) d.combinations.push_back(c.text);
+        report::MapOptions mo;
+        mo.grid = o.reportGrid;
+        mo.plane = o.reportPlane;
+        mo.toolLength = plan.runs.empty() ? 0.0 : plan.runs.front().RB;
+        report::addCompensationSections(d, m, r.deviations, splitList(o.reportControllers), mo);
+        report::stageHtmlReport(outputs, o.report, d);
+    } else if (!o.report.empty()) {
+        outputs.add(o.report, formatReportJson(r.report));
+    }
+    outputs.commit();
     const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
                                           [&](int i) { return r.deviations.present[i] != 0; });
     fmt::print("identified {} of {} requested deviations of '{}' (least squares on {} samples of {} runs) -> {}{}\n",
                identified, io.deviations.size(), m.name, r.report.observations, plan.runCount(), o.out,
                o.report.empty() ? "" : ", report -> " + o.report);
     printReport(r.report);
+    printCircularTests(runs);
 }
 
 void run(const Options& o) {
@@ -191,7 +268,13 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--observe", o->observe,
                   "least squares: traces (every raw sample) or eccentricity (fitted circle centres of ball-bar runs)")
         ->capture_default_str();
-    c->add_option("--report", o->report, "least squares: JSON report to write");
+    c->add_option("--report", o->report,
+                  "least squares: report to write: R.json (solver report) or R.html (page with polar plots, ISO 230-4 "
+                  "figures, deviations, maps; SVGs and R.summary.json beside it)");
+    c->add_option("--report-controllers", o->reportControllers,
+                  "HTML report: controllers (comma list) whose coverage and predicted residual to show");
+    c->add_option("--report-grid", o->reportGrid, "HTML report: map grid as for cnccomp map (default: X, Y over the travel)");
+    c->add_option("--report-plane", o->reportPlane, "HTML report: map plane as for cnccomp map --plane")->capture_default_str();
     c->add_option("--solver", o->solver, "least squares: lm (Levenberg-Marquardt) or nlopt:<ALGORITHM>, e.g. nlopt:LD_SLSQP")
         ->capture_default_str();
     c->add_option("--bounds", o->bounds, "NLopt: NAME=LOWER:UPPER,... in um / arcsec (default +-1000)");

@@ -39,7 +39,7 @@ void run(const Options& o) {
             for (double& v : t.dL) v += noise(rng);
         const std::string path = (std::filesystem::path(o.out) / (r.name + ".csv")).string();
         refuseToOverwrite(path, {o.machine, o.plan, o.deviations});
-        writeTraceCsv(path, t);
+        writeTraceCsv(path, t, r, m.name);  // with the run's metadata, checked when read back
         traces.push_back(std::move(t));
     }
     const auto rows = eccentricitiesFromTraces(m, plan.runs, traces);

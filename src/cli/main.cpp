@@ -7,6 +7,7 @@
 
 #include "cli/command.hpp"
 #include "cnccomp/error.hpp"
+#include "cnccomp/version.hpp"
 
 namespace cnccomp::cli {
 std::vector<CommandSetup>& commandRegistry() {
@@ -17,6 +18,7 @@ std::vector<CommandSetup>& commandRegistry() {
 
 int main(int argc, char** argv) {
     CLI::App app{"cnccomp: identify, map and compensate geometric deviations of 5-axis and mill-turn machines"};
+    app.set_version_flag("--version", fmt::format("cnccomp {}", cnccomp::kVersion), "print the version and exit");
     app.require_subcommand(1);
     for (const auto& setup : cnccomp::cli::commandRegistry()) setup(app);
     try {

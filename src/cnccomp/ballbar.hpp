@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cnccomp/kinematics.hpp"
+#include "cnccomp/run_capture.hpp"
 
 namespace cnccomp {
 
@@ -40,6 +41,7 @@ struct BallbarRun {
     bool estimateWorkBallOffset = false;  ///< identification: treat (xW, yW, zW) as nuisance parameters
     std::string headAxis = "B";
     std::string tableAxis = "C";
+    RunCapture capture;  ///< how the measured trace was recorded and exported (defaults: cnccomp's own traces)
 
     /// Sweep angles in degrees; a full turn does not repeat its first angle.
     std::vector<double> anglesDeg() const;

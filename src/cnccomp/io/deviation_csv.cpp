@@ -1,6 +1,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 
 #include <cmath>
+#include <map>
 #include <ostream>
 #include <sstream>
 
@@ -32,6 +33,7 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
     if (cName < 0 && cAlias < 0) throw InputError(path, t.header.line, "header needs a 'name' or 'alias' column");
     const int cValue = t.requireColumn("value"), cUnit = t.requireColumn("unit");
     DeviationSet set(machine);
+    std::map<std::pair<int, int>, int> firstLine;  // (deviation, coefficient) → line: a value given twice is an error
     for (const CsvRow& row : t.rows) {
         const std::string& rawName = t.cell(row, cName);
         const std::string& rawAlias = t.cell(row, cAlias);
@@ -51,6 +53,10 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
             coef = k;
         }
         const DeviationDef& d = machine.deviations[index];
+        if (const auto [it, fresh] = firstLine.emplace(std::pair{index, coef}, row.line); !fresh)
+            throw InputError(path, row.line,
+                             fmt::format("{}{} is given twice (first on line {}); which value is meant?", d.name,
+                                         coef >= 0 ? fmt::format("[{}]", coef) : "", it->second));
         if (d.kind == DeviationKind::Location && coef >= 0)
             throw InputError(path, row.line, fmt::format("'{}' is a location error and takes no [index]", d.name));
         if (d.kind == DeviationKind::Component && (coef < 0 || coef >= d.size()))

@@ -1,5 +1,6 @@
 #include "cnccomp/io/plan_xml.hpp"
 
+#include <cmath>
 #include <ostream>
 #include <set>
 #include <sstream>
@@ -7,6 +8,8 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/markup.hpp"
+#include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/xml_util.hpp"
 
@@ -16,9 +19,143 @@ namespace {
 
 using tinyxml2::XMLElement;
 
-BallbarRun readBallbarRun(const XMLElement& e, const std::string& path, bool absolute) {
+// --- measured runs: <instrument> and the capture attributes of <run> (RunCapture) -------------------------------
+
+struct UnitName {
+    const char* name;
+    double value;
+};
+constexpr UnitName kLengthUnits[] = {{"um", 1e-3}, {"µm", 1e-3}, {"mm", 1.0}, {"nm", 1e-6}, {"in", 25.4}};
+constexpr UnitName kAngleUnits[] = {{"deg", 1.0}, {"rad", 180.0 / M_PI}};
+constexpr UnitName kTimeUnits[] = {{"s", 1.0}, {"ms", 1e-3}};
+
+template <size_t N>
+void readUnit(const XMLElement& e, const std::string& path, const char* attr, const UnitName (&units)[N], double& out) {
+    if (!xml::has(e, attr)) return;
+    const std::string v = xml::text(e, path, attr);
+    std::string known;
+    for (const UnitName& u : units) {
+        if (v == u.name) {
+            out = u.value;
+            return;
+        }
+        known += known.empty() ? u.name : std::string(", ") + u.name;
+    }
+    xml::fail(e, path, fmt::format("{} '{}' is not one of {}", attr, v, known));
+}
+
+template <size_t N>
+const char* unitName(double value, const UnitName (&units)[N]) {
+    for (const UnitName& u : units)
+        if (u.value == value) return u.name;
+    return units[0].name;
+}
+
+std::string choice(const XMLElement& e, const std::string& path, const char* attr, std::initializer_list<const char*> allowed) {
+    const std::string v = xml::text(e, path, attr);
+    std::string list;
+    for (const char* a : allowed) {
+        if (v == a) return v;
+        list += list.empty() ? a : std::string(", ") + a;
+    }
+    xml::fail(e, path, fmt::format("{} '{}' is not one of {}", attr, v, list));
+}
+
+/// The instrument part of a capture (<instrument> or the same attributes on a run).
+void readInstrument(const XMLElement& e, const std::string& path, RunCapture& c) {
+    for (auto [attr, field] : {std::pair{"angle-column", &c.angleColumn}, {"time-column", &c.timeColumn},
+                               {"length-column", &c.lengthColumn}, {"pass-column", &c.passColumn}})
+        if (xml::has(e, attr)) {
+            *field = xml::text(e, path, attr);
+            if (field->empty() || field->find_first_of(",;\t\"") != std::string::npos)
+                xml::fail(e, path, fmt::format("{} '{}' must be a non-empty column name without , ; tab or \"", attr, *field));
+        }
+    readUnit(e, path, "length-unit", kLengthUnits, c.lengthUnit);
+    readUnit(e, path, "angle-unit", kAngleUnits, c.angleUnit);
+    readUnit(e, path, "time-unit", kTimeUnits, c.timeUnit);
+    if (xml::has(e, "decimal")) {
+        const std::string d = choice(e, path, "decimal", {"auto", "point", "comma"});
+        c.decimal = d == "point" ? '.' : d == "comma" ? ',' : 0;
+    }
+    if (xml::has(e, "length")) c.relativeLength = choice(e, path, "length", {"absolute", "relative"}) == "relative";
+    if (xml::has(e, "drift")) c.removeDrift = choice(e, path, "drift", {"keep", "remove"}) == "remove";
+}
+
+void readCapture(const XMLElement& e, const std::string& path, const RunCapture& instrument, RunCapture& c) {
+    c = instrument;
+    readInstrument(e, path, c);
+    c.feed = xml::number(e, path, "feed", 0.0);
+    c.feedRadius = xml::number(e, path, "feed-radius", 0.0);
+    c.overshootDeg = xml::number(e, path, "overshoot", 0.0);
+    if (!(c.feed >= 0) || !std::isfinite(c.feed)) xml::fail(e, path, "feed must be a non-negative number (mm/min)");
+    if (!(c.feedRadius >= 0) || !std::isfinite(c.feedRadius)) xml::fail(e, path, "feed-radius must be a non-negative number (mm)");
+    if (!(c.overshootDeg >= 0) || !(c.overshootDeg < 360)) xml::fail(e, path, "overshoot must be 0 .. 360 deg");
+    if (xml::has(e, "directions")) {
+        std::istringstream in(xml::text(e, path, "directions"));
+        std::string w;
+        while (in >> w) {
+            if (w == "ccw" || w == "CCW") c.passes.push_back(+1);
+            else if (w == "cw" || w == "CW") c.passes.push_back(-1);
+            else xml::fail(e, path, fmt::format("directions: '{}' is not ccw or cw", w));
+        }
+        if (c.passes.empty() || c.passes.size() > 2 || (c.passes.size() == 2 && c.passes[0] == c.passes[1]))
+            xml::fail(e, path, "directions must be \"ccw\", \"cw\", \"ccw cw\" or \"cw ccw\"");
+    }
+}
+
+/// Attributes of the instrument part that differ from `base`.
+std::string instrumentAttributes(const RunCapture& c, const RunCapture& base) {
+    std::string o;
+    const auto text = [&](const char* attr, const std::string& v, const std::string& b) {
+        if (v != b) o += fmt::format(" {}=\"{}\"", attr, escapeXml(v, attr));
+    };
+    text("angle-column", c.angleColumn, base.angleColumn);
+    text("time-column", c.timeColumn, base.timeColumn);
+    text("length-column", c.lengthColumn, base.lengthColumn);
+    text("pass-column", c.passColumn, base.passColumn);
+    if (c.lengthUnit != base.lengthUnit) o += fmt::format(" length-unit=\"{}\"", unitName(c.lengthUnit, kLengthUnits));
+    if (c.angleUnit != base.angleUnit) o += fmt::format(" angle-unit=\"{}\"", unitName(c.angleUnit, kAngleUnits));
+    if (c.timeUnit != base.timeUnit) o += fmt::format(" time-unit=\"{}\"", unitName(c.timeUnit, kTimeUnits));
+    if (c.decimal != base.decimal)
+        o += fmt::format(" decimal=\"{}\"", c.decimal == '.' ? "point" : c.decimal == ',' ? "comma" : "auto");
+    if (c.relativeLength != base.relativeLength) o += fmt::format(" length=\"{}\"", c.relativeLength ? "relative" : "absolute");
+    if (c.removeDrift != base.removeDrift) o += fmt::format(" drift=\"{}\"", c.removeDrift ? "remove" : "keep");
+    return o;
+}
+
+RunCapture instrumentPart(RunCapture c) {
+    const RunCapture d;
+    c.feed = d.feed;
+    c.feedRadius = d.feedRadius;
+    c.overshootDeg = d.overshootDeg;
+    c.passes = d.passes;
+    return c;
+}
+
+std::string captureAttributes(const RunCapture& c, const RunCapture& instrument) {
+    std::string o;
+    if (c.feed != 0) o += fmt::format(" feed=\"{:g}\"", c.feed);
+    if (c.feedRadius != 0) o += fmt::format(" feed-radius=\"{:g}\"", c.feedRadius);
+    if (c.overshootDeg != 0) o += fmt::format(" overshoot=\"{:g}\"", c.overshootDeg);
+    if (!c.passes.empty()) {
+        o += " directions=\"";
+        for (size_t i = 0; i < c.passes.size(); ++i) o += fmt::format("{}{}", i ? " " : "", c.passes[i] > 0 ? "ccw" : "cw");
+        o += "\"";
+    }
+    return o + instrumentAttributes(c, instrument);
+}
+
+/// A run's name names its data file DIR/<name>.csv: it must be a plain file name.
+std::string runName(const XMLElement& e, const std::string& path) {
+    std::string name = xml::text(e, path, "name");
+    if (const std::string why = fileNameProblem(name); !why.empty())
+        xml::fail(e, path, fmt::format("run name '{}' cannot name its data file <name>.csv: {}", name, why));
+    return name;
+}
+
+BallbarRun readBallbarRun(const XMLElement& e, const std::string& path, bool absolute, const RunCapture& instrument) {
     BallbarRun r;
-    r.name = xml::text(e, path, "name");
+    r.name = runName(e, path);
     const std::string test = xml::text(e, path, "test");
     const auto t = parseTest(test);
     if (!t)
@@ -44,6 +181,9 @@ BallbarRun readBallbarRun(const XMLElement& e, const std::string& path, bool abs
     r.estimateWorkBallOffset = est == "work" || est == "both";
     r.headAxis = xml::textOr(e, "head-axis", "B");
     r.tableAxis = xml::textOr(e, "table-axis", "C");
+    readCapture(e, path, instrument, r.capture);
+    if (absolute && r.capture.relativeLength)
+        xml::fail(e, path, "an absolute run measures the absolute length (seed 002); its instrument cannot be length=\"relative\"");
     try {
         r.validate();
     } catch (const ModelError& ex) {
@@ -80,7 +220,7 @@ int wholeNumber(const XMLElement& e, const std::string& path, const char* attr, 
 
 RtestRun readRtestRun(const XMLElement& e, const std::string& path) {
     RtestRun r;
-    r.name = xml::text(e, path, "name");
+    r.name = runName(e, path);
     if (!xml::has(e, "ball")) xml::fail(e, path, "missing attribute 'ball'");
     r.ball = xml::vec3(e, path, "ball", Vec3::Zero());
     r.nestLength = xml::number(e, path, "nest-length", 100.0);
@@ -98,7 +238,7 @@ RtestRun readRtestRun(const XMLElement& e, const std::string& path) {
 
 Dbb5Run readDbb5Run(const XMLElement& e, const std::string& path) {
     Dbb5Run r;
-    r.name = xml::text(e, path, "name");
+    r.name = runName(e, path);
     const std::string kind = xml::text(e, path, "kind");
     if (kind == "linear") r.kind = Dbb5Run::Kind::LinearCircle;
     else if (kind == "rotary") r.kind = Dbb5Run::Kind::RotaryCircle;
@@ -144,18 +284,21 @@ std::string vec(const Vec3& v) {  // + 0.0 prints −0 as 0
     return fmt::format("{:g} {:g} {:g}", v.x() + 0.0, v.y() + 0.0, v.z() + 0.0);
 }
 
-void formatBallbar(std::ostream& o, const char* element, const BallbarRun& r) {
+std::string esc(const std::string& s) { return escapeXml(s, "plan text"); }
+
+void formatBallbar(std::ostream& o, const char* element, const BallbarRun& r, const RunCapture& instrument) {
     o << fmt::format("  <{} name=\"{}\" test=\"{}\" LB=\"{:g}\" RB=\"{:g}\" RC=\"{:g}\" ZC=\"{:g}\" start=\"{:g}\" "
                      "end=\"{:g}\" step=\"{:g}\"",
-                     element, r.name, testName(r.test), r.LB, r.RB, r.RC, r.ZC, r.startDeg, r.endDeg, r.stepDeg);
+                     element, esc(r.name), testName(r.test), r.LB, r.RB, r.RC, r.ZC, r.startDeg, r.endDeg, r.stepDeg);
     if (!r.toolBallOffset.isZero()) o << fmt::format(" tool-ball-offset=\"{}\"", vec(r.toolBallOffset));
     if (!r.workBallOffset.isZero()) o << fmt::format(" work-ball-offset=\"{}\"", vec(r.workBallOffset));
     if (r.estimateToolBallOffset || r.estimateWorkBallOffset)
         o << fmt::format(" estimate-mounting=\"{}\"", r.estimateToolBallOffset && r.estimateWorkBallOffset ? "both"
                                                        : r.estimateToolBallOffset                             ? "tool"
                                                                                                               : "work");
-    if (r.headAxis != "B") o << fmt::format(" head-axis=\"{}\"", r.headAxis);
-    if (r.tableAxis != "C") o << fmt::format(" table-axis=\"{}\"", r.tableAxis);
+    if (r.headAxis != "B") o << fmt::format(" head-axis=\"{}\"", esc(r.headAxis));
+    if (r.tableAxis != "C") o << fmt::format(" table-axis=\"{}\"", esc(r.tableAxis));
+    o << captureAttributes(r.capture, instrument);
     o << "/>\n";
 }
 
@@ -168,15 +311,24 @@ MeasurementPlan readPlanXml(const std::string& path) {
     MeasurementPlan plan;
     plan.machine = xml::textOr(root, "machine", "");
     plan.description = xml::textOr(root, "description", "");
+    plan.line = root.GetLineNum();
+    RunCapture instrument;
+    const XMLElement* instrumentElement = root.FirstChildElement("instrument");
+    if (instrumentElement) {
+        if (instrumentElement->NextSiblingElement("instrument"))
+            xml::fail(*instrumentElement->NextSiblingElement("instrument"), path, "a plan has at most one <instrument>");
+        readInstrument(*instrumentElement, path, instrument);
+    }
     std::set<std::string> names;
     for (const auto* e = root.FirstChildElement(); e; e = e->NextSiblingElement()) {
         const std::string kind = e->Name();
         std::string name;
+        if (kind == "instrument") continue;
         if (kind == "run") {
-            plan.runs.push_back(readBallbarRun(*e, path, false));
+            plan.runs.push_back(readBallbarRun(*e, path, false, instrument));
             name = plan.runs.back().name;
         } else if (kind == "absolute-run") {
-            plan.absoluteRuns.push_back(readBallbarRun(*e, path, true));
+            plan.absoluteRuns.push_back(readBallbarRun(*e, path, true, instrument));
             name = plan.absoluteRuns.back().name;
         } else if (kind == "rtest") {
             plan.rtestRuns.push_back(readRtestRun(*e, path));
@@ -185,7 +337,7 @@ MeasurementPlan readPlanXml(const std::string& path) {
             plan.dbb5Runs.push_back(readDbb5Run(*e, path));
             name = plan.dbb5Runs.back().name;
         } else {
-            xml::fail(*e, path, "expected <run>, <absolute-run>, <rtest> or <dbb5>");
+            xml::fail(*e, path, "expected <run>, <absolute-run>, <rtest> or <dbb5> (or one <instrument>)");
         }
         if (!names.insert(name).second) xml::fail(*e, path, fmt::format("run name '{}' is used twice", name));
     }
@@ -196,18 +348,32 @@ MeasurementPlan readPlanXml(const std::string& path) {
 std::string formatPlanXml(const MeasurementPlan& plan) {
     std::ostringstream o;
     o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    o << fmt::format("<plan machine=\"{}\" description=\"{}\">\n", plan.machine, plan.description);
-    for (const auto& r : plan.runs) formatBallbar(o, "run", r);
-    for (const auto& r : plan.absoluteRuns) formatBallbar(o, "absolute-run", r);
+    o << fmt::format("<plan machine=\"{}\" description=\"{}\">\n", escapeXml(plan.machine, "machine name"),
+                     esc(plan.description));
+    // One <instrument> when every ball-bar run shares its settings; runs write what differs from it.
+    std::vector<const BallbarRun*> ballbar;
+    for (const auto& r : plan.runs) ballbar.push_back(&r);
+    for (const auto& r : plan.absoluteRuns) ballbar.push_back(&r);
+    RunCapture instrument;
+    if (!ballbar.empty()) {
+        const RunCapture first = instrumentPart(ballbar.front()->capture);
+        bool shared = true;
+        for (const BallbarRun* r : ballbar) shared = shared && instrumentPart(r->capture) == first;
+        if (shared) instrument = first;
+    }
+    if (const std::string attrs = instrumentAttributes(instrument, RunCapture{}); !attrs.empty())
+        o << fmt::format("  <instrument{}/>\n", attrs);
+    for (const auto& r : plan.runs) formatBallbar(o, "run", r, instrument);
+    for (const auto& r : plan.absoluteRuns) formatBallbar(o, "absolute-run", r, instrument);
     for (const auto& r : plan.rtestRuns) {
-        o << fmt::format("  <rtest name=\"{}\" ball=\"{}\" nest-length=\"{:g}\" steps=\"{}\"", r.name, vec(r.ball),
+        o << fmt::format("  <rtest name=\"{}\" ball=\"{}\" nest-length=\"{:g}\" steps=\"{}\"", esc(r.name), vec(r.ball),
                          r.nestLength, r.steps);
         if (!r.ballOffset.isZero()) o << fmt::format(" ball-offset=\"{}\"", vec(r.ballOffset));
         if (r.estimateBall) o << " estimate-ball=\"true\"";
         o << ">\n";
         for (const RotarySweep& s : r.sweeps) {
-            if (s.startDeg == s.endDeg) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", s.axis, s.startDeg);
-            else o << fmt::format("    <sweep axis=\"{}\" start=\"{:g}\" end=\"{:g}\"/>\n", s.axis, s.startDeg, s.endDeg);
+            if (s.startDeg == s.endDeg) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", esc(s.axis), s.startDeg);
+            else o << fmt::format("    <sweep axis=\"{}\" start=\"{:g}\" end=\"{:g}\"/>\n", esc(s.axis), s.startDeg, s.endDeg);
         }
         o << "  </rtest>\n";
     }
@@ -215,23 +381,30 @@ std::string formatPlanXml(const MeasurementPlan& plan) {
         const bool linear = r.kind == Dbb5Run::Kind::LinearCircle, cone = r.kind == Dbb5Run::Kind::ConeFrustum;
         o << fmt::format("  <dbb5 name=\"{}\" kind=\"{}\" LB=\"{:g}\" tool-length=\"{:g}\" ball=\"{}\" start=\"{:g}\" "
                          "end=\"{:g}\" step=\"{:g}\"",
-                         r.name, linear ? "linear" : cone ? "cone" : "rotary", r.LB, r.toolLength, vec(r.ball), r.startDeg,
-                         r.endDeg, r.stepDeg);
-        if (linear) o << fmt::format(" plane=\"{}\"", r.plane);
+                         esc(r.name), linear ? "linear" : cone ? "cone" : "rotary", r.LB, r.toolLength, vec(r.ball),
+                         r.startDeg, r.endDeg, r.stepDeg);
+        if (linear) o << fmt::format(" plane=\"{}\"", esc(r.plane));
         else if (cone)
             o << fmt::format(" cone-tilt=\"{:g}\" tool-angle=\"{:g}\" bar-angle=\"{:g}\" setup=\"{:g}\"", r.coneTiltDeg,
                              r.toolAngleDeg, r.barAngleDeg, r.setupDeg);
-        else o << fmt::format(" axis=\"{}\" direction=\"{}\" setup=\"{:g}\"", r.axis, vec(r.barDirection), r.setupDeg);
+        else o << fmt::format(" axis=\"{}\" direction=\"{}\" setup=\"{:g}\"", esc(r.axis), vec(r.barDirection), r.setupDeg);
         if (r.hold.empty()) {
             o << "/>\n";
             continue;
         }
         o << ">\n";
-        for (const auto& [axis, deg] : r.hold) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", axis, deg);
+        for (const auto& [axis, deg] : r.hold) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", esc(axis), deg);
         o << "  </dbb5>\n";
     }
     o << "</plan>\n";
     return o.str();
+}
+
+void checkPlanMachine(const MeasurementPlan& plan, const std::string& planPath, const std::string& machine) {
+    if (!plan.machine.empty() && plan.machine != machine)
+        throw InputError(planPath, plan.line,
+                         fmt::format("this plan was made for machine '{}', not for '{}' (the machine description given)",
+                                     plan.machine, machine));
 }
 
 void writePlanXml(const std::string& path, const MeasurementPlan& plan) {

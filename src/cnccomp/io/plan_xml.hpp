@@ -16,6 +16,7 @@ namespace cnccomp {
 
 struct MeasurementPlan {
     std::string machine;      ///< machine name the plan was made for (may be empty)
+    int line = 0;             ///< line of <plan> in the file it was read from (0 when not read from a file)
     std::string description;
     std::vector<BallbarRun> runs;          ///< <run>
     std::vector<BallbarRun> absoluteRuns;  ///< <absolute-run>
@@ -25,15 +26,22 @@ struct MeasurementPlan {
     size_t runCount() const { return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size(); }
 };
 
-/// Attributes of <run> and <absolute-run>: name, test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
+/// Attributes of <run> and <absolute-run>: name (a plain file name: DIR/<name>.csv), test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
 /// tool-ball-offset / work-ball-offset ("x y z" mm), estimate-mounting (none|tool|work|both: mounting offsets as
 /// nuisance parameters; an absolute run takes none|work), head-axis / table-axis (default B / C).
+/// Measured runs (RunCapture, cnccomp/run_capture.hpp): <run>/<absolute-run> take feed (mm/min), feed-radius (mm),
+/// overshoot (deg) and directions ("ccw", "cw", "ccw cw", "cw ccw"); one optional <instrument> element gives, for every
+/// run, angle-column, time-column, length-column, pass-column, length-unit (um|mm|nm|in), angle-unit (deg|rad),
+/// time-unit (s|ms), decimal (auto|point|comma), length (absolute|relative), drift (keep|remove); a run may override
+/// each of them with the same attribute. <dbb5> and <rtest> runs keep their own layouts.
 /// <rtest name ball="x y z" [nest-length=100] [steps=36] [ball-offset="x y z"] [estimate-ball=false]> with children
 /// <sweep axis start end/> (deg, linear in the pose index) and <hold axis deg/>.
 /// <dbb5 name kind="linear|rotary|cone" LB [tool-length=100] ball="x y z" [start=0 end=360 step=5] (linear:
 /// plane="XY|YZ|ZX"; rotary: axis direction="x y z" [setup=0]; cone: [cone-tilt=10 tool-angle=15 bar-angle=45 setup=0],
 /// deg) > with children <hold axis deg/>.
 MeasurementPlan readPlanXml(const std::string& path);
+/// Throws InputError naming the plan file and the line of <plan> when the plan names another machine than `machine`.
+void checkPlanMachine(const MeasurementPlan& plan, const std::string& planPath, const std::string& machine);
 void writePlanXml(const std::string& path, const MeasurementPlan& plan);
 std::string formatPlanXml(const MeasurementPlan& plan);
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/markup.hpp"
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp {
@@ -43,21 +44,63 @@ double niceStep(double lo, double hi, int n) {
     return 10 * p;
 }
 
-std::string escape(std::string_view s) {
-    std::string o;
-    for (char c : s) {
-        if (c == '<') o += "&lt;";
-        else if (c == '>') o += "&gt;";
-        else if (c == '&') o += "&amp;";
-        else o += c;
-    }
-    return o;
-}
+std::string escape(std::string_view s) { return escapeXml(s, "map text"); }
 
 std::string unitOf(const MachineModel& m, const VolumetricMap& map, const std::string& axis) {
     if (map.toolOrientation) return "mm";
     const int a = m.axisIndex(axis);
     return a >= 0 && m.axisLink(a).kind == AxisKind::Rotary ? "deg" : "mm";
+}
+
+/// What a plane coordinate is: a machine axis command, or the tool tip in the workpiece frame (orientation mode).
+std::string axisLabel(const MachineModel& m, const VolumetricMap& map, const std::string& axis) {
+    if (map.toolOrientation) return fmt::format("tool tip {} in the workpiece frame ({})", axis, unitOf(m, map, axis));
+    return fmt::format("{} axis position ({})", axis, unitOf(m, map, axis));
+}
+
+/// The plane's grid: axis indices and the cut along every other grid axis.
+struct PlaneCut {
+    int iu = -1, iv = -1;
+    std::vector<long> cut;
+    std::string text;
+};
+
+PlaneCut planeCut(const VolumetricMap& map, const MachineModel* m, const MapPlane& plane) {
+    const MapGrid& g = map.grid;
+    PlaneCut c;
+    c.iu = g.find(plane.u);
+    c.iv = g.find(plane.v);
+    if (c.iu < 0 || c.iv < 0 || g.axes[c.iu].count < 2 || g.axes[c.iv].count < 2)
+        throw InputError(kSource, 0, fmt::format("plane axes {} and {} must both be ranges of the grid", plane.u, plane.v));
+    c.cut.assign(g.axes.size(), 0);
+    for (size_t i = 0; i < g.axes.size(); ++i) {
+        if (static_cast<int>(i) == c.iu || static_cast<int>(i) == c.iv) continue;
+        const GridAxis& a = g.axes[i];
+        double want = 0.0;
+        bool given = false;
+        for (const auto& [n, v] : plane.at)
+            if (n == a.name) want = v, given = true;
+        long best = 0;
+        for (long k = 1; k < a.count; ++k)
+            if (std::abs(a.value(k) - want) < std::abs(a.value(best) - want)) best = k;
+        if (given && std::abs(a.value(best) - want) > 1e-6 * std::max(1.0, std::abs(want)))
+            throw InputError(kSource, 0, fmt::format("{}={:g} is not a grid value (nearest {:g})", a.name, want, a.value(best)));
+        c.cut[i] = best;
+        if (m) c.text += fmt::format("{}{}={:g} {}", c.text.empty() ? "" : ", ", a.name, a.value(best), unitOf(*m, map, a.name));
+    }
+    for (const auto& [n, v] : plane.at)
+        if (g.find(n) < 0 || n == plane.u || n == plane.v)
+            throw InputError(kSource, 0, fmt::format("'{}' is not a grid axis across the plane", n));
+    return c;
+}
+
+long flatIndex(const MapGrid& g, const PlaneCut& c, long ku, long kv) {
+    long index = 0;
+    for (size_t i = 0; i < g.axes.size(); ++i) {
+        const long k = static_cast<int>(i) == c.iu ? ku : static_cast<int>(i) == c.iv ? kv : c.cut[i];
+        index = index * g.axes[i].count + k;
+    }
+    return index;
 }
 
 }  // namespace
@@ -100,41 +143,25 @@ MapPlane parseMapPlane(std::string_view text) {
     return p;
 }
 
+double planeMaxError(const VolumetricMap& map, const MapPlane& plane) {
+    const PlaneCut c = planeCut(map, nullptr, plane);
+    double e = 0;
+    for (long ku = 0; ku < map.grid.axes[c.iu].count; ++ku)
+        for (long kv = 0; kv < map.grid.axes[c.iv].count; ++kv) {
+            const MapPoint& p = map.points[flatIndex(map.grid, c, ku, kv)];
+            if (p.ok) e = std::max(e, p.error.norm());
+        }
+    return e;
+}
+
 std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const MapPlane& plane, const SvgInfo& info) {
     const MapGrid& g = map.grid;
-    const int iu = g.find(plane.u), iv = g.find(plane.v);
-    if (iu < 0 || iv < 0 || g.axes[iu].count < 2 || g.axes[iv].count < 2)
-        throw InputError(kSource, 0, fmt::format("plane axes {} and {} must both be ranges of the grid", plane.u, plane.v));
-    // Index of the cut along every other grid axis.
-    std::vector<long> cut(g.axes.size(), 0);
-    std::string cutText;
-    for (size_t i = 0; i < g.axes.size(); ++i) {
-        if (static_cast<int>(i) == iu || static_cast<int>(i) == iv) continue;
-        const GridAxis& a = g.axes[i];
-        double want = 0.0;
-        bool given = false;
-        for (const auto& [n, v] : plane.at)
-            if (n == a.name) want = v, given = true;
-        long best = 0;
-        for (long k = 1; k < a.count; ++k)
-            if (std::abs(a.value(k) - want) < std::abs(a.value(best) - want)) best = k;
-        if (given && std::abs(a.value(best) - want) > 1e-6 * std::max(1.0, std::abs(want)))
-            throw InputError(kSource, 0, fmt::format("{}={:g} is not a grid value (nearest {:g})", a.name, want, a.value(best)));
-        cut[i] = best;
-        cutText += fmt::format("{}{}={:g} {}", cutText.empty() ? "" : ", ", a.name, a.value(best), unitOf(m, map, a.name));
-    }
-    for (const auto& [n, v] : plane.at)
-        if (g.find(n) < 0 || n == plane.u || n == plane.v)
-            throw InputError(kSource, 0, fmt::format("'{}' is not a grid axis across the plane", n));
+    const PlaneCut pc = planeCut(map, &m, plane);
+    const int iu = pc.iu, iv = pc.iv;
+    const std::string& cutText = pc.text;
     const GridAxis &au = g.axes[iu], &av = g.axes[iv];
-    const auto flat = [&](long ku, long kv) {
-        long index = 0;
-        for (size_t i = 0; i < g.axes.size(); ++i) {
-            const long k = static_cast<int>(i) == iu ? ku : static_cast<int>(i) == iv ? kv : cut[i];
-            index = index * g.axes[i].count + k;
-        }
-        return index;
-    };
+    const auto flat = [&](long ku, long kv) { return flatIndex(g, pc, ku, kv); };
+    const std::string id = escape(info.idPrefix);
     // Plane statistics.
     double emax = 0, emin = HUGE_VAL, sum = 0;
     long n = 0;
@@ -148,12 +175,14 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
             ++n;
         }
     const double rms = n > 0 ? std::sqrt(sum / n) : 0.0;
-    // Colour scale over the plane's own range (round ends), so that variations show.
+    // Colour scale from 0 to a round value at or above the plane's maximum (or the shared maximum given).
     if (n == 0) emin = emax = 0;
-    double clo = emin / kUm, chi = emax / kUm;
-    if (chi - clo < 1e-3 * std::max(1.0, chi)) clo = std::max(0.0, clo - 0.5), chi = clo + 1.0;
-    const double cstep = niceStep(clo, chi, 5);
-    clo = std::floor(clo / cstep + 1e-9) * cstep;
+    if (!(info.scaleMaxUm >= 0) || !std::isfinite(info.scaleMaxUm))
+        throw ModelError("map picture: the colour scale maximum must be a finite number >= 0 um");
+    const double clo = 0.0;
+    double chi = std::max(info.scaleMaxUm > 0 ? info.scaleMaxUm : 0.0, emax / kUm);
+    if (!(chi > 1e-6)) chi = 1.0;  // an all-zero plane: a 0..1 µm scale
+    const double cstep = niceStep(0.0, chi, 5);
     const double ctop = std::ceil(chi / cstep - 1e-9) * cstep;
     const auto shade = [&](double um) { return colour((um - clo) / (ctop - clo)); };
 
@@ -170,15 +199,17 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
     std::string s;
     s += fmt::format(R"(<svg xmlns="http://www.w3.org/2000/svg" width="{0}" height="{1}" viewBox="0 0 {0} {1}" font-family="Helvetica, Arial, sans-serif">)",
                      W, H);
-    s += "\n<defs><marker id=\"head\" markerUnits=\"userSpaceOnUse\" markerWidth=\"7\" markerHeight=\"6\" refX=\"6\" refY=\"3\" orient=\"auto\">"
+    s += fmt::format("\n<defs><clipPath id=\"{}-frame\"><rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\"/></clipPath>",
+                     id, left, top, pw, ph);
+    s += "<marker id=\"" + id + "-head\" markerUnits=\"userSpaceOnUse\" markerWidth=\"7\" markerHeight=\"6\" refX=\"6\" refY=\"3\" orient=\"auto\">"
          "<path d=\"M0,0 L7,3 L0,6 z\" fill=\"white\" stroke=\"black\" stroke-width=\"0.4\"/></marker>\n"
-         "<linearGradient id=\"bar\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">";
+         "<linearGradient id=\"" + id + "-bar\" x1=\"0\" y1=\"1\" x2=\"0\" y2=\"0\">";
     for (int k = 0; k <= 8; ++k) s += fmt::format("<stop offset=\"{:.3f}\" stop-color=\"{}\"/>", k / 8.0, colour(k / 8.0));
     s += "</linearGradient></defs>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
     s += fmt::format("<text x=\"{}\" y=\"32\" font-size=\"20\" font-weight=\"bold\">Volumetric tool-tip error |e| on the {}{} plane</text>\n",
                      left, plane.u, plane.v);
     s += fmt::format("<text x=\"{}\" y=\"54\" font-size=\"13\">{}</text>\n", left, escape(info.title));
-    s += fmt::format("<text x=\"{}\" y=\"74\" font-size=\"13\">{}tool length {:g} mm{} — plane max {:.2f} um, rms {:.2f} um</text>\n",
+    s += fmt::format("<text x=\"{}\" y=\"74\" font-size=\"13\">{}tool length {:g} mm{} — plane max {:.2f} µm, rms {:.2f} µm</text>\n",
                      left, cutText.empty() ? "" : escape(cutText) + "; ", map.toolLength,
                      map.toolOrientation ? fmt::format(", tool axis ({:.3g}, {:.3g}, {:.3g})", map.toolOrientation->x(),
                                                        map.toolOrientation->y(), map.toolOrientation->z())
@@ -201,8 +232,16 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
         return -1;
     };
     const int cu = comp(plane.u), cv = comp(plane.v);
-    std::string arrowNote = "no arrows: a plane axis is not X, Y or Z";
+    std::string arrowNote = map.toolOrientation || (cu >= 0 && cv >= 0)
+                                ? "no arrows: the error is zero on this whole plane"
+                                : "no arrows: a plane axis is not a linear axis X, Y or Z";
+    if (n == 0) arrowNote = "no point of this plane could be evaluated";
+    if (emax == 0 && n > 0)
+        s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"18\" text-anchor=\"middle\" fill=\"white\">no error on this "
+                         "plane: |e| = 0 everywhere</text>\n",
+                         left + pw / 2, top + ph / 2);
     if (cu >= 0 && cv >= 0 && emax > 0) {
+        s += "<g clip-path=\"url(#" + id + "-frame)\">\n";
         const long every = std::max<long>(1, (std::max(au.count, av.count) + 15) / 16);
         const double cell = std::min(au.step * sx, av.step * sy) * every;
         const double scale = 0.9 * cell / emax;  // px per mm of error
@@ -216,15 +255,16 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
                     s += fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"1\" fill=\"white\"/>\n", x0, y0);
                     continue;
                 }
-                s += fmt::format("<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"white\" stroke-width=\"1.6\" marker-end=\"url(#head)\"/>\n",
-                                 x0 - dx / 2, y0 - dy / 2, x0 + dx / 2, y0 + dy / 2);
+                s += fmt::format("<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"white\" stroke-width=\"1.6\" marker-end=\"url(#{}-head)\"/>\n",
+                                 x0 - dx / 2, y0 - dy / 2, x0 + dx / 2, y0 + dy / 2, id);
             }
+        s += "</g>\n";
         // A reference arrow with a round length under the plot.
         const double ref = niceStep(0, 0.5 * emax / kUm, 1);
         const double ry = top + ph + 66, rx = left + 270;
-        s += fmt::format("<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"black\" stroke-width=\"1.6\" marker-end=\"url(#head)\"/>"
-                         "<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"12\">= {:g} um</text>\n",
-                         rx, ry - 4, rx + ref * kUm * scale, ry - 4, rx + ref * kUm * scale + 8, ry, ref);
+        s += fmt::format("<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"black\" stroke-width=\"1.6\" marker-end=\"url(#{}-head)\"/>"
+                         "<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"12\">= {:g} µm</text>\n",
+                         rx, ry - 4, rx + ref * kUm * scale, ry - 4, id, rx + ref * kUm * scale + 8, ry, ref);
         arrowNote = fmt::format("arrows: in-plane error (e{}, e{}), scale:", plane.u == "X" ? "x" : plane.u == "Y" ? "y" : "z",
                                 plane.v == "X" ? "x" : plane.v == "Y" ? "y" : "z");
     }
@@ -240,21 +280,21 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
         s += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{2:.2f}\" y2=\"{1:.2f}\" stroke=\"black\"/>"
                          "<text x=\"{3:.2f}\" y=\"{4:.2f}\" font-size=\"12\" text-anchor=\"end\">{5:g}</text>\n",
                          left - 6, Y(v), left, left - 9, Y(v) + 4, std::abs(v) < 1e-9 * tv ? 0.0 : v);
-    s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"14\" text-anchor=\"middle\">{} ({})</text>\n", left + pw / 2,
-                     top + ph + 44, plane.u, unitOf(m, map, plane.u));
-    s += fmt::format("<text x=\"{0:.2f}\" y=\"{1:.2f}\" font-size=\"14\" text-anchor=\"middle\" transform=\"rotate(-90 {0:.2f} {1:.2f})\">{2} ({3})</text>\n",
-                     left - 56, top + ph / 2, plane.v, unitOf(m, map, plane.v));
+    s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"14\" text-anchor=\"middle\">{}</text>\n", left + pw / 2,
+                     top + ph + 44, escape(axisLabel(m, map, plane.u)));
+    s += fmt::format("<text x=\"{0:.2f}\" y=\"{1:.2f}\" font-size=\"14\" text-anchor=\"middle\" transform=\"rotate(-90 {0:.2f} {1:.2f})\">{2}</text>\n",
+                     left - 56, top + ph / 2, escape(axisLabel(m, map, plane.v)));
     s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"12\">{}</text>\n", left, top + ph + 66, escape(arrowNote));
     // Colour bar.
     const double bx = left + pw + 40, bh = std::min(ph, 400.0);
-    s += fmt::format("<rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"22\" height=\"{:.2f}\" fill=\"url(#bar)\" stroke=\"black\"/>\n", bx, top, bh);
+    s += fmt::format("<rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"22\" height=\"{:.2f}\" fill=\"url(#{}-bar)\" stroke=\"black\"/>\n", bx, top, bh, id);
     for (double c = clo; c <= ctop + 1e-9 * std::abs(ctop); c += cstep) {
         const double y = top + bh - (c - clo) / (ctop - clo) * bh;
         s += fmt::format("<line x1=\"{0:.2f}\" y1=\"{1:.2f}\" x2=\"{2:.2f}\" y2=\"{1:.2f}\" stroke=\"black\"/>"
                          "<text x=\"{3:.2f}\" y=\"{4:.2f}\" font-size=\"12\">{5:g}</text>\n",
                          bx + 22, y, bx + 28, bx + 31, y + 4, c);
     }
-    s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"13\">|e| (um)</text>\n", bx - 4, top - 10);
+    s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"13\">|e| (µm)</text>\n", bx - 4, top - 10);
     s += "</svg>\n";
     return s;
 }

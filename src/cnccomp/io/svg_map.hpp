@@ -1,6 +1,8 @@
 #pragma once
 // SVG picture of a volumetric map: colour map of |tip error| on one plane of the grid, with arrows showing the
-// in-plane error components, axes with ticks and units, a colour bar and a title.
+// in-plane error components (clipped to the plot frame), axes labelled with what the coordinates are (machine axis
+// commands, or tool-tip position in the workpiece frame) and their units, a colour bar in µm starting at 0 (its top
+// can be shared between maps shown side by side) and a title. A plane without error says so.
 #include <string>
 #include <string_view>
 #include <utility>
@@ -20,7 +22,16 @@ MapPlane parseMapPlane(std::string_view text);
 
 struct SvgInfo {
     std::string title;     ///< e.g. machine and deviation set
+    /// Top of the colour scale in µm (the scale always starts at 0); 0 = the plane's own largest |e|. Give maps shown
+    /// side by side (before / after compensation) the same value so that one colour is one error everywhere.
+    double scaleMaxUm = 0;
+    /// Prefix of the ids inside the picture (marker, gradient, clip path), so that several pictures can share one
+    /// HTML page.
+    std::string idPrefix = "map";
 };
+
+/// Largest |tip error| on the plane, mm (throws like renderMapSvg).
+double planeMaxError(const VolumetricMap& map, const MapPlane& plane);
 
 /// Renders the plane (throws InputError("--plane") when the plane axes are not varying grid axes or a cut value
 /// is not on the grid).

@@ -4,29 +4,45 @@
 
 #include <fmt/format.h>
 
-#include "cnccomp/error.hpp"
-#include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
+#include "cnccomp/io/trace_import.hpp"
 
 namespace cnccomp {
 
-BallbarTrace readTraceCsv(const std::string& path) {
-    const CsvTable t = readCsv(path);
-    const int ca = t.requireColumn("angle_deg"), cl = t.requireColumn("dL_um");
-    BallbarTrace tr;
-    for (const CsvRow& r : t.rows) {
-        tr.angleDeg.push_back(t.requireNumber(r, ca));
-        tr.dL.push_back(t.requireNumber(r, cl) * kUm);
+namespace {
+/// Metadata values stay on their line.
+std::string oneLine(std::string s) {
+    for (char& c : s)
+        if (c == '\n' || c == '\r') c = ' ';
+    return s;
+}
+}  // namespace
+
+BallbarTrace readTraceCsv(const std::string& path) { return importTrace(path).trace; }
+
+std::string formatTraceCsv(const BallbarTrace& trace, const BallbarRun* run, const std::string& machine) {
+    std::string o;
+    if (run) {
+        o += "# cnccomp ball-bar trace (angle in deg, dL = L - LB in um; lengths in mm)\n";
+        o += fmt::format("# run: {}\n# test: {}\n", oneLine(run->name), testName(run->test));
+        if (!machine.empty()) o += fmt::format("# machine: {}\n", oneLine(machine));
+        o += fmt::format("# LB: {:g}\n# RB: {:g}\n# RC: {:g}\n# ZC: {:g}\n# start: {:g}\n# end: {:g}\n# step: {:g}\n", run->LB,
+                         run->RB, run->RC, run->ZC, run->startDeg, run->endDeg, run->stepDeg);
+        if (run->capture.feed > 0) o += fmt::format("# feed: {:g}\n", run->capture.feed);
     }
-    if (tr.dL.size() < 3) throw InputError(path, 0, "a trace needs at least three samples");
-    return tr;
+    o += "angle_deg,dL_um\n";
+    for (size_t i = 0; i < trace.dL.size(); ++i) o += fmt::format("{:.6f},{:.6f}\n", trace.angleDeg[i], trace.dL[i] / kUm);
+    return o;
 }
 
 void writeTraceCsv(const std::string& path, const BallbarTrace& trace) {
-    writeFileAtomically(path, [&](std::ostream& o) {
-        o << "angle_deg,dL_um\n";
-        for (size_t i = 0; i < trace.dL.size(); ++i) o << fmt::format("{:.6f},{:.6f}\n", trace.angleDeg[i], trace.dL[i] / kUm);
-    });
+    const std::string text = formatTraceCsv(trace);
+    writeFileAtomically(path, [&](std::ostream& o) { o << text; });
+}
+
+void writeTraceCsv(const std::string& path, const BallbarTrace& trace, const BallbarRun& run, const std::string& machine) {
+    const std::string text = formatTraceCsv(trace, &run, machine);
+    writeFileAtomically(path, [&](std::ostream& o) { o << text; });
 }
 
 }  // namespace cnccomp
@@ -34,7 +50,7 @@ void writeTraceCsv(const std::string& path, const BallbarTrace& trace) {
 namespace cnccomp {
 std::vector<BallbarTrace> readRunTraces(const std::string& dir, const std::vector<BallbarRun>& runs) {
     std::vector<BallbarTrace> out;
-    for (const BallbarRun& r : runs) out.push_back(readTraceCsv(dir + "/" + r.name + ".csv"));
+    for (MeasuredTrace& m : importRunTraces(dir, runs)) out.push_back(std::move(m.trace));
     return out;
 }
 }  // namespace cnccomp

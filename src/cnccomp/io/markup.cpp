@@ -1,0 +1,32 @@
+#include "cnccomp/io/markup.hpp"
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+
+namespace cnccomp {
+
+std::string escapeXml(std::string_view text, std::string_view what) {
+    std::string o;
+    o.reserve(text.size());
+    for (const char c : text) {
+        switch (c) {
+            case '&': o += "&amp;"; break;
+            case '<': o += "&lt;"; break;
+            case '>': o += "&gt;"; break;
+            case '"': o += "&quot;"; break;
+            case '\'': o += "&apos;"; break;
+            case '\t': o += "&#9;"; break;
+            case '\n': o += "&#10;"; break;
+            case '\r': o += "&#13;"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20)
+                    throw ModelError(fmt::format("{} '{}' contains control character {:#04x}, which XML cannot hold", what,
+                                                 text, static_cast<unsigned>(static_cast<unsigned char>(c))));
+                o += c;
+        }
+    }
+    return o;
+}
+
+}  // namespace cnccomp

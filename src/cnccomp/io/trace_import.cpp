@@ -1,0 +1,474 @@
+#include "cnccomp/io/trace_import.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/output_set.hpp"
+#include "cnccomp/io/text_util.hpp"
+
+namespace cnccomp {
+namespace {
+
+struct Metadata {
+    std::string key, value;
+    int line = 0;
+};
+
+struct Row {
+    int line = 0;
+    double x = 0;                 ///< angle (deg) or time (s)
+    std::optional<double> dL;     ///< mm; empty = missing sample
+    std::string pass;             ///< pass label ("" without a pass column)
+};
+
+struct Table {
+    std::vector<Metadata> metadata;
+    std::vector<std::string> header;
+    int headerLine = 0;
+    char separator = ',';
+    std::vector<std::pair<int, std::vector<std::string>>> rows;  ///< line, cells
+};
+
+std::string lower(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::vector<std::string> splitCells(std::string_view line, char sep) {
+    std::vector<std::string> out;
+    size_t start = 0;
+    while (true) {
+        const size_t at = line.find(sep, start);
+        std::string cell(trim(line.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start)));
+        if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') cell = std::string(trim(cell.substr(1, cell.size() - 2)));
+        out.push_back(std::move(cell));
+        if (at == std::string_view::npos) break;
+        start = at + 1;
+    }
+    return out;
+}
+
+Table readTable(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "cannot open file");
+    std::ostringstream buf;
+    buf << in.rdbuf();
+    std::string text = buf.str();
+    if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
+        throw InputError(path, 1, "UTF-16 text; export the trace as UTF-8 (or ASCII) CSV");
+    if (text.rfind("\xef\xbb\xbf", 0) == 0) text.erase(0, 3);  // UTF-8 byte-order mark
+    Table t;
+    std::istringstream lines(text);
+    std::string line;
+    int n = 0;
+    bool haveHeader = false;
+    while (std::getline(lines, line)) {
+        ++n;
+        if (line.find('\0') != std::string::npos) throw InputError(path, n, "binary data where CSV text was expected");
+        const std::string_view s = trim(line);
+        if (s.empty()) continue;
+        if (s.front() == '#') {
+            const std::string_view body = trim(s.substr(1));
+            const size_t colon = body.find(':');
+            if (colon != std::string_view::npos && colon > 0)
+                t.metadata.push_back({std::string(trim(body.substr(0, colon))), std::string(trim(body.substr(colon + 1))), n});
+            continue;
+        }
+        if (!haveHeader) {
+            t.separator = s.find(';') != std::string_view::npos ? ';' : s.find('\t') != std::string_view::npos ? '\t' : ',';
+            t.header = splitCells(s, t.separator);
+            t.headerLine = n;
+            haveHeader = true;
+            continue;
+        }
+        auto cells = splitCells(s, t.separator);
+        if (cells.size() > t.header.size())
+            throw InputError(path, n, fmt::format("{} cells, but the header has {} columns (separator '{}')", cells.size(),
+                                                  t.header.size(), t.separator == '\t' ? "tab" : std::string(1, t.separator)));
+        t.rows.emplace_back(n, std::move(cells));
+    }
+    if (!haveHeader) throw InputError(path, n, "empty file; expected a CSV header line");
+    return t;
+}
+
+int findColumn(const Table& t, const std::string& name) {
+    for (size_t i = 0; i < t.header.size(); ++i)
+        if (t.header[i] == name) return static_cast<int>(i);
+    for (size_t i = 0; i < t.header.size(); ++i)
+        if (lower(t.header[i]) == lower(name)) return static_cast<int>(i);
+    return -1;
+}
+
+/// An empty cell is a missing sample; "nan" and other text are errors (a number was expected).
+bool isMissing(const std::string& cell) { return cell.empty(); }
+
+/// A number cell with the capture's decimal rules; InputError naming the column otherwise.
+double parseCell(const std::string& path, int line, const std::string& column, const std::string& cell, char sep,
+                 char decimal) {
+    std::string s = cell;
+    const bool comma = s.find(',') != std::string::npos;
+    if (comma) {
+        if (sep == ',' || decimal == '.' || s.find('.') != std::string::npos)
+            throw InputError(path, line, fmt::format("column '{}': '{}' is not a number (decimal {})", column, cell,
+                                                     decimal == '.' ? "point expected" : "comma and point mixed"));
+        std::replace(s.begin(), s.end(), ',', '.');
+    } else if (decimal == ',' && s.find('.') != std::string::npos) {
+        throw InputError(path, line, fmt::format("column '{}': '{}' has a decimal point; the plan says decimal comma",
+                                                 column, cell));
+    }
+    const auto v = parseNumber(s);
+    if (!v || !std::isfinite(*v))
+        throw InputError(path, line, fmt::format("column '{}': expected a finite number, found '{}'", column, cell));
+    return *v;
+}
+
+struct Pass {
+    int direction = +1;
+    std::vector<Row> rows;
+};
+
+bool near(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b)); }
+
+void checkMetadata(const std::string& path, const Table& t, const BallbarRun& run, const std::string& machine,
+                   TraceImportSummary& summary) {
+    for (const Metadata& m : t.metadata) {
+        const std::string key = lower(m.key);
+        const auto mismatch = [&](const std::string& planned) {
+            throw InputError(path, m.line, fmt::format("the file says {} '{}', but run '{}' of the plan has {}: this file "
+                                                       "belongs to another run or setup",
+                                                       m.key, m.value, run.name, planned));
+        };
+        const auto number = [&](double planned) {
+            const auto v = parseNumber(m.value);
+            if (!v) throw InputError(path, m.line, fmt::format("'{}: {}' is not a number", m.key, m.value));
+            if (!near(*v, planned)) mismatch(fmt::format("{:g}", planned));
+        };
+        if (key == "run") {
+            if (m.value != run.name) mismatch(fmt::format("the name '{}'", run.name));
+        } else if (key == "test") {
+            if (m.value != testName(run.test)) mismatch(std::string(testName(run.test)));
+        } else if (key == "machine") {
+            if (!machine.empty() && m.value != machine) mismatch(fmt::format("machine '{}'", machine));
+            if (machine.empty()) continue;
+        } else if (key == "lb") number(run.LB);
+        else if (key == "rb") number(run.RB);
+        else if (key == "rc") number(run.RC);
+        else if (key == "zc") number(run.ZC);
+        else if (key == "start") number(run.startDeg);
+        else if (key == "end") number(run.endDeg);
+        else if (key == "step") number(run.stepDeg);
+        else if (key == "feed") {
+            if (run.capture.feed == 0) continue;
+            number(run.capture.feed);
+        } else continue;
+        ++summary.metadataChecked;
+    }
+}
+
+/// Pass label → direction (+1/−1), or 0 for a pass number (resolved from the plan's order).
+int labelDirection(const std::string& label) {
+    const std::string l = lower(label);
+    if (l == "ccw" || l == "+" || l == "+1") return +1;
+    if (l == "cw" || l == "-" || l == "-1") return -1;
+    return 0;
+}
+
+/// ΔL and τ of a pass interpolated at `angle` (clamped to the pass's ends).
+void sampleAt(const std::vector<double>& angle, const std::vector<double>& value, const std::vector<double>& tau,
+              double at, double& v, double& t) {
+    size_t best = 0;
+    for (size_t i = 1; i < angle.size(); ++i)
+        if (std::abs(angle[i] - at) < std::abs(angle[best] - at)) best = i;
+    v = value[best];
+    t = tau[best];
+    for (size_t i = 0; i + 1 < angle.size(); ++i) {
+        const double a0 = angle[i], a1 = angle[i + 1];
+        if (a0 == a1 || (at - a0) * (at - a1) > 0) continue;
+        const double f = (at - a0) / (a1 - a0);
+        v = value[i] + f * (value[i + 1] - value[i]);
+        t = tau[i] + f * (tau[i + 1] - tau[i]);
+        return;
+    }
+}
+
+}  // namespace
+
+double linearPathRadius(const BallbarRun& r) {
+    switch (r.test) {  // seed 000 Table 2, the (X, Y, Z) circle of runCommands()
+        case BallbarTest::BRadial: return r.LB + r.RB;
+        case BallbarTest::BTangential: return std::hypot(r.RB, r.LB);
+        case BallbarTest::CRadial: return std::abs(r.RC - r.LB);
+        case BallbarTest::CTangential: return std::hypot(r.RC, r.LB);
+        case BallbarTest::BAxial:
+        case BallbarTest::BX:
+        case BallbarTest::BY:
+        case BallbarTest::BZ: return r.RB;
+        case BallbarTest::CAxial:
+        case BallbarTest::CX:
+        case BallbarTest::CY:
+        case BallbarTest::CZ: return r.RC;
+    }
+    return 0.0;
+}
+
+namespace {
+
+MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const RunCapture& cap, const std::string& machine) {
+    const Table t = readTable(path);
+    MeasuredTrace out;
+    out.path = path;
+    TraceImportSummary& sum = out.summary;
+    if (run) checkMetadata(path, t, *run, machine, sum);
+
+    const int cL = findColumn(t, cap.lengthColumn);
+    if (cL < 0)
+        throw InputError(path, t.headerLine, fmt::format("missing column '{}' (ΔL) in the header", cap.lengthColumn));
+    int cX = findColumn(t, cap.angleColumn);
+    const bool timeSampled = cX < 0;
+    if (timeSampled) cX = findColumn(t, cap.timeColumn);
+    if (cX < 0)
+        throw InputError(path, t.headerLine, fmt::format("missing column '{}' (angle) or '{}' (time) in the header",
+                                                         cap.angleColumn, cap.timeColumn));
+    const int cP = findColumn(t, cap.passColumn);
+    sum.layout = timeSampled ? "time" : "angle";
+    const double xUnit = timeSampled ? cap.timeUnit : cap.angleUnit;
+
+    // Rows → passes.
+    std::vector<Row> rows;
+    for (const auto& [line, cells] : t.rows) {
+        ++sum.rows;
+        const auto cell = [&](int c) -> const std::string& {
+            static const std::string empty;
+            return c < static_cast<int>(cells.size()) ? cells[c] : empty;
+        };
+        if (isMissing(cell(cX)) || isMissing(cell(cL))) {
+            ++sum.missing;
+            continue;
+        }
+        Row r;
+        r.line = line;
+        r.x = parseCell(path, line, t.header[cX], cell(cX), t.separator, cap.decimal) * xUnit;
+        r.dL = parseCell(path, line, t.header[cL], cell(cL), t.separator, cap.decimal) * cap.lengthUnit;
+        if (cP >= 0) {
+            r.pass = cell(cP);
+            if (r.pass.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", t.header[cP]));
+        }
+        rows.push_back(std::move(r));
+    }
+    if (rows.empty()) throw InputError(path, t.headerLine, "no samples: every row lacks a value");
+
+    const std::vector<int> planned = run && !run->capture.passes.empty() ? run->capture.passes
+                                     : std::vector<int>{run && run->stepDeg < 0 ? -1 : +1};
+    std::vector<Pass> passes;
+    if (cP >= 0) {
+        std::vector<std::string> seen;
+        for (const Row& r : rows) {
+            if (passes.empty() || r.pass != seen.back()) {
+                if (std::find(seen.begin(), seen.end(), r.pass) != seen.end())
+                    throw InputError(path, r.line, fmt::format("pass '{}' starts again after another pass; the rows of a "
+                                                               "pass must follow each other", r.pass));
+                seen.push_back(r.pass);
+                Pass p;
+                const int d = labelDirection(r.pass);
+                if (d != 0) {
+                    p.direction = d;
+                } else {
+                    const auto k = parseNumber(r.pass);
+                    if (!k || *k != std::floor(*k) || *k < 1 || *k > static_cast<double>(planned.size()))
+                        throw InputError(path, r.line,
+                                         fmt::format("pass '{}': expected ccw, cw, +, - or a pass number 1..{} (the "
+                                                     "plan's directions)", r.pass, planned.size()));
+                    p.direction = planned[static_cast<size_t>(*k) - 1];
+                }
+                passes.push_back(std::move(p));
+            }
+            passes.back().rows.push_back(r);
+        }
+    } else if (timeSampled) {
+        for (const Row& r : rows) {
+            if (passes.empty() || r.x < passes.back().rows.back().x) passes.emplace_back();
+            passes.back().rows.push_back(r);
+        }
+        for (size_t i = 0; i < passes.size() && i < planned.size(); ++i) passes[i].direction = planned[i];
+    } else {
+        // Angle-sampled without a pass column: unwrap, then split where the angle turns back (the extreme angle).
+        for (size_t i = 1; i < rows.size(); ++i) {
+            const double d = rows[i].x - rows[i - 1].x;
+            if (std::abs(d) > 180.0) rows[i].x -= 360.0 * std::round(d / 360.0);
+        }
+        if (planned.size() == 2) {
+            const auto cmp = [](const Row& a, const Row& b) { return a.x < b.x; };
+            const auto turn = planned[0] > 0 ? std::max_element(rows.begin(), rows.end(), cmp)
+                                             : std::min_element(rows.begin(), rows.end(), cmp);
+            passes.resize(2);
+            passes[0].rows.assign(rows.begin(), turn + 1);
+            passes[1].rows.assign(turn + 1, rows.end());
+            if (passes[1].rows.empty()) passes.pop_back();
+        } else {
+            passes.resize(1);
+            passes[0].rows = rows;
+        }
+        for (size_t i = 0; i < passes.size(); ++i) passes[i].direction = planned[std::min(i, planned.size() - 1)];
+    }
+    if (run && passes.size() != planned.size())
+        throw InputError(path, passes.size() > planned.size() ? passes[planned.size()].rows.front().line : t.headerLine,
+                         fmt::format("the file has {} pass(es), but run '{}' of the plan records {} ({})", passes.size(),
+                                     run->name, planned.size(), planned.size() == 2 ? "a CCW and a CW pass" : "one pass"));
+    for (size_t i = 0; i < passes.size() && run; ++i)
+        if (passes[i].direction != planned[i])
+            throw InputError(path, passes[i].rows.front().line,
+                             fmt::format("pass {} is {}, but the plan's run '{}' records {} first", i + 1,
+                                         passes[i].direction > 0 ? "CCW" : "CW", run->name,
+                                         planned[0] > 0 ? "CCW" : "CW"));
+
+    const double lo = run ? std::min(run->startDeg, run->endDeg) : -HUGE_VAL;
+    const double hi = run ? std::max(run->startDeg, run->endDeg) : HUGE_VAL;
+
+    // Time → angle.
+    std::vector<std::vector<double>> tau(passes.size());  // time (s) or row order, for the drift
+    for (size_t p = 0; p < passes.size(); ++p) {
+        Pass& ps = passes[p];
+        for (const Row& r : ps.rows) tau[p].push_back(timeSampled ? r.x : static_cast<double>(r.line));
+        if (!timeSampled) continue;
+        if (!run) throw InputError(path, t.headerLine, "a time-sampled file needs its run (feed, radius, start angle)");
+        if (!(run->capture.feed > 0))
+            throw InputError(path, t.headerLine,
+                             fmt::format("time-sampled file: run '{}' of the plan needs feed=\"F\" (mm/min) to turn time "
+                                         "into angle", run->name));
+        const double radius = run->capture.feedRadius > 0 ? run->capture.feedRadius : linearPathRadius(*run);
+        if (!(radius > 0))
+            throw InputError(path, t.headerLine, fmt::format("run '{}': the feed radius is 0; give feed-radius in the plan", run->name));
+        const double omegaDeg = run->capture.feed / 60.0 / radius * 180.0 / M_PI;  // deg/s
+        const double a0 = (ps.direction > 0 ? lo : hi) - ps.direction * run->capture.overshootDeg;
+        const double t0 = ps.rows.front().x;
+        for (Row& r : ps.rows) r.x = a0 + ps.direction * omegaDeg * (r.x - t0);
+    }
+
+    // Linear drift in time, from two samples at the same angle.
+    if (run && run->capture.removeDrift) {
+        const bool fullTurn = hi - lo >= 360.0 - 1e-9;
+        std::vector<std::vector<double>> ang(passes.size()), val(passes.size());
+        for (size_t p = 0; p < passes.size(); ++p)
+            for (const Row& r : passes[p].rows) ang[p].push_back(r.x), val[p].push_back(*r.dL);
+        double v1 = 0, t1 = 0, v2 = 0, t2 = 0;
+        if (passes.size() == 2) {
+            // Both ends of the sweep are seen by both passes: at the first pass's start long apart, at its end just
+            // apart. The difference of the two differences is drift alone (a constant CCW/CW hysteresis cancels).
+            const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
+            double v3 = 0, t3 = 0, v4 = 0, t4 = 0;
+            sampleAt(ang[0], val[0], tau[0], s, v1, t1);
+            sampleAt(ang[1], val[1], tau[1], s, v2, t2);
+            sampleAt(ang[0], val[0], tau[0], e, v3, t3);
+            sampleAt(ang[1], val[1], tau[1], e, v4, t4);
+            v2 -= v4 - v3;
+            t2 -= t4 - t3;
+        } else if (fullTurn) {
+            const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
+            sampleAt(ang[0], val[0], tau[0], s, v1, t1);
+            sampleAt(ang[0], val[0], tau[0], e, v2, t2);
+        } else {
+            throw InputError(path, t.headerLine, fmt::format("drift removal needs a full turn or a CCW and a CW pass; run "
+                                                             "'{}' sweeps {:g}° in one pass", run->name, hi - lo));
+        }
+        if (!(t2 > t1 + 1e-12))
+            throw InputError(path, t.headerLine, "drift removal: the samples at the sweep's ends are not apart in time");
+        const double rate = (v2 - v1) / (t2 - t1);
+        const double tFirst = tau[0].front();
+        double tLast = tFirst;
+        for (size_t p = 0; p < passes.size(); ++p)
+            for (size_t i = 0; i < passes[p].rows.size(); ++i) {
+                *passes[p].rows[i].dL -= rate * (tau[p][i] - tFirst);
+                tLast = std::max(tLast, tau[p][i]);
+            }
+        sum.driftRemoved = rate * (tLast - tFirst);
+    }
+
+    // Trim to the sweep and check each pass against the run.
+    const double eps = 1e-9 * std::max(1.0, std::max(std::abs(lo), std::abs(hi)));
+    const double step = run ? std::abs(run->stepDeg) : 0.0;
+    const double gapLimit = std::max(4.0 * step, 2.0);
+    for (size_t p = 0; p < passes.size(); ++p) {
+        Pass& ps = passes[p];
+        std::vector<Row> kept;
+        for (const Row& r : ps.rows) {
+            if (r.x < lo - eps || r.x > hi + eps) {
+                ++sum.trimmed;
+                continue;
+            }
+            kept.push_back(r);
+        }
+        const int d = ps.direction;
+        const std::string which = passes.size() > 1 ? fmt::format(" pass {} ({})", p + 1, d > 0 ? "CCW" : "CW") : "";
+        if (run) {
+            if (kept.empty())
+                throw InputError(path, ps.rows.front().line,
+                                 fmt::format("no sample of{} lies in run '{}''s sweep {:g}..{:g}°: is this the file of "
+                                             "another run?", which, run->name, run->startDeg, run->endDeg));
+            for (size_t i = 1; i < kept.size(); ++i) {
+                const double da = (kept[i].x - kept[i - 1].x) * d;
+                if (da < -1e-6)
+                    throw InputError(path, kept[i].line,
+                                     fmt::format("angle goes back from {:g} to {:g}°, but{} runs {}", kept[i - 1].x, kept[i].x,
+                                                 which.empty() ? " the run" : which, d > 0 ? "CCW (increasing)" : "CW (decreasing)"));
+                if (da > gapLimit + 1e-9)
+                    throw InputError(path, kept[i].line,
+                                     fmt::format("no samples between {:g} and {:g}°{}: at most {:g}° may be missing "
+                                                 "(4 steps of the plan)", kept[i - 1].x, kept[i].x, which, gapLimit));
+            }
+            const double first = d > 0 ? lo : hi, last = d > 0 ? hi : lo;
+            if ((kept.front().x - first) * d > gapLimit + 1e-9 || (last - kept.back().x) * d > gapLimit + 1e-9)
+                throw InputError(path, kept.front().line,
+                                 fmt::format("{}covers {:g}..{:g}°, but run '{}' sweeps {:g}..{:g}° (at most {:g}° may be "
+                                             "missing at either end): a partial trace or the file of another run",
+                                             which.empty() ? "the trace " : which.substr(1) + " ", kept.front().x,
+                                             kept.back().x, run->name, first, last, gapLimit));
+            const double expected = std::floor((hi - lo) / step + 1e-9) + 1;
+            if (static_cast<double>(kept.size()) < 0.75 * expected)
+                throw InputError(path, kept.back().line,
+                                 fmt::format("{}has {} samples in the sweep, but the plan's step of {:g}° gives {:g}: "
+                                             "too many are missing, or the file was recorded with another step",
+                                             which.empty() ? "the trace " : which.substr(1) + " ", kept.size(),
+                                             run->stepDeg, expected));
+        }
+        const size_t minimum = run ? 5 : 3;
+        if (kept.size() < minimum)
+            throw InputError(path, kept.empty() ? t.headerLine : kept.back().line,
+                             fmt::format("{} sample(s){}; at least {} are needed to fit the trace", kept.size(), which,
+                                         minimum));
+        DirectedTrace dt;
+        dt.direction = d;
+        for (const Row& r : kept) {
+            dt.trace.angleDeg.push_back(r.x);
+            dt.trace.dL.push_back(*r.dL);
+            out.trace.angleDeg.push_back(r.x);
+            out.trace.dL.push_back(*r.dL);
+        }
+        out.passes.push_back(std::move(dt));
+    }
+    return out;
+}
+
+}  // namespace
+
+MeasuredTrace importRunTrace(const std::string& path, const BallbarRun& run, const std::string& machine) {
+    return importImpl(path, &run, run.capture, machine);
+}
+
+std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::vector<BallbarRun>& runs,
+                                           const std::string& machine) {
+    std::vector<MeasuredTrace> out;
+    out.reserve(runs.size());
+    for (const BallbarRun& r : runs) out.push_back(importRunTrace(OutputSet::fileIn(dir, r.name + ".csv"), r, machine));
+    return out;
+}
+
+MeasuredTrace importTrace(const std::string& path) { return importImpl(path, nullptr, RunCapture{}, ""); }
+
+}  // namespace cnccomp

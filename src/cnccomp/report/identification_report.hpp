@@ -1,0 +1,43 @@
+#pragma once
+// The report of `cnccomp identify`: ReportData (report_data.hpp) filled from the measured runs and the
+// identification result. "After" everywhere means: the identified deviations compensated.
+//  - per ball-bar run: the passes as measured, and after = measured − (ΔL predicted with the identified deviations −
+//    ΔL predicted on the nominal machine), both with the run's mounting offsets; for a relative instrument both less
+//    the estimated length offset dL0; ISO 230-4 figures of both;
+//  - the deviations with 95 % intervals, the unidentified ones and the identifiable combinations;
+//  - a volumetric map of the identified machine, and per requested controller its coverage, the tool-tip error left
+//    when that controller compensates the identified deviations (its apply model, over workspace samples) and the
+//    map after it, all maps on one colour scale.
+#include <string>
+#include <vector>
+
+#include "cnccomp/identification/lsq.hpp"
+#include "cnccomp/identification/measured_observations.hpp"
+#include "cnccomp/report/report_data.hpp"
+
+namespace cnccomp::report {
+
+/// Ball-bar runs of a measured plan: before / after traces per pass, ISO 230-4 figures, fit RMS.
+/// `measured.observations` must be those the identification used (plan.runs first).
+std::vector<RunSection> measuredRunSections(const MachineModel& machine, const MeasurementPlan& plan,
+                                            const MeasuredRuns& measured, const IdentificationResult& result);
+
+/// The deviations of a report: every requested one, identified or not (display units um / arcsec).
+std::vector<DeviationRow> deviationRows(const IdentificationReport& report);
+
+struct MapOptions {
+    /// Grid as for `cnccomp map`; empty = X and Y over their travel (at most ±200 mm, 21 × 21 points), the other linear
+    /// axes at 0 (or the nearest end of their travel), the rotary axes at 0 unless the tool axis would be parallel to a
+    /// rotary axis there (then 30°, 45°, −30° or 60°: a TCP controller has no unique answer at such a pose).
+    std::string grid;
+    std::string plane = "XY";  ///< as `cnccomp map --plane`
+    double toolLength = 0;     ///< mm
+};
+
+/// Map of the identified machine ("before") and, per controller backend name, the coverage and the residual of that
+/// controller compensating the identified deviations (figures over workspaceSamples(machine, 5) less the poses whose
+/// tool axis is parallel to a rotary axis) with its "after" map.
+void addCompensationSections(ReportData& data, const MachineModel& machine, const DeviationSet& identified,
+                             const std::vector<std::string>& controllers, const MapOptions& options);
+
+}  // namespace cnccomp::report

@@ -1,0 +1,18 @@
+#pragma once
+// Small text helpers of the report: round scale steps, numbers with "–" for unknown values, JSON literals.
+#include <string>
+#include <string_view>
+
+namespace cnccomp::report {
+
+/// The smallest of 1, 2, 2.5, 5 × 10^k that is ≥ x (x > 0; 1 otherwise).
+double niceNumber(double x);
+/// `v` with `decimals` decimals; "–" when not finite.
+std::string fixed(double v, int decimals);
+/// JSON string literal (quotes, backslashes and control characters escaped; "</" written as "<\/" so that the text
+/// can sit inside an HTML <script> element).
+std::string jsonString(std::string_view s);
+/// JSON number with 9 significant digits, or null when not finite.
+std::string jsonNumber(double v);
+
+}  // namespace cnccomp::report

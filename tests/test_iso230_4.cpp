@@ -1,0 +1,136 @@
+// ISO 230-4 circular test figures (cnccomp/circular_test.hpp) on traces built from shapes whose G, F, mean radius
+// and H are known in closed form (the oracle is the construction, not our code), and the JSON summary of a report
+// carrying them (golden numbers).
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "cnccomp/circular_test.hpp"
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/report_json.hpp"
+#include "cnccomp/report/html_report.hpp"
+
+namespace cnccomp {
+namespace {
+
+constexpr double LB = 100.0;
+
+/// A path ρ(φ) = R + b·cos 2φ + h(φ) about the centre c, sampled at φ = k·step, seen by a ball bar whose centre ball
+/// is at the origin: ΔL = |p| − LB at angle atan2(p). G = 2b (+ hysteresis part), mean radius R, by construction.
+BallbarTrace shape(double R, double b, Eigen::Vector2d c, double stepDeg, int direction, double hysteresis = 0) {
+    BallbarTrace t;
+    const int n = static_cast<int>(std::lround(360.0 / stepDeg));
+    for (int i = 0; i < n; ++i) {
+        const int k = direction > 0 ? i : n - 1 - i;
+        const double phi = k * stepDeg * kDeg;
+        const double rho = R + b * std::cos(2 * phi) + hysteresis;
+        const Eigen::Vector2d p = c + rho * Eigen::Vector2d(std::cos(phi), std::sin(phi));
+        double a = std::atan2(p.y(), p.x()) / kDeg;
+        if (a < -1e-9) a += 360.0;
+        t.angleDeg.push_back(a);
+        t.dL.push_back(p.norm() - LB);
+    }
+    return t;
+}
+
+TEST(Iso230_4, CircularDeviationRadialDeviationAndMeanRadiusOfAKnownShape) {
+    const double R = LB + 3 * kUm, b = 4 * kUm;
+    const Eigen::Vector2d c(5 * kUm, -2 * kUm);
+    const BallbarTrace t = shape(R, b, c, 1.0, +1);
+    const CircularTestResult r = evaluateCircularTest(t, LB);
+    // The shape is point-symmetric about c, so the least-squares centre is c and the radius the mean of ρ.
+    EXPECT_NEAR(r.center.x(), c.x(), 1e-9);
+    EXPECT_NEAR(r.center.y(), c.y(), 1e-9);
+    EXPECT_NEAR(r.meanRadius, R, 1e-9);
+    EXPECT_NEAR(r.meanRadialError, 3 * kUm, 1e-9);
+    EXPECT_NEAR(r.circularity, 2 * b, 1e-9);  // G = max ρ − min ρ
+    // F about the nominal centre: |p| − LB, largest and smallest over the samples (to first order R−LB ± (b + |c|)).
+    double hi = -1, lo = 1;
+    for (int k = 0; k < 360; ++k) {
+        const double phi = k * kDeg;
+        const double v = (c + (R + b * std::cos(2 * phi)) * Eigen::Vector2d(std::cos(phi), std::sin(phi))).norm() - LB;
+        hi = std::max(hi, v);
+        lo = std::min(lo, v);
+    }
+    EXPECT_NEAR(r.radialMax, hi, 1e-12);
+    EXPECT_NEAR(r.radialMin, lo, 1e-12);
+    EXPECT_GT(r.radialMax, 3 * kUm + 4 * kUm);  // the eccentricity adds to F, not to G
+}
+
+TEST(Iso230_4, HysteresisIsTheLargestRadialGapBetweenCcwAndCw) {
+    const double R = LB, b = 2 * kUm;
+    const Eigen::Vector2d c(1 * kUm, 1 * kUm);
+    // The CW path lies 1.5 µm outside the CCW path everywhere.
+    const BallbarTrace ccw = shape(R, b, c, 1.0, +1), cw = shape(R, b, c, 1.0, -1, 1.5 * kUm);
+    const CircularRunResult run = evaluateCircularRun({{+1, ccw}, {-1, cw}}, LB);
+    ASSERT_EQ(run.passes.size(), 2u);
+    EXPECT_NEAR(run.hysteresis, 1.5 * kUm, 2e-4 * kUm);  // the centre shift makes it first order exact
+    EXPECT_GT(run.hysteresisSamples, 700);
+    EXPECT_NEAR(run.circularDeviation, 2 * b, 1e-9);
+    EXPECT_NEAR(run.meanRadius, R + 0.75 * kUm, 1e-9);
+    // One direction only: no hysteresis.
+    EXPECT_TRUE(std::isnan(evaluateCircularRun({{+1, ccw}}, LB).hysteresis));
+    // A gap that varies: ρ_cw − ρ_ccw = 2 µm · |sin φ| peaks at 90° and 270°.
+    BallbarTrace cw2 = ccw;
+    for (size_t i = 0; i < cw2.dL.size(); ++i) cw2.dL[i] += 2 * kUm * std::abs(std::sin(cw2.angleDeg[i] * kDeg));
+    EXPECT_NEAR(circularHysteresis(ccw, cw2), 2 * kUm, 1e-4 * kUm);
+    EXPECT_THROW(evaluateCircularRun({}, LB), ModelError);
+    EXPECT_THROW(evaluateCircularRun({{0, ccw}}, LB), ModelError);
+}
+
+TEST(Iso230_4, PartialArcsOverlapOnlyWhereBothPassesRun) {
+    BallbarTrace a, b;
+    for (int k = 0; k <= 90; ++k) a.angleDeg.push_back(k), a.dL.push_back(0.0);
+    for (int k = 60; k <= 180; ++k) b.angleDeg.push_back(k), b.dL.push_back(k <= 90 ? 1e-3 : 1.0);
+    int n = 0;
+    EXPECT_NEAR(circularHysteresis(a, b, &n), 1e-3, 1e-12);  // only 60..90° compared
+    EXPECT_EQ(n, 31 + 31);
+    BallbarTrace far;
+    far.angleDeg = {200, 210};
+    far.dL = {0, 0};
+    EXPECT_TRUE(std::isnan(circularHysteresis(a, far, &n)));
+    EXPECT_EQ(n, 0);
+}
+
+TEST(Iso230_4, JsonSummaryCarriesTheFiguresGolden) {
+    const double R = LB + 3 * kUm, b = 4 * kUm;
+    const Eigen::Vector2d c(5 * kUm, -2 * kUm);
+    const BallbarTrace ccw = shape(R, b, c, 1.0, +1), cw = shape(R, b, c, 1.0, -1, 1.5 * kUm);
+    report::ReportData d;
+    d.title = "golden";
+    d.machine = "m";
+    report::RunSection r;
+    r.name = "C-X";
+    r.test = "C-X";
+    r.LB = LB;
+    r.passes.push_back({+1, ccw.angleDeg, ccw.dL, {}});
+    r.passes.push_back({-1, cw.angleDeg, cw.dL, {}});
+    r.before = report::isoFigures(evaluateCircularRun({{+1, ccw}, {-1, cw}}, LB));
+    d.runs.push_back(r);
+    d.deviations.push_back({"EB0B", "bXB", "arcsec", true, 9.1234, 8.5, 9.75, 9.0});
+    d.deviations.push_back({"EC0Y", "gXY", "arcsec", false});
+    const report::ReportFiles files = report::reportFiles("out/r.html", d);
+    const JsonValue j = parseJson(report::formatReportSummaryJson(d, files), "summary");
+    EXPECT_EQ(j["schema"].string, "cnccomp-report-summary/1");
+    const JsonValue& run = j["runs"][0];
+    EXPECT_EQ(run["name"].string, "C-X");
+    EXPECT_EQ(run["samples"].num(), 720);
+    EXPECT_EQ(run["passes"][1].string, "cw");
+    EXPECT_NEAR(run["before"]["G_um"].num(), 8.0, 1e-6);          // 2b
+    EXPECT_NEAR(run["before"]["H_um"].num(), 1.5, 2e-4);          // the CW offset
+    EXPECT_NEAR(run["before"]["mean_radius_mm"].num(), 100.00375, 1e-8);  // R + 0.75 µm
+    EXPECT_EQ(run["after"]["G_um"].type, JsonValue::Type::Null);  // no after traces
+    EXPECT_EQ(run["plot"].string, "r-polar-C-X.svg");
+    EXPECT_NEAR(j["deviations"][0]["value"].num(), 9.1234, 1e-12);
+    EXPECT_NEAR(j["deviations"][0]["low95"].num(), 8.5, 1e-12);
+    EXPECT_NEAR(j["deviations"][0]["truth"].num(), 9.0, 1e-12);
+    EXPECT_FALSE(j["deviations"][1]["identified"].boolean);
+    EXPECT_EQ(j["deviations"][1]["value"].type, JsonValue::Type::Null);
+    ASSERT_EQ(j["unidentified"].array.size(), 1u);
+    EXPECT_EQ(j["unidentified"][0].string, "EC0Y");
+}
+
+}  // namespace
+}  // namespace cnccomp

@@ -1,0 +1,371 @@
+// The HTML report: `identify --report r.html` end to end, the page's content (self-contained, escaped, every plot also
+// as its own SVG, the numbers in the JSON summary), the map pictures (scale from 0 shared, arrows clipped, µm, labelled
+// coordinates, the all-zero message), and the page in a real browser: headless Chromium loads it without console
+// errors, and screenshots show the traces in their colours where the plot puts them (pixels read back from the PNG).
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <dlfcn.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/report_json.hpp"
+#include "cnccomp/io/svg_map.hpp"
+#include "cnccomp/map_grid.hpp"
+#include "cnccomp/report/html_report.hpp"
+#include "cnccomp/error.hpp"
+#include "cnccomp/report/polar_plot.hpp"
+#include "cnccomp/report/report_format.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp {
+namespace {
+namespace fs = std::filesystem;
+
+const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");
+const std::string kPlan = test::sourcePath("samples/plans/multitasking-six-circles.xml");
+const std::string kTruth = test::sourcePath("samples/deviations/multitasking-truth.csv");
+
+// ---- headless Chromium and PNG pixels ---------------------------------------------------------------------------
+
+const char* chromium() {
+    for (const char* p : {"/usr/bin/chromium", "/usr/bin/chromium-browser"})
+        if (fs::exists(p)) return p;
+    return nullptr;
+}
+
+/// Loads `file` in headless Chromium, takes a screenshot of w × h px; returns Chromium's log (console messages are
+/// logged as "CONSOLE" lines).
+std::string screenshot(const std::string& file, const std::string& png, int w, int h, const test::ScratchDir& dir) {
+    const std::string profile = dir.file("chromium-profile-" + std::to_string(w) + "x" + std::to_string(h));
+    fs::create_directories(profile);
+    const std::string log = dir.file("chromium.log");
+    const std::string cmd = fmt::format(
+        "timeout 180 {} --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking "
+        "--disable-component-update --disable-sync --hide-scrollbars --force-device-scale-factor=1 --user-data-dir='{}' "
+        "--enable-logging=stderr --v=0 --window-size={},{} --screenshot='{}' 'file://{}' >'{}' 2>&1",
+        chromium(), profile, w, h, png, fs::absolute(file).string(), log);
+    const int rc = std::system(cmd.c_str());
+    EXPECT_EQ(rc, 0) << cmd << "\n" << test::readText(log);
+    return test::readText(log);
+}
+
+/// An RGB(A) picture decoded from a PNG (8-bit, colour type 2 or 6, no interlace), inflated with the system zlib.
+struct Picture {
+    int w = 0, h = 0, channels = 0;
+    std::vector<unsigned char> px;
+    std::array<int, 3> at(int x, int y) const {
+        const size_t i = (static_cast<size_t>(y) * w + x) * channels;
+        return {px[i], px[i + 1], px[i + 2]};
+    }
+};
+
+std::optional<Picture> readPng(const std::string& path, std::string& why) {
+    using Uncompress = int (*)(unsigned char*, unsigned long*, const unsigned char*, unsigned long);
+    static void* z = dlopen("libz.so.1", RTLD_NOW);
+    if (!z) return why = "libz.so.1 not found", std::nullopt;
+    const auto uncompress = reinterpret_cast<Uncompress>(dlsym(z, "uncompress"));
+    const std::string s = test::readText(path);
+    if (s.size() < 8 || s.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0) return why = "not a PNG", std::nullopt;
+    const auto be32 = [&](size_t i) {
+        return (static_cast<unsigned>(static_cast<unsigned char>(s[i])) << 24) | (static_cast<unsigned char>(s[i + 1]) << 16) |
+               (static_cast<unsigned char>(s[i + 2]) << 8) | static_cast<unsigned char>(s[i + 3]);
+    };
+    Picture p;
+    std::string idat;
+    for (size_t i = 8; i + 8 <= s.size();) {
+        const unsigned len = be32(i);
+        const std::string type = s.substr(i + 4, 4);
+        if (type == "IHDR") {
+            p.w = static_cast<int>(be32(i + 8));
+            p.h = static_cast<int>(be32(i + 12));
+            const int depth = static_cast<unsigned char>(s[i + 16]), colour = static_cast<unsigned char>(s[i + 17]);
+            if (depth != 8 || (colour != 2 && colour != 6) || s[i + 20] != 0) return why = "unsupported PNG format", std::nullopt;
+            p.channels = colour == 6 ? 4 : 3;
+        } else if (type == "IDAT") {
+            idat += s.substr(i + 8, len);
+        }
+        i += 12 + len;
+    }
+    const size_t stride = static_cast<size_t>(p.w) * p.channels;
+    std::vector<unsigned char> raw((stride + 1) * p.h);
+    unsigned long n = raw.size();
+    if (uncompress(raw.data(), &n, reinterpret_cast<const unsigned char*>(idat.data()), idat.size()) != 0 || n != raw.size())
+        return why = "inflate failed", std::nullopt;
+    p.px.assign(stride * p.h, 0);
+    for (int y = 0; y < p.h; ++y) {  // PNG filters (RFC 2083 section 6)
+        const unsigned char f = raw[y * (stride + 1)];
+        const unsigned char* in = &raw[y * (stride + 1) + 1];
+        unsigned char* out = &p.px[y * stride];
+        const unsigned char* up = y > 0 ? &p.px[(y - 1) * stride] : nullptr;
+        for (size_t x = 0; x < stride; ++x) {
+            const int a = x >= static_cast<size_t>(p.channels) ? out[x - p.channels] : 0, b = up ? up[x] : 0,
+                      c = up && x >= static_cast<size_t>(p.channels) ? up[x - p.channels] : 0;
+            int v = in[x];
+            if (f == 1) v += a;
+            else if (f == 2) v += b;
+            else if (f == 3) v += (a + b) / 2;
+            else if (f == 4) {
+                const int pa = std::abs(b - c), pb = std::abs(a - c), pc = std::abs(a + b - 2 * c);
+                v += pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+            }
+            out[x] = static_cast<unsigned char>(v & 0xff);
+        }
+    }
+    return p;
+}
+
+std::array<int, 3> rgb(const char* hex) {
+    const unsigned v = static_cast<unsigned>(std::stoul(hex + 1, nullptr, 16));
+    return {static_cast<int>(v >> 16), static_cast<int>((v >> 8) & 0xff), static_cast<int>(v & 0xff)};
+}
+
+bool near(std::array<int, 3> a, std::array<int, 3> b, int tol = 40) {
+    return std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]) <= tol;
+}
+
+/// Is there a pixel of `colour` within `r` px of (x, y)?
+bool colourNear(const Picture& p, double x, double y, const char* colour, int r = 3) {
+    for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx) {
+            const int xx = static_cast<int>(std::lround(x)) + dx, yy = static_cast<int>(std::lround(y)) + dy;
+            if (xx >= 0 && yy >= 0 && xx < p.w && yy < p.h && near(p.at(xx, yy), rgb(colour))) return true;
+        }
+    return false;
+}
+
+long countColour(const Picture& p, const char* colour) {
+    long n = 0;
+    for (int y = 0; y < p.h; ++y)
+        for (int x = 0; x < p.w; ++x) n += near(p.at(x, y), rgb(colour), 24) ? 1 : 0;
+    return n;
+}
+
+// ---- a run built by hand, for the plot tests ---------------------------------------------------------------------
+
+report::RunSection sampleRun() {
+    report::RunSection r;
+    r.name = "C-X";
+    r.test = "C-X";
+    r.LB = 100;
+    report::PolarPass ccw, cw;
+    ccw.direction = +1;
+    cw.direction = -1;
+    for (int k = 0; k < 360; ++k) {
+        const double a = k * kDeg;
+        // An ellipse of ±8 µm (squareness) and 3 µm more on the CW pass; after compensation ±0.5 µm.
+        ccw.angleDeg.push_back(k);
+        ccw.before.push_back(8 * kUm * std::cos(2 * a));
+        ccw.after.push_back(0.5 * kUm * std::sin(3 * a));
+        cw.angleDeg.push_back(359 - k);
+        cw.before.push_back(8 * kUm * std::cos(2 * (359 - k) * kDeg) + 3 * kUm);
+        cw.after.push_back(0.5 * kUm * std::sin(3 * (359 - k) * kDeg) + 1.0 * kUm);
+    }
+    r.passes = {ccw, cw};
+    return r;
+}
+
+TEST(ReportPolarPlot, TracesSitWhereTheScaleSaysInABrowserScreenshot) {
+    const report::RunSection run = sampleRun();
+    const report::PolarScale sc = report::polarScale(run);
+    EXPECT_EQ(sc.ringUm, 5.0);  // 11 µm full scale → 5 µm rings (3 of them)
+    EXPECT_EQ(sc.rings, 3);
+    const std::string svg = report::renderPolarPlot(run, "p");
+    EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+    for (const char* c : {report::kCcwBefore, report::kCwBefore, report::kCcwAfter, report::kCwAfter})
+        EXPECT_NE(svg.find(c), std::string::npos) << c;
+    EXPECT_NE(svg.find("5 µm per ring"), std::string::npos);
+    if (!chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
+    test::ScratchDir dir("polar-browser");
+    test::writeText(dir.file("p.svg"), svg);
+    const std::string log = screenshot(dir.file("p.svg"), dir.file("p.png"), static_cast<int>(report::kPolarWidth),
+                                       static_cast<int>(report::kPolarHeight), dir);
+    EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
+    std::string why;
+    const auto pic = readPng(dir.file("p.png"), why);
+    if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
+    // At 0°: CCW before at +8 µm, CW before at +11 µm, both outside the nominal circle on the right; at 90° the CCW
+    // trace is 8 µm inside. The after traces stay within 1.5 µm of the nominal circle.
+    const auto at = [&](double deg, double dl) { return report::polarPixel(sc, deg, dl); };
+    for (const auto& [deg, dl, colour] : std::vector<std::tuple<double, double, const char*>>{
+             {0, 8 * kUm, report::kCcwBefore}, {90, -8 * kUm, report::kCcwBefore}, {45, 0, report::kCcwBefore},
+             {0, 11 * kUm, report::kCwBefore}, {90, -5 * kUm, report::kCwBefore}, {180, 11 * kUm, report::kCwBefore},
+             {30, 0.5 * kUm, report::kCcwAfter}, {210, -0.5 * kUm + 1.0 * kUm, report::kCwAfter}}) {
+        const report::PolarPixel p = at(deg, dl);
+        EXPECT_TRUE(colourNear(*pic, p.x, p.y, colour)) << colour << " expected near " << deg << " deg, " << dl / kUm << " um";
+    }
+    // And not where nothing was drawn: the CCW trace is not on the nominal circle at 0°.
+    const report::PolarPixel off = at(0, -8 * kUm);
+    EXPECT_FALSE(colourNear(*pic, off.x, off.y, report::kCcwBefore, 2));
+}
+
+TEST(ReportMapSvg, ScaleFromZeroSharedClippedArrowsMicrometresAndZeroMessage) {
+    const MachineModel& m = test::multitasking();
+    const DeviationSet truth = readDeviationCsv(kTruth, m);
+    MapRequest req{m, truth, parseGrid("X=-100:100:20 Y=-100:100:20 Z=0 B=0 C=0"), 100.0, {}, 1};
+    const VolumetricMap map = computeMap(req);
+    const MapPlane plane = parseMapPlane("XY");
+    const double own = planeMaxError(map, plane) / kUm;
+    ASSERT_GT(own, 1.0);
+    SvgInfo info;
+    info.title = "machine <A&B>";
+    info.scaleMaxUm = 3 * own;  // shared with a worse map
+    info.idPrefix = "m1";
+    const std::string svg = renderMapSvg(map, m, plane, info);
+    EXPECT_NE(svg.find("machine &lt;A&amp;B&gt;"), std::string::npos);
+    EXPECT_NE(svg.find("|e| (µm)"), std::string::npos);
+    EXPECT_EQ(svg.find(" um"), std::string::npos);
+    EXPECT_NE(svg.find("X axis position (mm)"), std::string::npos);
+    EXPECT_NE(svg.find("clip-path=\"url(#m1-frame)\""), std::string::npos);
+    EXPECT_NE(svg.find("marker-end=\"url(#m1-head)\""), std::string::npos);
+    // The colour bar starts at 0 and reaches the shared maximum.
+    EXPECT_NE(svg.find(">0</text>"), std::string::npos);
+    const double top = report::niceNumber(3 * own / 5) * std::ceil(3 * own / report::niceNumber(3 * own / 5) - 1e-9);
+    EXPECT_NE(svg.find(fmt::format(">{:g}</text>", top)), std::string::npos) << top;
+    // The cells use only the lower part of the scale: no yellow (the top colour) in any cell.
+    EXPECT_NE(svg.find("#fde725"), std::string::npos);  // in the colour bar
+    EXPECT_EQ(svg.find("fill=\"#fde725\" stroke"), std::string::npos);
+    // Orientation mode: the coordinates are the tool tip in the workpiece frame.
+    MapRequest ori{m, truth, parseGrid("X=-50:50:50 Y=-50:50:50 Z=300"), 100.0, Vec3(0, 0, 1), 1};
+    EXPECT_NE(renderMapSvg(computeMap(ori), m, plane, {}).find("tool tip X in the workpiece frame (mm)"), std::string::npos);
+    // All zero.
+    const DeviationSet zero(m);
+    MapRequest zr{m, zero, parseGrid("X=-100:100:20 Y=-100:100:20 Z=0 B=0 C=0"), 100.0, {}, 1};
+    const std::string z = renderMapSvg(computeMap(zr), m, plane, {});
+    EXPECT_NE(z.find("no error on this plane: |e| = 0 everywhere"), std::string::npos);
+    EXPECT_NE(z.find("the error is zero on this whole plane"), std::string::npos);
+    EXPECT_EQ(z.find("a plane axis is not"), std::string::npos);
+}
+
+TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
+    test::ScratchDir dir("report-html");
+    const std::string traces = dir.file("traces");
+    auto r = test::runCli("simulate --machine " + kMachine + " --plan " + kPlan + " --deviations " + kTruth + " --out " + traces +
+                          " --noise-um 0.2 --seed 5");
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
+                     dir.file("d.csv") + " --report " + dir.file("report.html") + " --report-controllers linuxcnc,isg");
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    // Every file of the report.
+    for (const char* f : {"report.html", "report.summary.json", "report-polar-B-X.svg", "report-polar-C-radial-RB2.svg",
+                          "report-map-1.svg", "report-map-2.svg", "report-map-3.svg"})
+        EXPECT_TRUE(fs::exists(dir.file(f))) << f;
+    const std::string html = test::readText(dir.file("report.html"));
+    // Self-contained: nothing fetched (the only URL is the SVG namespace), no script that runs.
+    for (const char* bad : {"src=", "href=", "<link", "@import", "url(http", "<script>", "<script src"})
+        EXPECT_EQ(html.find(bad), std::string::npos) << bad;
+    size_t pos = 0;
+    while ((pos = html.find("http", pos)) != std::string::npos) {
+        EXPECT_EQ(html.compare(pos, 26, "http://www.w3.org/2000/svg"), 0) << html.substr(pos, 60);
+        ++pos;
+    }
+    // The plots in the page are the SVG files.
+    EXPECT_NE(html.find(test::readText(dir.file("report-polar-B-X.svg")).substr(0, 200)), std::string::npos);
+    const JsonValue j = readJsonFile(dir.file("report.summary.json"));
+    EXPECT_EQ(j["runs"].array.size(), 6u);
+    EXPECT_EQ(j["deviations"].array.size(), 13u);
+    EXPECT_EQ(j["unidentified"].array.size(), 0u);
+    EXPECT_EQ(j["maps"].array.size(), 3u);
+    ASSERT_EQ(j["controllers"].array.size(), 2u);
+    EXPECT_EQ(j["controllers"][0]["name"].string, "linuxcnc");
+    EXPECT_GT(j["controllers"][0]["not_compensated"].array.size(), 0u);  // LinuxCNC tables cannot hold squareness
+    EXPECT_LT(j["controllers"][1]["after_max_um"].num(), 0.1 * j["controllers"][1]["before_max_um"].num());  // ISG: all
+    // Before vs after on every run: the compensation removes almost all of the circular deviation.
+    for (const JsonValue& run : j["runs"].array) {
+        EXPECT_GT(run["before"]["G_um"].num(), 0.0) << run["name"].string;
+        EXPECT_LT(run["after"]["G_um"].num(), 2.0) << run["name"].string;  // noise 0.2 µm: a few σ
+        EXPECT_NEAR(run["rms_after_um"].num(), 0.2, 0.03) << run["name"].string;
+    }
+    // The radial deviation F before spans several µm on some run (the machine's eccentricities), after well below.
+    double spanBefore = 0, spanAfter = 0;
+    for (const JsonValue& run : j["runs"].array) {
+        spanBefore = std::max(spanBefore, run["before"]["F_max_um"].num() - run["before"]["F_min_um"].num());
+        spanAfter = std::max(spanAfter, run["after"]["F_max_um"].num() - run["after"]["F_min_um"].num());
+    }
+    EXPECT_GT(spanBefore, 20.0);
+    EXPECT_LT(spanAfter, 2.5);
+    // The maps share one scale from 0 up to the worst of them.
+    double worst = 0;
+    for (const JsonValue& mp : j["maps"].array) worst = std::max(worst, mp["plane_max_um"].num());
+    EXPECT_NEAR(j["map_scale_max_um"].num(), worst, 1e-9);
+
+    if (!chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
+    const std::string log = screenshot(dir.file("report.html"), dir.file("page.png"), 1400, 2400, dir);
+    EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
+    std::string why;
+    const auto pic = readPng(dir.file("page.png"), why);
+    if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
+    // The polar plots are on the page: the before traces (blue) in quantity, and each plot's blue pixels form a ring
+    // (the bounding box of the first plot's trace is about as wide as it is high, with no blue at its centre).
+    EXPECT_GT(countColour(*pic, report::kCcwBefore), 3000);
+    EXPECT_GT(countColour(*pic, report::kCcwAfter), 3000);
+    // The first plot's CCW trace: the connected set of its pixels (3 px neighbourhood: the after trace is drawn over
+    // it where they cross) from the topmost one in the first column of plots.
+    const int column = static_cast<int>(report::kPolarWidth) + 40;
+    int sx = -1, sy = -1;
+    for (int y = 0; y < pic->h && sy < 0; ++y)
+        for (int x = 0; x < column; ++x)
+            if (near(pic->at(x, y), rgb(report::kCcwBefore), 24)) {
+                sx = x, sy = y;
+                break;
+            }
+    ASSERT_GE(sy, 0);
+    std::vector<char> seen(static_cast<size_t>(pic->w) * pic->h, 0);
+    std::vector<std::pair<int, int>> todo{{sx, sy}};
+    seen[static_cast<size_t>(sy) * pic->w + sx] = 1;
+    int x0 = sx, x1 = sx, y0 = sy, y1 = sy;
+    while (!todo.empty()) {
+        const auto [x, y] = todo.back();
+        todo.pop_back();
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        for (int dy = -3; dy <= 3; ++dy)
+            for (int dx = -3; dx <= 3; ++dx) {
+                const int xx = x + dx, yy = y + dy;
+                if (xx < 0 || yy < 0 || xx >= pic->w || yy >= pic->h) continue;
+                char& v = seen[static_cast<size_t>(yy) * pic->w + xx];
+                if (v || !near(pic->at(xx, yy), rgb(report::kCcwBefore), 60)) continue;
+                v = 1;
+                todo.emplace_back(xx, yy);
+            }
+    }
+    ASSERT_GT(x1, x0);
+    const double wBox = x1 - x0, hBox = y1 - y0;
+    EXPECT_NEAR(wBox / hBox, 1.0, 0.15) << x0 << " " << x1 << " " << y0 << " " << y1;
+    EXPECT_GT(wBox, 2 * (report::kPolarNominalPx - report::kPolarBandPx));  // within the scale rings
+    EXPECT_LT(wBox, 2 * (report::kPolarNominalPx + report::kPolarBandPx));
+    EXPECT_FALSE(colourNear(*pic, (x0 + x1) / 2.0, (y0 + y1) / 2.0, report::kCcwBefore, 20));
+}
+
+TEST(ReportHtml, NamesAreEscapedAndRunNamesMustBeFileNames) {
+    report::ReportData d;
+    d.title = "Machine <A&B> \"test\"";
+    d.machine = "A&B";
+    d.deviations.push_back({"EB0B", "bXB", "arcsec", true, 1, 0, 2});
+    d.deviations.push_back({"EC0Y", "gXY", "arcsec", false});
+    d.warnings.push_back("x < y & z");
+    const report::ReportFiles f = report::reportFiles("o/r.html", d);
+    const std::string html = report::formatHtmlReport(d, f, {});
+    EXPECT_NE(html.find("<title>Machine &lt;A&amp;B&gt; &quot;test&quot;</title>"), std::string::npos);
+    EXPECT_NE(html.find("x &lt; y &amp; z"), std::string::npos);
+    EXPECT_EQ(html.substr(0, html.find("<script")).find("<A&B>"), std::string::npos);
+    EXPECT_NE(html.find("Not identified (these measurements cannot tell them apart, or do not see them): EC0Y (gXY)"),
+              std::string::npos);
+    // The JSON summary inside the page cannot end the script element early.
+    d.title = "</script><b>";
+    const std::string json = report::formatReportSummaryJson(d, f);
+    EXPECT_EQ(json.find("</script>"), std::string::npos);
+    EXPECT_EQ(parseJson(json)["title"].string, "</script><b>");
+    report::RunSection bad;
+    bad.name = "../x";
+    d.runs.push_back(bad);
+    EXPECT_THROW(report::reportFiles("o/r.html", d), InputError);
+}
+
+}  // namespace
+}  // namespace cnccomp
