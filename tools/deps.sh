@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages cnccomp needs, only those missing (apt-get; run as root).
 set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config libeigen3-dev libnlopt-cxx-dev libtinyxml2-dev libfmt-dev libcli11-dev
-          libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev)
+          libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev linuxcnc-uspace)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
