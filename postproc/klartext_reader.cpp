@@ -421,6 +421,7 @@ private:
             }
             return arcRow(w.dr > 0, a0, a1, pc0_, pc1_, end, startKnown && poleKnown_ ? endKnown : endKnown & ~plane, row, s);
         }
+        if (key == "CT" && !tangentKnown_) fail("CT needs a preceding contour element to be tangential to");
         if (!startKnown) return arcRow(w.dr > 0, a0, a1, 0, 0, end, endKnown & ~plane, row, s);
         const double s0 = pos_[a0], s1 = pos_[a1], e0 = end[a0], e1 = end[a1];
         const double dx = e0 - s0, dy = e1 - s1, d = std::hypot(dx, dy);
@@ -438,7 +439,6 @@ private:
                           row, s);
         }
         // CT: tangential to the previous contour element.
-        if (!tangentKnown_) fail("CT needs a preceding contour element to be tangential to");
         double t0 = 0, t1 = 0;
         for (int c = 0; c < 3; ++c) {
             if (L_.axis("XYZ"[c]) == a0) t0 = tangent_[c];
