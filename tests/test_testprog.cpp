@@ -287,7 +287,7 @@ TEST(TestPrograms, CliWritesOneProgramPerRunAndAnIndexAllOrNothing) {
     EXPECT_NE(index.find("1,XYC,R-test,TP01_XYC.h,72,forward"), std::string::npos) << index;
     const std::string h = test::readText(dir.file("h/TP05_XYZAC.h"));
     EXPECT_EQ(h.rfind("0 BEGIN PGM TP05_XYZAC MM", 0), 0u) << h.substr(0, 80);
-    EXPECT_NE(h.find("CYCL DEF 9.1 DWELL 1.0"), std::string::npos);
+    EXPECT_NE(h.find("CYCL DEF 9.1 DWELL 1\n"), std::string::npos);
     EXPECT_NE(h.find("END PGM TP05_XYZAC MM"), std::string::npos);
     // A folder standing where a program goes: refused before anything is written.
     std::filesystem::create_directories(dir.file("f/TP03_XYC_A_45.nc"));
@@ -316,7 +316,7 @@ TEST(TestPrograms, ProgramsStartAndEndInTheirDialectsFrame) {
     };
     const std::string fanuc = text(ProgramDialect::Fanuc);
     EXPECT_EQ(fanuc.rfind("%\nO1004 (TP04_C_RADIAL)\n", 0), 0u) << fanuc.substr(0, 40);
-    EXPECT_NE(fanuc.find("G10 L2 P1 X0.0 Y0.0 Z0.0 B0.0 C0.0"), std::string::npos);
+    EXPECT_NE(fanuc.find("G10 L2 P1 X0.000000 Y0.000000 Z0.000000 B0.000000 C0.000000"), std::string::npos);
     EXPECT_EQ(fanuc.substr(fanuc.size() - 2), "%\n");
     const std::string siemens = text(ProgramDialect::Sinumerik);
     EXPECT_NE(siemens.find("G500"), std::string::npos);
@@ -335,7 +335,7 @@ TEST(TestPrograms, ProgramsStartAndEndInTheirDialectsFrame) {
             o.dialect = ProgramDialect::Heidenhain;
             const auto p = testprog::makeTestProgram(sp.machine, testprog::planMotions(sp.machine, sp.plan)[0], 1, o);
             EXPECT_TRUE(p.arcs);
-            EXPECT_NE(p.text.find(" CC X+0.0 Y+0.0"), std::string::npos);
+            EXPECT_NE(p.text.find(" CC X+0.000000 Y+0.000000"), std::string::npos);
             EXPECT_NE(p.text.find(" DR- R0"), std::string::npos);
         }
 }

@@ -50,14 +50,19 @@ pp::Dialect readerDialect(ProgramDialect d) {
 }
 
 std::string ProgramSyntax::number(double v, bool plus) const {
+    // Fixed digits (no trimming): `cnccomp correct` keeps a word's decimals, so every word carries the full resolution.
     std::string s = fmt::format("{:.{}f}", v, decimals_);
-    if (s.find('.') != std::string::npos) {
-        while (s.back() == '0') s.pop_back();
-        if (s.back() == '.') s.push_back('0');
-    }
-    if (s == "-0.0") s = "0.0";
+    if (s.find('.') == std::string::npos) s.push_back('.');
+    if (s.find_first_not_of("-0.") == std::string::npos && s.front() == '-') s.erase(s.begin());
     if (plus && s.front() != '-') s.insert(s.begin(), '+');
     return s;
+}
+
+std::string ProgramSyntax::plain(double v) {
+    std::string s = fmt::format("{:.3f}", v);
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s.pop_back();
+    return s == "-0" ? "0" : s;
 }
 
 std::string ProgramSyntax::axisWords(const AxisVector& p, unsigned mask, bool plus) const {
@@ -159,9 +164,9 @@ public:
     bool arcsWithRotaryAxes() const override { return true; }
     void dwell(double seconds) override {
         switch (d_) {
-            case ProgramDialect::LinuxCnc: block("G4 P" + number(seconds)); break;
+            case ProgramDialect::LinuxCnc: block("G4 P" + plain(seconds)); break;
             case ProgramDialect::Fanuc: block(fmt::format("G4 P{}", static_cast<long>(std::lround(seconds * 1000)))); break;
-            default: block("G4 F" + number(seconds)); break;
+            default: block("G4 F" + plain(seconds)); break;
         }
     }
     void stop(std::string_view message) override {
@@ -195,7 +200,7 @@ private:
     std::string feedWord(double f) {
         if (f == lastFeed_) return "";
         lastFeed_ = f;
-        return " F" + number(f);
+        return " F" + plain(f);
     }
     void track(const AxisVector& p, unsigned mask) {
         if (pos_.size() != p.size()) pos_ = AxisVector::Zero(p.size());
@@ -245,7 +250,7 @@ public:
     bool arcsWithRotaryAxes() const override { return false; }
     void dwell(double seconds) override {
         block("CYCL DEF 9.0 DWELL TIME");
-        block("CYCL DEF 9.1 DWELL " + number(seconds, false));
+        block("CYCL DEF 9.1 DWELL " + plain(seconds));
     }
     void stop(std::string_view message) override {
         comment(message);
@@ -265,7 +270,7 @@ private:
     std::string feedWord(double f) {
         if (f == lastFeed_) return "";
         lastFeed_ = f;
-        return " F" + number(f);
+        return " F" + plain(f);
     }
 
     std::string name_;

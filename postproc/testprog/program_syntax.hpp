@@ -66,8 +66,10 @@ public:
 
 protected:
     ProgramSyntax(const MachineModel& machine, int decimals) : machine_(machine), decimals_(decimals) {}
-    /// Number with `decimals` digits, trailing zeros trimmed (at least one digit after the point); `plus` forces '+'.
+    /// Number with exactly `decimals` digits after the point (a point always); `plus` forces '+'.
     std::string number(double v, bool plus = false) const;
+    /// Feeds and times: up to three decimals, trailing zeros dropped ("1000", "0.5").
+    static std::string plain(double v);
     /// Axis words of p for the axes in mask, in X Y Z U V W A B C order: "X12.5 Y0.0 C90.0" (Heidenhain: X+12.5).
     std::string axisWords(const AxisVector& p, unsigned mask, bool plus) const;
     unsigned allAxes() const { return machine_.axisCount() >= 32 ? ~0u : (1u << machine_.axisCount()) - 1u; }

@@ -47,6 +47,10 @@ void print(const VerifyResult& r) {
         }
     fmt::print("(um; span = max - min of dL, R-test: of a displacement component; G = ISO 230-4 circular deviation; "
                "F = radial deviation)\n");
+    for (const VerifyRun& run : r.runs)
+        for (const VerifyPass& p : run.passes)
+            if (!p.outsideTravel.empty())
+                fmt::print("warning: run '{}' {}: the compensated commands leave the travel: {}\n", run.name, p.label, p.outsideTravel);
     const VerifyVolumetric& v = r.volumetric;
     if (v.available)
         fmt::print("volumetric tool-tip error over the plan's workspace ({} points: {}):\n  max {:.3f} -> {:.3f} um, RMS {:.3f} -> "

@@ -67,27 +67,45 @@ RunCommands samplesOf(const testprog::RunMotion& r, const testprog::ProgramComma
     return c;
 }
 
-void checkTravel(const Kinematics& k, const AxisVector& q, const std::string& run, const std::string& where) {
-    try {
-        k.checkTravel(q);
-    } catch (const ModelError& e) {
-        throw ModelError(fmt::format("run '{}' {}: {}", run, where, e.what()));
+/// Largest excursion beyond an axis' travel along a pass (the commands as they reach the drives).
+struct TravelCheck {
+    int axis = -1, count = 0;
+    double excess = 0, value = 0;
+    void check(const MachineModel& m, const AxisVector& q) {
+        bool out = false;
+        for (int a = 0; a < m.axisCount(); ++a) {
+            const Link& l = m.axisLink(a);
+            const double e = std::max(l.min - q[a], q[a] - l.max);
+            if (!(e > 1e-9) && std::isfinite(q[a])) continue;
+            out = true;
+            if (!(e <= excess)) excess = e, axis = a, value = q[a];
+        }
+        count += out;
     }
-}
+    std::string describe(const MachineModel& m) const {
+        if (count == 0) return {};
+        const Link& l = m.axisLink(axis);
+        const double s = l.kind == AxisKind::Rotary ? 1 / kDeg : 1.0;
+        const char* u = l.kind == AxisKind::Rotary ? "deg" : "mm";
+        return fmt::format("{} reaches {:.4f} {} (travel {:g} .. {:g} {}) at {} command(s)", m.axisNames[axis], value * s, u,
+                           l.min * s, l.max * s, u, count);
+    }
+};
 
 /// The instrument's readings along one pass on machine k: ΔL of a bar (seed 000 eq. (14); absolute bar: Ball 2 at its
 /// nominal place, seed 002; DBB5, seed 003), or the R-test displacement (seed 001).
 void simulatePass(const Kinematics& k, const Kinematics& nominal, const testprog::RunMotion& r, const AxisVector& setup,
                   const AxisVector& nominalSetup, const std::vector<double>& t, const std::vector<AxisVector>& q,
-                  BallbarTrace& trace, std::vector<Vec3>& displacement) {
-    checkTravel(k, setup, r.name, "setup");
+                  BallbarTrace& trace, std::vector<Vec3>& displacement, TravelCheck& travel) {
+    const MachineModel& m = k.machine();
+    travel.check(m, setup);
     trace.angleDeg = t;
     trace.dL.assign(q.size(), 0.0);
     displacement.clear();
     if (r.rtest) {
         const Vec3 nest = k.toolPoint(r.rtest->nestLength), ball = r.rtest->ball + r.rtest->ballOffset;
         for (size_t i = 0; i < q.size(); ++i) {
-            checkTravel(k, q[i], r.name, fmt::format("at pose {:g}", t[i]));
+            travel.check(m, q[i]);
             displacement.push_back(rtestDisplacement(k, q[i], ball, nest));
             trace.dL[i] = displacement.back().norm();
         }
@@ -108,7 +126,7 @@ void simulatePass(const Kinematics& k, const Kinematics& nominal, const testprog
         ref = k.toolPointInWorkpiece(setup, tool);
     }
     for (size_t i = 0; i < q.size(); ++i) {
-        checkTravel(k, q[i], r.name, fmt::format("at {:g} deg", t[i]));
+        travel.check(m, q[i]);
         trace.dL[i] = (k.toolPointInWorkpiece(q[i], tool) - ref).norm() - LB;  // eq. (14)
     }
 }
@@ -257,8 +275,12 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
                                                                   "plan's samples", r.name, before.labels[p]));
             VerifyPass v;
             v.label = before.labels[p];
-            simulatePass(k, nominal, r, before.setup, before.setup, before.t[p], before.q[p], v.before, v.displacementBefore);
-            simulatePass(k, nominal, r, after.setup, before.setup, after.t[pa], after.q[pa], v.after, v.displacementAfter);
+            TravelCheck travelBefore, travelAfter;
+            simulatePass(k, nominal, r, before.setup, before.setup, before.t[p], before.q[p], v.before, v.displacementBefore,
+                         travelBefore);
+            simulatePass(k, nominal, r, after.setup, before.setup, after.t[pa], after.q[pa], v.after, v.displacementAfter,
+                         travelAfter);
+            v.outsideTravel = travelAfter.describe(m);
             if (r.rtest) {
                 v.spanBefore = displacementSpan(v.displacementBefore);
                 v.spanAfter = displacementSpan(v.displacementAfter);
@@ -287,7 +309,7 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
         VerifyRemaining rem;
         rem.deviation = c.deviation;
         rem.reason = c.note;
-        const int d = m.deviationIndex(c.deviation);
+        const int d = m.deviationIndex(c.deviation.substr(0, c.deviation.find(' ')));  // "EBB (constant part)" → EBB
         if (d >= 0) {
             const DeviationDef& def = m.deviations[static_cast<size_t>(d)];
             double v = 0;

@@ -60,6 +60,9 @@ struct VerifyPass {
     CircularTestResult isoBefore, isoAfter;
     Vec3 eccentricityBefore = Vec3::Constant(NAN), eccentricityAfter = Vec3::Constant(NAN);  ///< mm, machine X Y Z
     double spanBefore = 0, spanAfter = 0;  ///< mm: max − min ΔL; R-test: largest span of a displacement component
+    /// Non-empty when the compensated commands leave an axis' travel (a real control would stop with a limit alarm);
+    /// the readings are still simulated there.
+    std::string outsideTravel;
 };
 
 struct VerifyRun {

@@ -54,7 +54,8 @@ std::vector<controllers::Coverage> readNotCompensated(const std::vector<controll
                 item.resize(item.size() - suffix.size());
             const std::string_view t = trim(item);
             if (t == "(none)" || t == "[none]") break;
-            const size_t sp = t.find(' ');
+            // "NAME  reason": the name column is padded and followed by two blanks (header.hpp); a name may hold one blank.
+            const size_t sp = t.find("  ");
             out.push_back({std::string(t.substr(0, sp)), sp == std::string_view::npos ? "" : std::string(trim(t.substr(sp)))});
         }
         if (inList) return out;

@@ -47,8 +47,8 @@ std::string iso(const CircularTestResult& r) {
 std::string vec(const Vec3& v) { return fmt::format("[{}, {}, {}]", um(v.x()), um(v.y()), um(v.z())); }
 
 std::string pass(const VerifyPass& p) {
-    std::string o = fmt::format("{{\"direction\": {}, \"span_before_um\": {}, \"span_after_um\": {}, ", str(p.label),
-                                um(p.spanBefore), um(p.spanAfter));
+    std::string o = fmt::format("{{\"direction\": {}, \"span_before_um\": {}, \"span_after_um\": {}, \"outside_travel\": {}, ",
+                                str(p.label), um(p.spanBefore), um(p.spanAfter), p.outsideTravel.empty() ? "null" : str(p.outsideTravel));
     o += fmt::format("\"angle_deg\": {}, ", list(p.before.angleDeg.size(), [&](size_t i) { return num(p.before.angleDeg[i]); }));
     if (!p.displacementBefore.empty()) {
         o += fmt::format("\"displacement_before_um\": {}, ",
