@@ -13,7 +13,6 @@ std::optional<Dialect> parseDialect(std::string_view name) {
     if (n == "fanuc" || n == "haas") return Dialect::Fanuc;
     if (n == "sinumerik" || n == "siemens") return Dialect::Sinumerik;
     if (n == "printer" || n == "marlin" || n == "reprap" || n == "3d-printer") return Dialect::Printer;
-    if (n == "heidenhain" || n == "klartext") return Dialect::Heidenhain;
     return std::nullopt;
 }
 

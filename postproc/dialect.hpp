@@ -14,8 +14,8 @@ enum class Dialect {
     Heidenhain, ///< HEIDENHAIN conversational (Klartext): numbered blocks, BEGIN PGM, L/CC/C; read by klartext_reader only
 };
 
-/// "rs274ngc" (or "linuxcnc"), "fanuc", "sinumerik", "printer" (or "marlin", "reprap"), "heidenhain" (or "klartext");
-/// nullopt otherwise.
+/// "rs274ngc" (or "linuxcnc"), "fanuc", "sinumerik", "printer" (or "marlin", "reprap"); nullopt otherwise.
+/// (Heidenhain is detected from BEGIN PGM, not named: `correct` cannot rewrite Klartext.)
 std::optional<Dialect> parseDialect(std::string_view name);
 const char* dialectName(Dialect d);
 

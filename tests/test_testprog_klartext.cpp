@@ -61,7 +61,6 @@ void expectError(const std::string& program, int line, const std::string& words)
 TEST(Klartext, DetectedFromBeginPgmAndDispatchedByPoses) {
     EXPECT_EQ(pp::detectDialect("0 BEGIN PGM ABC MM\n1 L X+0 R0 FMAX\n").dialect, pp::Dialect::Heidenhain);
     EXPECT_EQ(pp::detectDialect("(BEGIN PGM in a comment)\nG0 X1\n").dialect, pp::Dialect::Rs274ngc);
-    EXPECT_EQ(pp::parseDialect("heidenhain"), pp::Dialect::Heidenhain);
     test::ScratchDir dir("klartext-cli");
     test::writeText(dir.file("p.h"), "0 BEGIN PGM P MM\n1 L X+10 Y-5 Z+100 R0 FMAX\n2 END PGM P MM\n");
     const auto r = test::runCli("poses --in " + dir.file("p.h"));
