@@ -63,12 +63,18 @@ public:
     /// Conventions no vendor document confirmed (marked [G] in the files), each as what the user must check on the
     /// control before loading the files. `cnccomp emit --help` lists them. Default: none.
     virtual std::vector<std::string> checks() const { return {}; }
+    /// Whether a folder's files are this backend's output, by the file names its emit() writes (registry.cpp keeps
+    /// the table; a backend may override).
+    virtual bool recognizes(const std::vector<OutputFile>& files) const;
 };
 
 /// All registered backends, sorted by name.
 std::vector<const Backend*> backends();
 /// Backend by name; throws ModelError listing the known names.
 const Backend& backend(std::string_view name);
+/// The one backend that recognizes `files` (Backend::recognizes); nullptr when none does. Throws ModelError naming the
+/// candidates when several do.
+const Backend* recognizeBackend(const std::vector<OutputFile>& files);
 
 struct RegisterBackend {
     explicit RegisterBackend(std::unique_ptr<Backend> b);

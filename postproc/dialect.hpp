@@ -11,9 +11,11 @@ enum class Dialect {
     Fanuc,      ///< Fanuc (and Haas, Mazak EIA): % O1234, #100 macros, G65/M98, G43.4/G43.5, axis integers in increments
     Sinumerik,  ///< Siemens Sinumerik in ISO mode: ; comments, %_N_ headers, NAME(...) calls, R and $ variables
     Printer,    ///< 3D-printer style (Marlin/RepRap): ; comments, E extruder words, M117 text arguments
+    Heidenhain, ///< HEIDENHAIN conversational (Klartext): numbered blocks, BEGIN PGM, L/CC/C; read by klartext_reader only
 };
 
 /// "rs274ngc" (or "linuxcnc"), "fanuc", "sinumerik", "printer" (or "marlin", "reprap"); nullopt otherwise.
+/// (Heidenhain is detected from BEGIN PGM, not named: `correct` cannot rewrite Klartext.)
 std::optional<Dialect> parseDialect(std::string_view name);
 const char* dialectName(Dialect d);
 
@@ -23,7 +25,7 @@ struct DetectedDialect {
     const char* reason = "";    ///< what decided it (a static string)
 };
 
-/// Looks at the first bytes of a program: ;FLAVOR: / M104 / M109 / E words → printer; %_N_ / TRAORI / CYCLE… →
+/// Looks at the first bytes of a program: BEGIN PGM → Heidenhain Klartext; ;FLAVOR: / M104 / M109 / E words → printer; %_N_ / TRAORI / CYCLE… →
 /// Sinumerik; O-number program header or G65 / M98 / G43.4 → Fanuc; #<name> / o-words → RS274NGC. Numbered
 /// variables (#100) exist in both Fanuc and RS274NGC and decide nothing.
 /// Ambiguous (clues of two families) or no clue → RS274NGC with certain = false.

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "postproc/block_writer.hpp"
+#include "postproc/klartext_reader.hpp"
 #include "postproc/line_reader.hpp"
 #include "postproc/processor.hpp"
 
@@ -17,6 +18,7 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
     const std::string_view head = reader.head();
     checkTextHead(head, options.inputName);
     s.dialect = options.dialect ? *options.dialect : detectDialect(head).dialect;
+    if (s.dialect == Dialect::Heidenhain) return writeKlartextPoses(layout, reader, csv, options);
     Interpreter interp(layout, InterpreterOptions{s.dialect, options.setup, options.rotaryShortest});
     OutputBuffer out(csv);
     out.write("line,motion,X,Y,Z,A,B,C\n");

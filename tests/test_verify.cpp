@@ -1,48 +1,251 @@
-// Verification: compensating with the true set removes the ball-bar errors; with the closed-form estimate it removes
-// nearly all of them; the uncompensated run reproduces simulateRun.
+// `cnccomp verify`: the readings before compensation are those of the simulation (the programs as written read back
+// give the same ΔL), recognising the compensation a path holds, the gate and its exit statuses, damaged files, the
+// JSON report, and `cnccomp emit --plan`.
 #include <gtest/gtest.h>
 
-#include "cnccomp/closed_form.hpp"
+#include <filesystem>
+
+#include "cnccomp/identification/rtest_run.hpp"
+#include "cnccomp/identification/seed002_tilting_head.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/report_json.hpp"
 #include "cnccomp/verify.hpp"
+#include "cnccomp/verify_sources.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-TEST(Verify, CompensationWithTheTruthFlattensEveryRun) {
-    const MachineModel& m = test::multitasking();
-    const DeviationSet truth = readDeviationCsv(test::sourcePath("samples/deviations/multitasking-truth.csv"), m);
-    MeasurementPlan plan = readPlanXml(test::sourcePath("samples/plans/multitasking-six-circles.xml"));
-    for (auto& r : plan.runs) r.stepDeg = 10;
-    const Kinematics nominal(m), actual(m, truth);
-    const auto rows = verifyRuns(actual, plan.runs, modelCompensation(nominal, actual));
-    ASSERT_EQ(rows.size(), plan.runs.size());
-    for (const auto& r : rows) {
-        EXPECT_GT(r.spanBefore, 1e-3) << r.run;  // micrometres of error before
-        EXPECT_LT(r.spanAfter, 1e-8) << r.run;   // nothing left after
+struct Sample {
+    const char* plan;
+    const char* machine;
+    const char* truth;
+};
+constexpr Sample kSamples[] = {
+    {"multitasking-six-circles.xml", "multitasking", "multitasking-truth.csv"},
+    {"lsq-multitasking-planned.xml", "multitasking", "multitasking-truth.csv"},
+    {"tilting-head-b-seed002.xml", "tilting-head-b", "tilting-head-b-truth.csv"},
+    {"table-table-ac-rtest.xml", "table-table-ac", "table-table-ac-truth.csv"},
+    {"table-table-ac-kinematic.xml", "table-table-ac", "table-table-ac-truth.csv"},
+    {"dbb5-table-table-ac.xml", "table-table-ac", "dbb5-truth.csv"},
+};
+
+std::string src(const std::string& rel) { return test::sourcePath(rel); }
+
+TEST(Verify, ReadingsBeforeCompensationAreTheSimulationsForEveryPlanKind) {
+    // The commands come from the test programs read back (6 decimals); the oracle is simulate / simulate-runs on the
+    // same machine with the plan's own commands.
+    for (const Sample& s : kSamples) {
+        const MachineModel m = readMachineXml(src(std::string("samples/machines/") + s.machine + ".xml"));
+        const MeasurementPlan plan = readPlanXml(src(std::string("samples/plans/") + s.plan));
+        const DeviationSet truth = readDeviationCsv(src(std::string("samples/deviations/") + s.truth), m);
+        VerifyCompensation comp;
+        comp.kind = VerifyCompensation::Kind::Deviations;
+        comp.model = idealCompensation(m, truth);
+        VerifyOptions o;
+        o.volumetricPerAxis = 2;
+        const VerifyResult r = verify(m, plan, truth, "truth", comp, o);
+        ASSERT_EQ(r.runs.size(), plan.runCount()) << s.plan;
+        const Kinematics k(m, truth);
+        size_t i = 0;
+        const auto compare = [&](const BallbarTrace& want) {
+            const VerifyRun& run = r.runs[i++];
+            for (const VerifyPass& p : run.passes) {
+                ASSERT_EQ(p.before.dL.size(), want.dL.size()) << s.plan << " " << run.name;
+                for (size_t j = 0; j < want.dL.size(); ++j) {
+                    // The pass may run backwards: find the sample by its angle.
+                    const auto at = std::find(want.angleDeg.begin(), want.angleDeg.end(), p.before.angleDeg[j]);
+                    ASSERT_NE(at, want.angleDeg.end());
+                    EXPECT_NEAR(p.before.dL[j], want.dL[static_cast<size_t>(at - want.angleDeg.begin())], 2e-6)
+                        << s.plan << " " << run.name << " " << p.label << " at " << p.before.angleDeg[j];
+                }
+                // The ideal compensation with the truth itself leaves only the programs' rounding.
+                EXPECT_LT(p.spanAfter, 0.01 * kUm) << s.plan << " " << run.name;
+            }
+        };
+        for (const BallbarRun& b : plan.runs) compare(simulateRun(k, b));
+        for (const BallbarRun& b : plan.absoluteRuns) compare(simulateAbsoluteRun(k, b));
+        for (const Dbb5Run& d : plan.dbb5Runs) compare(simulateDbb5(k, d));
+        for (const RtestRun& t : plan.rtestRuns) {
+            const RtestTrace want = simulateRtest(k, t);
+            const VerifyRun& run = r.runs[i++];
+            for (const VerifyPass& p : run.passes)
+                for (size_t j = 0; j < p.displacementBefore.size(); ++j)
+                    EXPECT_LT((p.displacementBefore[j] - want.d[static_cast<size_t>(p.before.angleDeg[j])]).norm(), 2e-6)
+                        << s.plan << " " << run.name;
+        }
+        EXPECT_GT(r.residualBefore, 1 * kUm) << s.plan;
     }
 }
 
-TEST(Verify, ClosedFormEstimateRemovesMostOfTheError) {
+TEST(Verify, IsoFiguresEccentricityAndJsonOfAnIdealCompensation) {
+    test::ScratchDir dir("verify-json");
+    const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
+                      t = src("samples/deviations/multitasking-truth.csv");
+    const auto r = test::runCli("verify --machine " + m + " --plan " + p + " --truth " + t + " --compensation " + t +
+                                " --max-residual-um 0.05 --json " + dir.file("v.json"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("verification passed"), std::string::npos) << r.out;
+    const JsonValue j = readJsonFile(dir.file("v.json"));
+    EXPECT_EQ(j["schema"].string, "cnccomp-verify/1");
+    EXPECT_EQ(j["passed"].boolean, true);
+    ASSERT_EQ(j["runs"].array.size(), 6u);
+    const JsonValue& cRadial = j["runs"][3];
+    EXPECT_EQ(cRadial["name"].string, "C-radial");
+    ASSERT_EQ(cRadial["passes"].array.size(), 2u);
+    EXPECT_EQ(cRadial["passes"][0]["direction"].string, "CW");
+    EXPECT_EQ(cRadial["passes"][1]["direction"].string, "CCW");
+    EXPECT_EQ(cRadial["passes"][0]["dL_before_um"].array.size(), 360u);
+    // Seed 000 Table 5 sign convention: the C-radial eccentricity before is the one `simulate` + eccentricities give.
+    const MachineModel& mm = test::multitasking();
+    const MeasurementPlan plan = readPlanXml(p);
+    const DeviationSet truth = readDeviationCsv(t, mm);
+    const Vec3 e = traceEccentricity(mm, plan.runs[3], simulateRun(Kinematics(mm, truth), plan.runs[3]));
+    EXPECT_NEAR(cRadial["passes"][0]["eccentricity_before_um"][0].num(), e.x() / kUm, 1e-3);
+    EXPECT_NEAR(cRadial["passes"][0]["eccentricity_before_um"][1].num(), e.y() / kUm, 1e-3);
+    EXPECT_EQ(cRadial["passes"][0]["eccentricity_before_um"][2].type, JsonValue::Type::Null);
+    EXPECT_GT(cRadial["passes"][0]["iso_before"]["circular_deviation_G_um"].num(), 0.5);
+    EXPECT_LT(cRadial["passes"][0]["iso_after"]["circular_deviation_G_um"].num(), 0.01);
+    EXPECT_LT(j["residual_um"].num(), 0.01);
+    EXPECT_GT(j["volumetric"]["max_before_um"].num(), 10.0);
+    EXPECT_LT(j["volumetric"]["max_after_um"].num(), 0.01);
+}
+
+TEST(Verify, BackendRecognisedFromTheFilesAndUnknownFoldersRefused) {
+    test::ScratchDir dir("verify-recognise");
     const MachineModel& m = test::multitasking();
-    const DeviationSet truth = readDeviationCsv(test::sourcePath("samples/deviations/multitasking-truth.csv"), m);
-    MeasurementPlan plan = readPlanXml(test::sourcePath("samples/plans/multitasking-six-circles.xml"));
-    for (auto& r : plan.runs) r.stepDeg = 5;
-    const Kinematics nominal(m), actual(m, truth);
-    std::vector<BallbarTrace> traces;
-    for (const auto& r : plan.runs) traces.push_back(simulateRun(actual, r));
-    const DeviationSet id = identifyClosedForm(m, eccentricitiesFromTraces(m, plan.runs, traces));
-    const Kinematics model(m, id);
-    for (const auto& r : verifyRuns(actual, plan.runs, modelCompensation(nominal, model))) {
-        // γXY (3″) is not identified by the closed form and stays: its C-radial signature is a 2nd harmonic.
-        EXPECT_LT(r.spanAfter, 0.1 * r.spanBefore + 0.2e-3) << r.run;
-        for (int c = 0; c < 3; ++c)
-            if (std::isfinite(r.eccentricityAfter[c])) {
-                EXPECT_LT(std::abs(r.eccentricityAfter[c]), 0.05e-3) << r.run << " e" << "xyz"[c];
-            }
+    const DeviationSet d = readDeviationCsv(src("samples/deviations/multitasking-truth.csv"), m);
+    for (const controllers::Backend* b : controllers::backends()) {
+        const auto files = b->emit({m, d, "d.csv", "2024-01-01"}).files;
+        const controllers::Backend* found = controllers::recognizeBackend(files);
+        ASSERT_TRUE(found) << b->name();
+        EXPECT_EQ(found->name(), b->name());
     }
+    EXPECT_EQ(controllers::recognizeBackend({{"notes.txt", "x"}}), nullptr);
+    // Through the CLI: an emit folder without --controller; a folder of anything else is refused by name.
+    const std::string mf = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
+                      t = src("samples/deviations/multitasking-truth.csv");
+    auto r = test::runCli("emit --controller fanuc-30i --machine " + mf + " --deviations " + t + " --out " + dir.file("f"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli("verify --machine " + mf + " --plan " + p + " --truth " + t + " --compensation " + dir.file("f"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("fanuc-30i files in"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("EA0C1"), std::string::npos) << "the NOT-compensated list of the files is printed";
+    std::filesystem::create_directories(dir.file("other"));
+    test::writeText(dir.file("other/readme.txt"), "hello\n");
+    r = test::runCli("verify --machine " + mf + " --plan " + p + " --truth " + t + " --compensation " + dir.file("other"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("neither controller files"), std::string::npos) << r.out;
+    r = test::runCli("verify --machine " + mf + " --plan " + p + " --truth " + t + " --compensation " + dir.file("f") +
+                     " --controller okuma");
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("unknown controller 'okuma'"), std::string::npos) << r.out;
+    // Without --truth a folder needs the identified set it was made from.
+    r = test::runCli("verify --machine " + mf + " --plan " + p + " --compensation " + dir.file("f"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("--identified"), std::string::npos) << r.out;
+    r = test::runCli("verify --machine " + mf + " --plan " + p + " --compensation " + dir.file("f") + " --identified " + t);
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("identified machine"), std::string::npos) << r.out;
+}
+
+TEST(Verify, ADamagedFileFailsTheGateWithExitStatusOne) {
+    // ISG files of the tilting head: the B tables are rows of volcomp.csv. Emitted from the truth they pass a 0.1 µm
+    // gate; one sign flipped or one row missing does not.
+    test::ScratchDir dir("verify-damaged");
+    const std::string m = src("samples/machines/tilting-head-b.xml"), p = src("samples/plans/tilting-head-b-seed002.xml"),
+                      t = src("samples/deviations/tilting-head-b-truth.csv");
+    auto r = test::runCli("emit --controller isg --machine " + m + " --deviations " + t + " --out " + dir.file("good"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const auto gate = [&](const std::string& folder) {
+        return test::runCli("verify --machine " + m + " --plan " + p + " --truth " + t + " --compensation " + folder +
+                            " --max-residual-um 0.1 --json " + dir.file(folder.substr(folder.rfind('/') + 1) + ".json"));
+    };
+    r = gate(dir.file("good"));
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    const std::string csv = test::readText(dir.file("good/volcomp.csv"));
+    const std::string row = "\n45.000000 0.000621320";
+    ASSERT_NE(csv.find(row), std::string::npos) << csv;
+    std::filesystem::create_directories(dir.file("sign"));
+    std::filesystem::copy(dir.file("good/volcomp.lis"), dir.file("sign/volcomp.lis"));
+    std::string flipped = csv;
+    flipped.replace(flipped.find(row), row.size(), "\n45.000000 -0.000621320");
+    test::writeText(dir.file("sign/volcomp.csv"), flipped);
+    r = gate(dir.file("sign"));
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_NE(r.out.find("above --max-residual-um"), std::string::npos) << r.out;
+    EXPECT_EQ(readJsonFile(dir.file("sign.json"))["passed"].boolean, false) << "the report is written before the gate fails";
+    std::filesystem::create_directories(dir.file("row"));
+    std::filesystem::copy(dir.file("good/volcomp.lis"), dir.file("row/volcomp.lis"));
+    std::string missing = csv;
+    const size_t at = missing.find(row) + 1;
+    missing.erase(at, missing.find('\n', at) - at + 1);
+    test::writeText(dir.file("row/volcomp.csv"), missing);
+    r = gate(dir.file("row"));
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+}
+
+TEST(Verify, CorrectedTestProgramsFolderThroughTheCli) {
+    // testprog → correct (each program with its tool length, as its header says) → verify --compensation FOLDER.
+    test::ScratchDir dir("verify-corrected");
+    const std::string m = src("samples/machines/table-table-ac.xml"), p = src("samples/plans/table-table-ac-rtest.xml"),
+                      t = src("samples/deviations/table-table-ac-truth.csv");
+    auto r = test::runCli("testprog --machine " + m + " --plan " + p + " --out " + dir.file("prog"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    std::filesystem::create_directories(dir.file("corr"));
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("prog"))) {
+        if (e.path().extension() != ".ngc") continue;
+        r = test::runCli("correct --machine " + m + " --deviations " + t + " --tool-length 100 --in " + e.path().string() +
+                         " --out " + dir.file("corr/" + e.path().filename().string()));
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+    }
+    r = test::runCli("verify --machine " + m + " --plan " + p + " --truth " + t + " --compensation " + dir.file("corr") +
+                     " --max-residual-um 0.1");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("corrected test programs"), std::string::npos) << r.out;
+    // Uncorrected programs do not pass the gate.
+    r = test::runCli("verify --machine " + m + " --plan " + p + " --truth " + t + " --compensation " + dir.file("prog") +
+                     " --max-residual-um 0.1");
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    // A run's program missing: refused, naming the run.
+    std::filesystem::remove(dir.file("corr/TP02_YZA.ngc"));
+    r = test::runCli("verify --machine " + m + " --plan " + p + " --truth " + t + " --compensation " + dir.file("corr"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("YZA"), std::string::npos) << r.out;
+}
+
+TEST(Verify, EmitPrintsThePredictedResidualOfItsFiles) {
+    test::ScratchDir dir("verify-emit");
+    const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
+                      t = src("samples/deviations/multitasking-truth.csv");
+    auto r = test::runCli("emit --controller isg --machine " + m + " --deviations " + t + " --out " + dir.file("a") + " --plan " + p);
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("predicted residual on the identified machine"), std::string::npos) << r.out;
+    // The same figure as `verify --identified` through the files.
+    const auto v = test::runCli("verify --machine " + m + " --plan " + p + " --compensation " + dir.file("a") + " --identified " + t);
+    ASSERT_EQ(v.exitCode, 0) << v.out;
+    const auto figure = [](const std::string& out, const std::string& key) {
+        const size_t at = out.find(key);
+        return at == std::string::npos ? -1.0 : std::stod(out.substr(at + key.size()));
+    };
+    EXPECT_NEAR(figure(r.out, "largest span "), figure(v.out, "residual (largest span after compensation): "), 1e-3);
+    r = test::runCli("emit --controller linuxcnc --machine " + m + " --deviations " + t + " --out " + dir.file("b"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("predicted tool-tip error on the identified machine over the travel"), std::string::npos) << r.out;
+}
+
+TEST(Verify, NotCompensatedListReadFromAnyCommentSyntax) {
+    const std::vector<controllers::OutputFile> files = {
+        {"a.txt", "nothing here\n"},
+        {"b.PRM", "%\n(NOT compensated:)\n(  EA0B   tilt [no parameter])\n(  EBB [constant part]  at the reference)\n(units)\n%\n"},
+    };
+    const auto list = readNotCompensated(files);
+    ASSERT_EQ(list.size(), 2u);
+    EXPECT_EQ(list[0].deviation, "EA0B");
+    EXPECT_EQ(list[0].note, "tilt [no parameter]");
+    EXPECT_EQ(list[1].deviation, "EBB [constant part]");
+    EXPECT_TRUE(readNotCompensated({{"c.ini", "# NOT compensated:\n#   (none)\n"}}).empty());
 }
 
 }  // namespace

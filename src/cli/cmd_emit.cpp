@@ -10,16 +10,50 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "controllers/backend.hpp"
+#include "cnccomp/verify.hpp"
+#include "controllers/common/evaluate.hpp"
 #include "controllers/common/header.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string controller, machine, deviations, out, date;
+    std::string controller, machine, deviations, out, date, plan;
 };
+
+/// What the files just written leave on the identified machine: `cnccomp verify` with the plan's test programs through
+/// the backend's apply model, or (without a plan) the tool-tip error over the travel.
+void predict(const controllers::Backend& b, const MachineModel& m, const DeviationSet& d, const controllers::EmitResult& r,
+             const Options& o) {
+    try {
+        std::shared_ptr<const controllers::AppliedCompensation> model(b.apply(m, r.files));
+        if (!model) return;
+        if (!o.plan.empty()) {
+            const MeasurementPlan plan = readPlanXml(o.plan);
+            VerifyCompensation c;
+            c.kind = VerifyCompensation::Kind::ControllerFiles;
+            c.backend = std::string(b.name());
+            c.description = fmt::format("{} files just written", b.name());
+            c.model = model;
+            c.notCompensated = r.notCompensated;
+            const VerifyResult v = verify(m, plan, d, "identified machine", c);
+            fmt::print("predicted residual on the identified machine (cnccomp verify, {}): largest span {:.3f} um (before {:.3f} um); "
+                       "volumetric max {:.3f} -> {:.3f} um\n",
+                       std::filesystem::path(o.plan).filename().string(), v.residual / kUm, v.residualBefore / kUm,
+                       v.volumetric.maxBefore / kUm, v.volumetric.maxAfter / kUm);
+            return;
+        }
+        const auto f = controllers::evaluateCompensation(m, d, *model, controllers::workspaceSamples(m, 5), 0.0);
+        fmt::print("predicted tool-tip error on the identified machine over the travel ({} poses, tool length 0; give --plan for "
+                   "the ball-bar residual): max {:.3f} -> {:.3f} um, RMS {:.3f} -> {:.3f} um\n",
+                   f.points, f.maxBefore / kUm, f.maxAfter / kUm, f.rmsBefore / kUm, f.rmsAfter / kUm);
+    } catch (const std::exception& e) {
+        fmt::print("predicted residual: not available ({})\n", e.what());
+    }
+}
 
 std::string today() {
     const std::time_t t = std::time(nullptr);
@@ -43,6 +77,7 @@ void run(const Options& o) {
     fmt::print("{} compensation for '{}' from {} ({} files in {})\n", b.name(), m.name, o.deviations, r.files.size(), o.out);
     for (const controllers::OutputFile& f : r.files) fmt::print("  {}\n", f.name);
     fmt::print("{}", controllers::formatCoverage(r));
+    predict(b, m, d, r, o);
 }
 
 const RegisterCommand reg([](CLI::App& app) {
@@ -65,6 +100,9 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--deviations", o->deviations, "deviation set CSV")->required()->check(CLI::ExistingFile);
     c->add_option("--out", o->out, "output folder (created if missing)")->required();
     c->add_option("--date", o->date, "date for the header comments (default: today, UTC)");
+    c->add_option("--plan", o->plan, "measurement plan XML: print the predicted ball-bar residual of the files on the identified "
+                                     "machine (as cnccomp verify)")
+        ->check(CLI::ExistingFile);
     c->callback([o] { run(*o); });
 });
 

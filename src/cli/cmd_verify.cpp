@@ -1,54 +1,146 @@
-// cnccomp verify: the plan's ball-bar runs on the true machine, before and after compensating with an identified set.
+// cnccomp verify: the plan's test programs through the compensation the user will load (a deviation set, the files of
+// `cnccomp emit`, or programs corrected by `cnccomp correct`) to the true or the identified machine, before and after.
 #include <cmath>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "cli/command.hpp"
+#include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "cnccomp/io/verify_json.hpp"
 #include "cnccomp/verify.hpp"
+#include "cnccomp/verify_sources.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, plan, truth, identified;
+    std::string machine, plan, compensation, controller, truth, identified, json, dialect = "linuxcnc";
+    std::optional<double> maxResidualUm;
+    int grid = 5;
 };
+
+std::string ecc(const Vec3& v) {
+    std::string s;
+    for (int c = 0; c < 3; ++c) s += std::isfinite(v[c]) ? fmt::format("{:8.3f}", v[c] / kUm) : fmt::format("{:>8}", "-");
+    return s;
+}
+
+void print(const VerifyResult& r) {
+    fmt::print("verification on '{}': {}\ncompensation: {}\n", r.machine, r.simulated, r.compensation);
+    fmt::print("{:<22} {:<16} {:<7} {:>19} {:>19} {:>19}   {:<24}  {}\n", "run", "type", "pass", "span before/after",
+               "G before/after", "F max/min after", "eccentricity before (um)", "after");
+    for (const VerifyRun& run : r.runs)
+        for (const VerifyPass& p : run.passes) {
+            const std::string g = p.circular ? fmt::format("{:9.3f} {:9.3f}", p.isoBefore.circularity / kUm, p.isoAfter.circularity / kUm)
+                                             : fmt::format("{:>19}", "-");
+            const std::string f = p.circular ? fmt::format("{:9.3f} {:9.3f}", p.isoAfter.radialMax / kUm, p.isoAfter.radialMin / kUm)
+                                             : fmt::format("{:>19}", "-");
+            fmt::print("{:<22} {:<16} {:<7} {:9.3f} {:9.3f} {} {}   {}  {}\n", run.name, run.type, p.label, p.spanBefore / kUm,
+                       p.spanAfter / kUm, g, f, p.circular ? ecc(p.eccentricityBefore) : "", p.circular ? ecc(p.eccentricityAfter) : "");
+        }
+    fmt::print("(um; span = max - min of dL, R-test: of a displacement component; G = ISO 230-4 circular deviation; "
+               "F = radial deviation)\n");
+    for (const VerifyRun& run : r.runs)
+        for (const VerifyPass& p : run.passes)
+            if (!p.outsideTravel.empty())
+                fmt::print("warning: run '{}' {}: the compensated commands leave the travel: {}\n", run.name, p.label, p.outsideTravel);
+    const VerifyVolumetric& v = r.volumetric;
+    if (v.available)
+        fmt::print("volumetric tool-tip error over the plan's workspace ({} points: {}):\n  max {:.3f} -> {:.3f} um, RMS {:.3f} -> "
+                   "{:.3f} um, tool-axis tilt {:.2f} -> {:.2f} arcsec\n",
+                   v.points, v.note, v.maxBefore / kUm, v.maxAfter / kUm, v.rmsBefore / kUm, v.rmsAfter / kUm,
+                   v.tiltBefore / kArcsec, v.tiltAfter / kArcsec);
+    else
+        fmt::print("volumetric: {}\n", v.note);
+    if (r.remaining.empty()) {
+        fmt::print("deviations left by the compensation: none listed\n");
+    } else {
+        fmt::print("deviations left by the compensation (value in the simulated machine, reason):\n");
+        for (const VerifyRemaining& x : r.remaining)
+            fmt::print("  {:<10} {:>12}  {}\n", x.deviation, x.valueKnown ? fmt::format("{:.3f} {}", x.value, x.unit) : "-", x.reason);
+    }
+    fmt::print("residual (largest span after compensation): {:.3f} um (before: {:.3f} um)\n", r.residual / kUm,
+               r.residualBefore / kUm);
+}
 
 void run(const Options& o) {
     const MachineModel m = readMachineXml(o.machine);
     const MeasurementPlan plan = readPlanXml(o.plan);
-    const DeviationSet truth = readDeviationCsv(o.truth, m);
-    const DeviationSet identified = readDeviationCsv(o.identified, m);
-    const Kinematics nominal(m), actual(m, truth), model(m, identified);
-    const auto rows = verifyRuns(actual, plan.runs, modelCompensation(nominal, model));
-    fmt::print("verification on '{}': ball-bar runs on the true machine, as programmed and compensated with {}\n", m.name,
-               o.identified);
-    fmt::print("{:<16} {:>30}   {:>30}   {:>9} {:>9}\n", "run", "eccentricity before (ex ey ez)", "after (ex ey ez)",
-               "span bef", "span aft");
-    const auto e = [](const Vec3& v) {
-        std::string s;
-        for (int c = 0; c < 3; ++c) s += std::isfinite(v[c]) ? fmt::format("{:10.3f}", v[c] / kUm) : fmt::format("{:>10}", "-");
-        return s;
-    };
-    double worstBefore = 0, worstAfter = 0;
-    for (const auto& r : rows) {
-        fmt::print("{:<16} {}   {}   {:9.3f} {:9.3f}\n", r.run, e(r.eccentricityBefore), e(r.eccentricityAfter),
-                   r.spanBefore / kUm, r.spanAfter / kUm);
-        worstBefore = std::max(worstBefore, r.spanBefore);
-        worstAfter = std::max(worstAfter, r.spanAfter);
+    const std::string source = !o.compensation.empty() ? o.compensation : o.identified;
+    if (source.empty()) throw InputError("--compensation", 0, "give the compensation to verify (deviation CSV or folder)");
+    const auto dialect = testprog::parseProgramDialect(o.dialect);
+    if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (linuxcnc, fanuc, sinumerik, heidenhain)", o.dialect));
+    if (o.maxResidualUm && !(*o.maxResidualUm >= 0)) throw InputError("--max-residual-um", 0, "expected a number >= 0");
+    LoadedCompensation c = loadCompensation(m, plan, source, o.controller);
+    namespace fs = std::filesystem;
+    std::optional<DeviationSet> simulated;
+    std::string simulatedName;
+    if (!o.truth.empty()) {
+        simulated = readDeviationCsv(o.truth, m);
+        simulatedName = fmt::format("true machine ({})", fs::path(o.truth).filename().string());
+    } else if (!o.identified.empty()) {
+        simulated = readDeviationCsv(o.identified, m);
+        simulatedName = fmt::format("identified machine ({}): predicted residual", fs::path(o.identified).filename().string());
+    } else if (c.identified) {
+        simulated = c.identified;
+        simulatedName = fmt::format("identified machine ({}): predicted residual", fs::path(source).filename().string());
+    } else {
+        throw InputError("--truth", 0,
+                         "the machine to simulate is missing: --truth T.csv (simulation) or --identified D.csv (the set the "
+                         "compensation was made from)");
     }
-    fmt::print("largest ΔL span (um): before {:.3f}, after {:.3f}\n", worstBefore / kUm, worstAfter / kUm);
+    VerifyOptions vo;
+    vo.dialect = *dialect;
+    vo.volumetricPerAxis = o.grid;
+    const VerifyResult r = verify(m, plan, *simulated, simulatedName, c.compensation, vo);
+    print(r);
+    if (!o.json.empty()) {
+        refuseToOverwrite(o.json, {o.machine, o.plan, o.truth, o.identified, o.compensation});
+        writeVerifyJson(o.json, r, o.maxResidualUm);
+    }
+    if (o.maxResidualUm) {
+        if (r.residual / kUm > *o.maxResidualUm)
+            throw std::runtime_error(fmt::format("verification failed: residual {:.3f} um is above --max-residual-um {:g}",
+                                                 r.residual / kUm, *o.maxResidualUm));
+        fmt::print("verification passed: residual {:.3f} um <= {:g} um\n", r.residual / kUm, *o.maxResidualUm);
+    }
 }
 
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
-    auto* c = app.add_subcommand("verify", "Re-simulate the plan's ball-bar runs before/after compensating with an identified set");
+    auto* c = app.add_subcommand(
+        "verify",
+        "Run the plan's test programs through the compensation you will load, to the true machine (--truth) or the\n"
+        "identified one, and compare the instrument readings before and after (ISO 230-4 G and F, eccentricity,\n"
+        "dL span), the volumetric error over the plan's workspace, and the deviations left.\n"
+        "--compensation: a deviation CSV (ideal compensation), a folder written by `cnccomp emit` (backend recognised\n"
+        "from the file names, or --controller), or a folder of test programs corrected by `cnccomp correct`.\n"
+        "Exit status: 0 verified (residual at or below --max-residual-um, or no gate); 1 residual above\n"
+        "--max-residual-um (report printed and --json written first; 1 also for an unexpected internal error);\n"
+        "2 bad input (unreadable or unrecognised files, unknown names, commands outside the travel);\n"
+        "105/106/109 command-line usage (invalid value, missing option, unknown option).");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->required()->check(CLI::ExistingFile);
-    c->add_option("--truth", o->truth, "deviations of the real machine (CSV)")->required()->check(CLI::ExistingFile);
-    c->add_option("--identified", o->identified, "identified deviations used for compensation (CSV)")->required()->check(CLI::ExistingFile);
+    c->add_option("--compensation", o->compensation, "deviation CSV, `cnccomp emit` folder or folder of corrected test programs")
+        ->check(CLI::ExistingPath);
+    c->add_option("--controller", o->controller, "backend of the folder's files (default: recognised from the file names)");
+    c->add_option("--truth", o->truth, "deviations of the real machine (CSV): simulate the true machine")->check(CLI::ExistingFile);
+    c->add_option("--identified", o->identified,
+                  "identified deviations (CSV) the compensation was made from: the machine simulated without --truth "
+                  "(alone: the compensation itself, ideal)")
+        ->check(CLI::ExistingFile);
+    c->add_option("--max-residual-um", o->maxResidualUm, "gate: exit status 1 when the residual (largest span after) is above");
+    c->add_option("--json", o->json, "write the result as JSON (schema cnccomp-verify/1)");
+    c->add_option("--dialect", o->dialect, "dialect of the test programs generated in memory (linuxcnc, fanuc, sinumerik, heidenhain)")
+        ->capture_default_str();
+    c->add_option("--volumetric-grid", o->grid, "samples per axis of the volumetric grid")->capture_default_str()->check(CLI::Range(1, 20));
     c->callback([o] { run(*o); });
 });
 

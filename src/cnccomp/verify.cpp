@@ -1,35 +1,327 @@
 #include "cnccomp/verify.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/identification/rtest_run.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
+#include "controllers/common/evaluate.hpp"
+#include "postproc/testprog/read_back.hpp"
+#include "postproc/testprog/test_program.hpp"
 
 namespace cnccomp {
 
-CompensationFactory modelCompensation(const Kinematics& nominal, const Kinematics& identified) {
-    return [&nominal, &identified](const BallbarRun& run) -> CommandMap {
-        const Vec3 tip = nominal.toolPoint(run.RB);
-        return [&nominal, &identified, tip](const AxisVector& q) {
-            const IkResult r = solveToolPose(identified, toolPose(nominal, q, tip), tip, q);
-            return r.converged ? r.q : q;
-        };
-    };
+namespace {
+
+class IdealCompensation final : public controllers::AppliedCompensation {
+public:
+    IdealCompensation(const MachineModel& m, const DeviationSet& d) : nominal_(m), identified_(m, d) {}
+    AxisVector driveCommands(const AxisVector& q) const override { return driveCommandsForTool(q, 0.0); }
+    AxisVector driveCommandsForTool(const AxisVector& q, double toolLength) const override {
+        const Vec3 tip = nominal_.toolPoint(toolLength);
+        const IkResult r = solveToolPose(identified_, toolPose(nominal_, q, tip), tip, q);
+        return r.converged ? r.q : q;
+    }
+
+private:
+    Kinematics nominal_, identified_;
+};
+
+double span(const std::vector<double>& v) {
+    if (v.empty()) return 0;
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    return *hi - *lo;
 }
 
-std::vector<VerifyRow> verifyRuns(const Kinematics& truth, const std::vector<BallbarRun>& runs,
-                                  const CompensationFactory& compensation) {
-    const auto span = [](const BallbarTrace& t) {
-        const auto [lo, hi] = std::minmax_element(t.dL.begin(), t.dL.end());
-        return *hi - *lo;
-    };
-    std::vector<VerifyRow> rows;
-    for (const BallbarRun& run : runs) {
-        const BallbarTrace before = simulateRun(truth, run);
-        const BallbarTrace after = simulateRun(truth, run, compensation(run));
-        rows.push_back({run.name, run.test, traceEccentricity(truth.machine(), run, before),
-                        traceEccentricity(truth.machine(), run, after), span(before), span(after)});
+std::string runType(const testprog::RunMotion& r) {
+    if (r.ballbar) return std::string(testName(r.ballbar->test)) + (r.kind == testprog::RunKind::AbsoluteBallbar ? " absolute" : "");
+    if (r.dbb5)
+        return r.dbb5->kind == Dbb5Run::Kind::LinearCircle ? fmt::format("DBB5 {} circle", r.dbb5->plane)
+                                                           : fmt::format("DBB5 {} circle", r.dbb5->axis);
+    return "R-test";
+}
+
+double barLength(const testprog::RunMotion& r) { return r.ballbar ? r.ballbar->LB : r.dbb5 ? r.dbb5->LB : 0.0; }
+
+/// The commands of one run that reach the drives: setup and the samples of each pass.
+struct RunCommands {
+    AxisVector setup;
+    std::vector<std::string> labels;
+    std::vector<std::vector<double>> t;
+    std::vector<std::vector<AxisVector>> q;
+};
+
+RunCommands samplesOf(const testprog::RunMotion& r, const testprog::ProgramCommands& p) {
+    RunCommands c;
+    c.setup = p.setup;
+    for (const auto& pass : p.passes) {
+        c.labels.push_back(pass.label);
+        c.t.emplace_back();
+        c.q.emplace_back();
+        testprog::passSamples(r, pass, c.t.back(), c.q.back());
     }
-    return rows;
+    return c;
+}
+
+/// Largest excursion beyond an axis' travel along a pass (the commands as they reach the drives).
+struct TravelCheck {
+    int axis = -1, count = 0;
+    double excess = 0, value = 0;
+    void check(const MachineModel& m, const AxisVector& q) {
+        bool out = false;
+        for (int a = 0; a < m.axisCount(); ++a) {
+            const Link& l = m.axisLink(a);
+            const double e = std::max(l.min - q[a], q[a] - l.max);
+            if (!(e > 1e-9) && std::isfinite(q[a])) continue;
+            out = true;
+            if (!(e <= excess)) excess = e, axis = a, value = q[a];
+        }
+        count += out;
+    }
+    std::string describe(const MachineModel& m) const {
+        if (count == 0) return {};
+        const Link& l = m.axisLink(axis);
+        const double s = l.kind == AxisKind::Rotary ? 1 / kDeg : 1.0;
+        const char* u = l.kind == AxisKind::Rotary ? "deg" : "mm";
+        return fmt::format("{} reaches {:.4f} {} (travel {:g} .. {:g} {}) at {} command(s)", m.axisNames[axis], value * s, u,
+                           l.min * s, l.max * s, u, count);
+    }
+};
+
+/// The instrument's readings along one pass on machine k: ΔL of a bar (seed 000 eq. (14); absolute bar: Ball 2 at its
+/// nominal place, seed 002; DBB5, seed 003), or the R-test displacement (seed 001).
+void simulatePass(const Kinematics& k, const Kinematics& nominal, const testprog::RunMotion& r, const AxisVector& setup,
+                  const AxisVector& nominalSetup, const std::vector<double>& t, const std::vector<AxisVector>& q,
+                  BallbarTrace& trace, std::vector<Vec3>& displacement, TravelCheck& travel) {
+    const MachineModel& m = k.machine();
+    travel.check(m, setup);
+    trace.angleDeg = t;
+    trace.dL.assign(q.size(), 0.0);
+    displacement.clear();
+    if (r.rtest) {
+        const Vec3 nest = k.toolPoint(r.rtest->nestLength), ball = r.rtest->ball + r.rtest->ballOffset;
+        for (size_t i = 0; i < q.size(); ++i) {
+            travel.check(m, q[i]);
+            displacement.push_back(rtestDisplacement(k, q[i], ball, nest));
+            trace.dL[i] = displacement.back().norm();
+        }
+        return;
+    }
+    Vec3 tool, ref;
+    double LB = 0;
+    if (r.ballbar) {
+        const BallbarRun& b = *r.ballbar;
+        tool = k.toolPoint(b.RB, b.toolBallOffset);
+        LB = b.LB;
+        ref = r.kind == testprog::RunKind::AbsoluteBallbar
+                  ? nominal.toolPointInWorkpiece(nominalSetup, nominal.toolPoint(b.RB, b.toolBallOffset)) + b.workBallOffset
+                  : k.toolPointInWorkpiece(setup, tool) + b.workBallOffset;  // eq. (11)–(13), (16)
+    } else {
+        tool = k.toolPoint(r.dbb5->toolLength);
+        LB = r.dbb5->LB;
+        ref = k.toolPointInWorkpiece(setup, tool);
+    }
+    for (size_t i = 0; i < q.size(); ++i) {
+        travel.check(m, q[i]);
+        trace.dL[i] = (k.toolPointInWorkpiece(q[i], tool) - ref).norm() - LB;  // eq. (14)
+    }
+}
+
+double displacementSpan(const std::vector<Vec3>& d) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) {
+        std::vector<double> v;
+        for (const Vec3& x : d) v.push_back(x[c]);
+        s = std::max(s, span(v));
+    }
+    return s;
+}
+
+/// ISO 230-4 figures and eccentricity of a ball-bar trace.
+void analyse(const MachineModel& m, const testprog::RunMotion& r, const BallbarTrace& trace, CircularTestResult& iso,
+             Vec3& eccentricity) {
+    iso = evaluateCircularTest(trace, barLength(r));
+    eccentricity = Vec3::Constant(NAN);
+    if (r.ballbar) {
+        eccentricity = traceEccentricity(m, *r.ballbar, trace);
+    } else if (r.dbb5 && r.dbb5->kind == Dbb5Run::Kind::LinearCircle) {
+        const auto [e1, e2] = r.dbb5->planeAxes();
+        eccentricity = iso.center.x() * e1 + iso.center.y() * e2;
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(e1[c]) + std::abs(e2[c]) == 0) eccentricity[c] = NAN;
+    }
+}
+
+void volumetric(const MachineModel& m, const DeviationSet& simulated, const controllers::AppliedCompensation& comp,
+                const std::vector<testprog::RunMotion>& motions, const std::vector<RunCommands>& programmed, int perAxis,
+                VerifyVolumetric& v) {
+    const int n = m.axisCount();
+    AxisVector lo = AxisVector::Constant(n, HUGE_VAL), hi = AxisVector::Constant(n, -HUGE_VAL);
+    for (const RunCommands& c : programmed)
+        for (const auto& pass : c.q)
+            for (const AxisVector& q : pass) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+    std::vector<AxisVector> grid;
+    std::vector<int> idx(n, 0);
+    const int k = std::max(1, perAxis);
+    for (;;) {
+        AxisVector q(n);
+        for (int a = 0; a < n; ++a) q[a] = k == 1 || hi[a] <= lo[a] ? 0.5 * (lo[a] + hi[a]) : lo[a] + (hi[a] - lo[a]) * idx[a] / (k - 1);
+        grid.push_back(q);
+        int a = n - 1;
+        for (; a >= 0; --a) {
+            const int count = hi[a] > lo[a] ? k : 1;
+            if (++idx[a] < count) break;
+            idx[a] = 0;
+        }
+        if (a < 0) break;
+    }
+    for (const auto& r : motions)
+        if (std::find(v.toolLengths.begin(), v.toolLengths.end(), r.toolLength) == v.toolLengths.end())
+            v.toolLengths.push_back(r.toolLength);
+    double sumBefore = 0, sumAfter = 0;
+    for (double L : v.toolLengths) {
+        const auto f = controllers::evaluateCompensation(m, simulated, comp, grid, L);
+        v.maxBefore = std::max(v.maxBefore, f.maxBefore);
+        v.maxAfter = std::max(v.maxAfter, f.maxAfter);
+        v.tiltBefore = std::max(v.tiltBefore, f.maxAxisBefore);
+        v.tiltAfter = std::max(v.tiltAfter, f.maxAxisAfter);
+        sumBefore += f.rmsBefore * f.rmsBefore * f.points;
+        sumAfter += f.rmsAfter * f.rmsAfter * f.points;
+        v.points += f.points;
+    }
+    if (v.points > 0) {
+        v.rmsBefore = std::sqrt(sumBefore / static_cast<double>(v.points));
+        v.rmsAfter = std::sqrt(sumAfter / static_cast<double>(v.points));
+    }
+    v.available = true;
+    std::string box;
+    for (int a = 0; a < n; ++a) {
+        const bool rotary = m.axisLink(a).kind == AxisKind::Rotary;
+        const double s = rotary ? 1 / kDeg : 1.0;
+        box += fmt::format("{}{}={:g}:{:g}", box.empty() ? "" : " ", m.axisNames[a], lo[a] * s, hi[a] * s);
+    }
+    v.note = fmt::format("{} per axis over the commands of the plan's runs ({}), tool lengths", k, box);
+    for (double L : v.toolLengths) v.note += fmt::format(" {:g}", L);
+    v.note += " mm";
+}
+
+}  // namespace
+
+std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const MachineModel& machine,
+                                                                          const DeviationSet& identified) {
+    return std::make_shared<IdealCompensation>(machine, identified);
+}
+
+double VerifyRun::spanBefore() const {
+    double s = 0;
+    for (const auto& p : passes) s = std::max(s, p.spanBefore);
+    return s;
+}
+double VerifyRun::spanAfter() const {
+    double s = 0;
+    for (const auto& p : passes) s = std::max(s, p.spanAfter);
+    return s;
+}
+
+VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const DeviationSet& simulated,
+                    const std::string& simulatedName, const VerifyCompensation& comp, const VerifyOptions& options) {
+    if (comp.kind == VerifyCompensation::Kind::None) throw ModelError("verify: no compensation given");
+    if ((comp.kind == VerifyCompensation::Kind::Deviations || comp.kind == VerifyCompensation::Kind::ControllerFiles) && !comp.model)
+        throw ModelError("verify: the compensation has no controller model");
+    const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
+    testprog::TestProgramOptions po;
+    po.dialect = options.dialect;
+    const testprog::TestProgramSet programs = testprog::makeTestPrograms(m, plan, po);
+    const Kinematics k(m, simulated), nominal(m);
+    VerifyResult out;
+    out.machine = m.name;
+    out.simulated = simulatedName;
+    out.compensation = comp.description;
+    std::vector<RunCommands> programmed;
+    for (size_t i = 0; i < motions.size(); ++i) {
+        const testprog::RunMotion& r = motions[i];
+        const testprog::TestProgram& prog = programs.programs[i];
+        // The commands as written: the program generated in memory, read back by the post-processor.
+        const RunCommands before =
+            samplesOf(r, testprog::readTestProgram(m, r, prog.text, testprog::readerDialect(options.dialect), prog.file));
+        RunCommands after;
+        if (comp.kind == VerifyCompensation::Kind::CorrectedPrograms) {
+            const auto it = std::find_if(comp.programs.begin(), comp.programs.end(), [&](const auto& p) { return p.first == r.name; });
+            if (it == comp.programs.end()) throw InputError(comp.description, 0, fmt::format("no corrected program for run '{}'", r.name));
+            const auto& [file, text] = it->second;
+            after = samplesOf(r, testprog::readTestProgram(m, r, text, comp.programDialect, file));
+        } else {
+            after = before;
+            after.setup = comp.model->driveCommandsForTool(before.setup, r.toolLength);
+            for (auto& pass : after.q)
+                for (AxisVector& q : pass) q = comp.model->driveCommandsForTool(q, r.toolLength);
+        }
+        VerifyRun run;
+        run.name = r.name;
+        run.kind = r.kind;
+        run.type = runType(r);
+        run.LB = barLength(r);
+        run.program = prog.file;
+        for (size_t p = 0; p < before.q.size(); ++p) {
+            size_t pa = p;  // the corrected program's pass in the same direction
+            for (size_t j = 0; j < after.labels.size(); ++j)
+                if (after.labels[j] == before.labels[p]) pa = j;
+            if (pa >= after.q.size() || after.t[pa] != before.t[p])
+                throw InputError(comp.description, 0, fmt::format("run '{}': the corrected program's pass {} does not follow the "
+                                                                  "plan's samples", r.name, before.labels[p]));
+            VerifyPass v;
+            v.label = before.labels[p];
+            TravelCheck travelBefore, travelAfter;
+            simulatePass(k, nominal, r, before.setup, before.setup, before.t[p], before.q[p], v.before, v.displacementBefore,
+                         travelBefore);
+            simulatePass(k, nominal, r, after.setup, before.setup, after.t[pa], after.q[pa], v.after, v.displacementAfter,
+                         travelAfter);
+            v.outsideTravel = travelAfter.describe(m);
+            if (r.rtest) {
+                v.spanBefore = displacementSpan(v.displacementBefore);
+                v.spanAfter = displacementSpan(v.displacementAfter);
+            } else {
+                v.spanBefore = span(v.before.dL);
+                v.spanAfter = span(v.after.dL);
+                if (v.before.dL.size() >= 5) {
+                    v.circular = true;
+                    analyse(m, r, v.before, v.isoBefore, v.eccentricityBefore);
+                    analyse(m, r, v.after, v.isoAfter, v.eccentricityAfter);
+                }
+            }
+            run.passes.push_back(std::move(v));
+        }
+        out.residualBefore = std::max(out.residualBefore, run.spanBefore());
+        out.residual = std::max(out.residual, run.spanAfter());
+        out.runs.push_back(std::move(run));
+        programmed.push_back(before);
+    }
+    if (comp.model) {
+        volumetric(m, simulated, *comp.model, motions, programmed, options.volumetricPerAxis, out.volumetric);
+    } else {
+        out.volumetric.note = "a corrected program compensates its own poses only: no volumetric figure";
+    }
+    for (const controllers::Coverage& c : comp.notCompensated) {
+        VerifyRemaining rem;
+        rem.deviation = c.deviation;
+        rem.reason = c.note;
+        const int d = m.deviationIndex(c.deviation.substr(0, c.deviation.find(' ')));  // "EBB (constant part)" → EBB
+        if (d >= 0) {
+            const DeviationDef& def = m.deviations[static_cast<size_t>(d)];
+            double v = 0;
+            for (int j = 0; j < def.size(); ++j) v = std::max(v, std::abs(simulated.values[def.offset + j]));
+            if (def.size() == 1) v = simulated.values[def.offset];
+            rem.valueKnown = true;
+            rem.value = def.isAngle() ? v / kArcsec : v / kUm;
+            rem.unit = def.isAngle() ? "arcsec" : "um";
+        }
+        out.remaining.push_back(rem);
+    }
+    return out;
 }
 
 }  // namespace cnccomp

@@ -1,30 +1,112 @@
 #pragma once
-// Verification (DESIGN data flow, step 5): the ball-bar runs of a plan re-simulated on the true machine, without and
-// with a compensation, side by side.
+// Verification through what the user loads (issue 9; DESIGN data flow, step 5): the plan's test programs
+// (postproc/testprog, generated in memory and read back through the post-processor, never recomputed) go through a
+// compensation to a machine, and the simulated instrument readings are analysed exactly like measured ones.
+//   compensation: a deviation set (ideal: what a perfect TCP controller or `cnccomp correct` does with it), the
+//   files of `cnccomp emit` (read back by the backend: Backend::apply), or test programs corrected by `cnccomp correct`
+//   (read back by the post-processor and run as they are);
+//   machine: the true one (simulation with --truth) or the identified one (the prediction of what the compensation
+//   leaves on the machine that was measured, given what the controller can hold).
+// Per run and pass (CW, CCW): the ΔL trace before and after, ISO 230-4 circular deviation G and radial deviation F
+// (evaluateCircularTest), eccentricity (seed 000 eq. (14), Table 5 convention), ΔL span; R-test runs: the ball
+// displacement (seed 001). The volumetric tool-tip error over the plan's workspace before and after, and the deviations
+// the compensation leaves, with the backend's reason. A plain struct, for the terminal, --json and the HTML report.
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cnccomp/ballbar.hpp"
+#include "cnccomp/deviations.hpp"
+#include "cnccomp/identification/dbb5_circular.hpp"
+#include "cnccomp/io/plan_xml.hpp"
+#include "controllers/backend.hpp"
+#include "postproc/dialect.hpp"
+#include "postproc/testprog/program_syntax.hpp"
+#include "postproc/testprog/run_motion.hpp"
 
 namespace cnccomp {
 
-/// Builds the command map of a compensation for one run (the run fixes the tool length, RB).
-using CompensationFactory = std::function<CommandMap(const BallbarRun&)>;
-
-/// Ideal model-based compensation (what a TCP controller or `cnccomp correct` does with an identified set): the
-/// commands that put the tool of the `identified` machine where the nominal machine would have it (eq. (7) inverted
-/// by Newton). Commands where the solver does not converge are passed through unchanged.
-CompensationFactory modelCompensation(const Kinematics& nominal, const Kinematics& identified);
-
-struct VerifyRow {
-    std::string run;
-    BallbarTest test = BallbarTest::BX;
-    Vec3 eccentricityBefore, eccentricityAfter;  ///< mm, NaN out of plane
-    double spanBefore = 0, spanAfter = 0;        ///< max ΔL − min ΔL, mm
+/// What the test programs' commands go through before they reach the drives.
+struct VerifyCompensation {
+    enum class Kind { None, Deviations, ControllerFiles, CorrectedPrograms };
+    Kind kind = Kind::None;
+    std::string description;  ///< e.g. "ideal compensation of deviations.csv", "siemens-840d files in DIR"
+    std::string backend;      ///< ControllerFiles: the backend's name
+    /// Deviations / ControllerFiles: the controller with the compensation loaded (drive = model(programmed, tool length)).
+    std::shared_ptr<const controllers::AppliedCompensation> model;
+    /// CorrectedPrograms: run name → (file name, program text), read in `programDialect`.
+    std::vector<std::pair<std::string, std::pair<std::string, std::string>>> programs;
+    pp::Dialect programDialect = pp::Dialect::Rs274ngc;
+    /// What the compensation leaves, and why (the backend's NOT-compensated list).
+    std::vector<controllers::Coverage> notCompensated;
 };
 
-/// Simulates every run of `runs` on `truth`, once as programmed and once through `compensation`.
-std::vector<VerifyRow> verifyRuns(const Kinematics& truth, const std::vector<BallbarRun>& runs,
-                                  const CompensationFactory& compensation);
+/// The ideal compensation of an identified set: drive commands that put the tool of the identified machine where the
+/// nominal machine would have it, solved on the exact model (inverse_kinematics.hpp); unconverged poses pass unchanged.
+std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const MachineModel& machine,
+                                                                          const DeviationSet& identified);
+
+struct VerifyOptions {
+    testprog::ProgramDialect dialect = testprog::ProgramDialect::LinuxCnc;  ///< the in-memory test programs
+    int volumetricPerAxis = 5;  ///< grid over the plan's workspace: samples per axis
+};
+
+/// One pass (direction) of a run, before and after compensation.
+struct VerifyPass {
+    std::string label;                  ///< "CW", "CCW", "forward", "reverse"
+    BallbarTrace before, after;         ///< angle_deg = sweep parameter; dL in mm (R-test: |d| in mm)
+    std::vector<Vec3> displacementBefore, displacementAfter;  ///< R-test: ball − nest, sensor frame, mm
+    bool circular = false;              ///< ISO values below are filled (ball-bar kinds with ≥ 5 samples)
+    CircularTestResult isoBefore, isoAfter;
+    Vec3 eccentricityBefore = Vec3::Constant(NAN), eccentricityAfter = Vec3::Constant(NAN);  ///< mm, machine X Y Z
+    double spanBefore = 0, spanAfter = 0;  ///< mm: max − min ΔL; R-test: largest span of a displacement component
+    /// Non-empty when the compensated commands leave an axis' travel (a real control would stop with a limit alarm);
+    /// the readings are still simulated there.
+    std::string outsideTravel;
+};
+
+struct VerifyRun {
+    std::string name;
+    testprog::RunKind kind = testprog::RunKind::Ballbar;
+    std::string type;      ///< "B-X", "DBB5 XY circle", "R-test", …
+    double LB = 0;         ///< bar length, mm (0 for R-test)
+    std::string program;   ///< the test program's file name
+    std::vector<VerifyPass> passes;
+    double spanBefore() const;
+    double spanAfter() const;
+};
+
+struct VerifyVolumetric {
+    bool available = false;
+    std::string note;           ///< why not, or what the grid was
+    long points = 0;
+    std::vector<double> toolLengths;  ///< mm
+    double maxBefore = 0, rmsBefore = 0, maxAfter = 0, rmsAfter = 0;  ///< tool-tip error, mm
+    double tiltBefore = 0, tiltAfter = 0;                             ///< largest tool-axis error, rad
+};
+
+struct VerifyRemaining {
+    std::string deviation;      ///< name as the backend lists it
+    std::string reason;
+    bool valueKnown = false;    ///< the name is a deviation of the machine
+    double value = 0;           ///< in the simulated machine, display units
+    std::string unit;           ///< "um" or "arcsec"
+};
+
+struct VerifyResult {
+    std::string machine;
+    std::string simulated;      ///< "true machine (T.csv)" / "identified machine (D.csv)"
+    std::string compensation;   ///< VerifyCompensation::description
+    std::vector<VerifyRun> runs;
+    VerifyVolumetric volumetric;
+    std::vector<VerifyRemaining> remaining;
+    double residualBefore = 0;  ///< largest span of any run before compensation, mm
+    double residual = 0;        ///< largest span of any run after compensation, mm (what --max-residual-um gates)
+};
+
+/// Runs the loop. `simulated` is the machine the commands reach (truth or identified); `simulatedName` says which.
+/// Throws ModelError / InputError (a corrected program missing or malformed, commands outside the travel …).
+VerifyResult verify(const MachineModel& machine, const MeasurementPlan& plan, const DeviationSet& simulated,
+                    const std::string& simulatedName, const VerifyCompensation& compensation, const VerifyOptions& options = {});
 
 }  // namespace cnccomp

@@ -1,0 +1,85 @@
+#pragma once
+// NC syntax of the test programs: RS274NGC (LinuxCNC), Fanuc (ISO, O-number programs), Sinumerik (DIN 66025 /
+// Siemens mode) and HEIDENHAIN conversational (Klartext). One writer per dialect behind one interface; every position
+// is given in the controller's machine coordinates (mm, rad; written in mm and degrees).
+// Sources: LinuxCNC G-code reference (G2/G3 with rotary words, G10 L2, G61, G91.1, G4 P seconds, (MSG,) comments);
+// Fanuc 30i operator's manual B-64484EN (G02/G03 helical interpolation with additional axes, G10 L2 Pp, G04 P ms);
+// Sinumerik 840D sl programming manual Fundamentals 6FC5398-1BP40 (G2/G3 with I/J/K incremental, G500, G4 F s, ';');
+// HEIDENHAIN TNC 640 user's manual for Klartext programming 1303406 (BEGIN/END PGM, TOOL CALL, L … R0 FMAX,
+// CC, C … DR+/-, STOP, CYCL DEF 7 datum shift, CYCL DEF 9 dwell). Points not confirmed are marked [G] in the output.
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cnccomp/machine.hpp"
+#include "postproc/dialect.hpp"
+
+namespace cnccomp::testprog {
+
+enum class ProgramDialect { LinuxCnc, Fanuc, Sinumerik, Heidenhain };
+
+/// "linuxcnc" (or "rs274ngc"), "fanuc", "sinumerik" (or "siemens"), "heidenhain" (or "klartext", "tnc"); nullopt otherwise.
+std::optional<ProgramDialect> parseProgramDialect(std::string_view name);
+const char* programDialectName(ProgramDialect d);
+/// File extension with the dot: ".ngc", ".nc", ".mpf", ".h".
+const char* programExtension(ProgramDialect d);
+/// The post-processor dialect that reads such a program back (`cnccomp poses`).
+pp::Dialect readerDialect(ProgramDialect d);
+
+/// Plane of a circular block: 17 (X, Y), 18 (Z, X), 19 (Y, Z).
+struct ArcBlock {
+    int plane = 17;
+    int axis0 = -1, axis1 = -1;  ///< machine axes of the plane
+    double c0 = 0, c1 = 0;       ///< centre, controller coordinates (mm)
+    bool ccw = false;            ///< counter-clockwise seen from the + side of the plane normal (G3, DR+)
+};
+
+class ProgramSyntax {
+public:
+    /// `decimals`: digits after the point of positions (mm and deg).
+    static std::unique_ptr<ProgramSyntax> make(ProgramDialect d, const MachineModel& machine, int decimals);
+    virtual ~ProgramSyntax() = default;
+
+    /// Program start; `number` is the Fanuc O number.
+    virtual void begin(const std::string& name, int number) = 0;
+    virtual void comment(std::string_view text) = 0;
+    /// Metric, absolute, XY plane, no cutter or tool-length compensation, work coordinates = machine coordinates.
+    virtual void init() = 0;
+    /// Rapid move of the axes in `mask` (bit = machine axis) to p (controller coordinates, mm and rad).
+    virtual void rapid(const AxisVector& p, unsigned mask) = 0;
+    /// Straight feed move of every axis to p.
+    virtual void line(const AxisVector& p, double feed) = 0;
+    /// Circular block from the current position to p (every axis; rotary axes turn with the arc's angle).
+    virtual void arc(const AxisVector& p, const ArcBlock& a, double feed) = 0;
+    /// Whether a circular block may carry rotary-axis words (else the caller writes straight blocks).
+    virtual bool arcsWithRotaryAxes() const = 0;
+    virtual void dwell(double seconds) = 0;
+    /// Program stop (M0) with an operator message.
+    virtual void stop(std::string_view message) = 0;
+    virtual void end() = 0;
+    /// Notes on conventions not confirmed for this dialect ([G]), for the header.
+    virtual std::vector<std::string> unconfirmed() const = 0;
+    /// The program text so far.
+    const std::string& text() const { return out_; }
+
+protected:
+    ProgramSyntax(const MachineModel& machine, int decimals) : machine_(machine), decimals_(decimals) {}
+    /// Number with exactly `decimals` digits after the point (a point always); `plus` forces '+'.
+    std::string number(double v, bool plus = false) const;
+    /// Feeds and times: up to three decimals, trailing zeros dropped ("1000", "0.5").
+    static std::string plain(double v);
+    /// Axis words of p for the axes in mask, in X Y Z U V W A B C order: "X12.5 Y0.0 C90.0" (Heidenhain: X+12.5).
+    std::string axisWords(const AxisVector& p, unsigned mask, bool plus) const;
+    unsigned allAxes() const { return machine_.axisCount() >= 32 ? ~0u : (1u << machine_.axisCount()) - 1u; }
+    /// Text for a comment: characters that would end it replaced, upper case where the dialect wants it.
+    static std::string clean(std::string_view text, bool parentheses, bool upper);
+    void emit(const std::string& line) { out_ += line + "\n"; }
+
+    const MachineModel& machine_;
+    int decimals_;
+    std::string out_;
+};
+
+}  // namespace cnccomp::testprog

@@ -1,0 +1,182 @@
+#include "postproc/testprog/read_back.hpp"
+
+#include <sstream>
+#include <strings.h>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "postproc/modal.hpp"
+#include "postproc/poses.hpp"
+
+namespace cnccomp::testprog {
+
+std::vector<PoseRow> readPoses(const MachineModel& m, std::string_view text, pp::Dialect dialect, const std::string& source) {
+    const pp::AxisLayout layout = pp::AxisLayout::fromMachine(m);
+    pp::PosesOptions o;
+    o.dialect = dialect;
+    o.inputName = source;
+    std::istringstream in{std::string(text)};
+    std::ostringstream csv;
+    pp::writePoses(layout, in, csv, o);
+    static constexpr char kColumns[] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
+    std::vector<PoseRow> rows;
+    std::istringstream lines(csv.str());
+    std::string l;
+    std::getline(lines, l);  // header
+    while (std::getline(lines, l)) {
+        std::vector<std::string_view> cells;
+        std::string_view v = l;
+        for (size_t p; (p = v.find(',')) != std::string_view::npos; v.remove_prefix(p + 1)) cells.push_back(v.substr(0, p));
+        cells.push_back(v);
+        if (cells.size() != 8) throw ModelError(fmt::format("{}: unexpected poses row '{}'", source, l));
+        PoseRow r;
+        r.line = static_cast<long>(parseNumber(cells[0]).value_or(0));
+        r.motion = std::string(cells[1]);
+        AxisVector p = AxisVector::Zero(m.axisCount());
+        for (int c = 0; c < 6; ++c) {
+            const int a = m.axisIndex(std::string(1, kColumns[c]));
+            if (a < 0 || cells[2 + c].empty()) continue;
+            const double value = parseNumber(cells[2 + c]).value_or(0.0);
+            p[a] = m.axisLink(a).kind == AxisKind::Rotary ? value * kDeg : value;
+            r.known |= 1u << a;
+        }
+        r.q = m.fromController(p);
+        rows.push_back(std::move(r));
+    }
+    return rows;
+}
+
+namespace {
+
+struct Marker {
+    long line = 0;
+    int pass = 0;
+    bool begin = false;
+    std::string label;
+};
+
+/// A block with a number: ISO "N123 …", Klartext "12 …".
+bool numberedBlock(std::string_view line, pp::Dialect d) {
+    line = trim(line);
+    if (line.empty()) return false;
+    if (d == pp::Dialect::Heidenhain) return std::isdigit(static_cast<unsigned char>(line.front()));
+    return (line.front() == 'N' || line.front() == 'n') && line.size() > 1 && std::isdigit(static_cast<unsigned char>(line[1]));
+}
+
+bool isMove(const PoseRow& r) { return r.motion == "G0" || r.motion == "G1" || r.motion == "G2" || r.motion == "G3"; }
+
+}  // namespace
+
+ProgramCommands readTestProgram(const MachineModel& m, const RunMotion& motion, std::string_view text, pp::Dialect dialect,
+                                const std::string& source) {
+    const std::vector<PoseRow> rows = readPoses(m, text, dialect, source);
+    std::vector<std::string_view> lines;
+    for (std::string_view v = text; !v.empty();) {
+        const size_t e = v.find('\n');
+        lines.push_back(v.substr(0, e));
+        if (e == std::string_view::npos) break;
+        v.remove_prefix(e + 1);
+    }
+    long setupLine = 0;
+    std::vector<Marker> markers;
+    for (size_t i = 0; i < lines.size(); ++i) {
+        const std::string_view l = lines[i];
+        const size_t at = l.find("CNCCOMP ");
+        if (at == std::string_view::npos) continue;
+        std::istringstream words{std::string(l.substr(at + 8))};
+        std::string w1, w2, w3, w4;
+        words >> w1 >> w2 >> w3 >> w4;
+        const long no = static_cast<long>(i) + 1;
+        if (w1.rfind("SETUP", 0) == 0) setupLine = no;
+        if (w1 == "PASS") {
+            Marker mk;
+            mk.line = no;
+            mk.pass = static_cast<int>(parseNumber(w2).value_or(0));
+            mk.begin = w4.rfind("BEGIN", 0) == 0;
+            for (const char* label : {"CW", "CCW", "forward", "reverse"})
+                if (mk.begin && strcasecmp(w3.c_str(), label) == 0) mk.label = label;
+            markers.push_back(mk);
+        }
+    }
+    const unsigned all = m.axisCount() >= 32 ? ~0u : (1u << m.axisCount()) - 1u;
+    const auto complete = [&](const PoseRow& r, long line) {
+        if ((r.known & all) != all)
+            throw InputError(source, static_cast<int>(line), "a sweep point where an axis position is not known");
+        return r.q;
+    };
+    const auto lastMoveBefore = [&](long line, const char* what) -> const PoseRow& {
+        const PoseRow* found = nullptr;
+        for (const PoseRow& r : rows)
+            if (r.line < line && isMove(r)) found = &r;
+        if (!found) throw InputError(source, static_cast<int>(line), fmt::format("no move reaches the {}", what));
+        return *found;
+    };
+    if (setupLine == 0) throw InputError(source, 0, "no 'CNCCOMP SETUP' marker: not a cnccomp test program");
+    ProgramCommands out;
+    const PoseRow& setup = lastMoveBefore(setupLine, "setup pose");
+    out.setup = complete(setup, setup.line);
+    out.setupLine = setup.line;
+    const size_t n = motion.points.size();
+    for (int k = 1; k <= 2; ++k) {
+        const Marker* b = nullptr;
+        const Marker* e = nullptr;
+        for (const Marker& mk : markers)
+            if (mk.pass == k) (mk.begin ? b : e) = &mk;
+        if (!b || !e || e->line < b->line)
+            throw InputError(source, 0, fmt::format("markers 'CNCCOMP PASS {} … BEGIN' and 'CNCCOMP PASS {} END' missing", k, k));
+        PassCommands pass;
+        pass.label = b->label;
+        const PoseRow& first = lastMoveBefore(b->line, "first sweep point");
+        pass.q.push_back(complete(first, first.line));
+        pass.lines.push_back(first.line);
+        // Groups: each numbered block between the markers and the lines that follow it (pieces of a split block).
+        std::vector<long> starts;
+        for (long l = b->line + 1; l < e->line; ++l)
+            if (numberedBlock(lines[static_cast<size_t>(l - 1)], dialect)) starts.push_back(l);
+        for (size_t g = 0; g < starts.size(); ++g) {
+            const long end = g + 1 < starts.size() ? starts[g + 1] : e->line;
+            const PoseRow* last = nullptr;
+            for (const PoseRow& r : rows) {
+                if (r.line < starts[g] || r.line >= end) continue;
+                if (r.motion == "-" || r.motion == "G53")
+                    throw InputError(source, static_cast<int>(r.line), "a block between the sweep markers that cannot be evaluated");
+                if (isMove(r)) last = &r;
+            }
+            if (!last) continue;  // dwell, comment
+            pass.q.push_back(complete(*last, last->line));
+            pass.lines.push_back(last->line);
+        }
+        if (pass.q.size() != n)
+            throw InputError(source, static_cast<int>(b->line),
+                             fmt::format("pass {} reaches {} points, the plan's run '{}' has {}", k, pass.q.size(), motion.name, n));
+        // Direction: the assignment of the plan's points that the commands follow more closely (a whole turn starts
+        // and ends on the same pose, so the whole pass decides).
+        double dForward = 0, dReverse = 0;
+        for (size_t i = 0; i < n; ++i) {
+            dForward += (pass.q[i] - motion.at(motion.points[i])).norm();
+            dReverse += (pass.q[i] - motion.at(motion.points[n - 1 - i])).norm();
+        }
+        const bool forward = dForward <= dReverse;
+        for (size_t i = 0; i < n; ++i) {
+            const size_t idx = forward ? i : n - 1 - i;
+            pass.index.push_back(idx);
+            pass.t.push_back(motion.points[idx]);
+        }
+        out.passes.push_back(std::move(pass));
+    }
+    return out;
+}
+
+void passSamples(const RunMotion& motion, const PassCommands& pass, std::vector<double>& t, std::vector<AxisVector>& q) {
+    t.clear();
+    q.clear();
+    for (size_t i = 0; i < pass.index.size(); ++i)
+        if (pass.index[i] < motion.sampleCount) {
+            t.push_back(pass.t[i]);
+            q.push_back(pass.q[i]);
+        }
+}
+
+}  // namespace cnccomp::testprog

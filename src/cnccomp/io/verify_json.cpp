@@ -1,0 +1,106 @@
+#include "cnccomp/io/verify_json.hpp"
+
+#include <cmath>
+#include <ostream>
+
+#include <fmt/format.h>
+
+#include "cnccomp/io/text_util.hpp"
+
+namespace cnccomp {
+namespace {
+
+std::string str(std::string_view s) {
+    std::string o = "\"";
+    for (char c : s) {
+        switch (c) {
+            case '"': o += "\\\""; break;
+            case '\\': o += "\\\\"; break;
+            case '\n': o += "\\n"; break;
+            case '\t': o += "\\t"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20) o += fmt::format("\\u{:04x}", static_cast<int>(c));
+                else o += c;
+        }
+    }
+    return o + "\"";
+}
+
+std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
+
+std::string um(double mm) { return num(mm / kUm); }
+
+template <class F>
+std::string list(size_t n, F item) {
+    std::string o = "[";
+    for (size_t i = 0; i < n; ++i) o += (i ? ", " : "") + item(i);
+    return o + "]";
+}
+
+std::string iso(const CircularTestResult& r) {
+    return fmt::format("{{\"circular_deviation_G_um\": {}, \"radial_deviation_F_max_um\": {}, \"radial_deviation_F_min_um\": {}, "
+                       "\"mean_radial_error_um\": {}, \"centre_um\": [{}, {}]}}",
+                       um(r.circularity), um(r.radialMax), um(r.radialMin), um(r.meanRadialError), um(r.center.x()),
+                       um(r.center.y()));
+}
+
+std::string vec(const Vec3& v) { return fmt::format("[{}, {}, {}]", um(v.x()), um(v.y()), um(v.z())); }
+
+std::string pass(const VerifyPass& p) {
+    std::string o = fmt::format("{{\"direction\": {}, \"span_before_um\": {}, \"span_after_um\": {}, \"outside_travel\": {}, ",
+                                str(p.label), um(p.spanBefore), um(p.spanAfter), p.outsideTravel.empty() ? "null" : str(p.outsideTravel));
+    o += fmt::format("\"angle_deg\": {}, ", list(p.before.angleDeg.size(), [&](size_t i) { return num(p.before.angleDeg[i]); }));
+    if (!p.displacementBefore.empty()) {
+        o += fmt::format("\"displacement_before_um\": {}, ",
+                         list(p.displacementBefore.size(), [&](size_t i) { return vec(p.displacementBefore[i]); }));
+        o += fmt::format("\"displacement_after_um\": {}", list(p.displacementAfter.size(), [&](size_t i) { return vec(p.displacementAfter[i]); }));
+    } else {
+        o += fmt::format("\"dL_before_um\": {}, ", list(p.before.dL.size(), [&](size_t i) { return um(p.before.dL[i]); }));
+        o += fmt::format("\"dL_after_um\": {}", list(p.after.dL.size(), [&](size_t i) { return um(p.after.dL[i]); }));
+    }
+    if (p.circular)
+        o += fmt::format(", \"iso_before\": {}, \"iso_after\": {}, \"eccentricity_before_um\": {}, \"eccentricity_after_um\": {}",
+                         iso(p.isoBefore), iso(p.isoAfter), vec(p.eccentricityBefore), vec(p.eccentricityAfter));
+    return o + "}";
+}
+
+}  // namespace
+
+std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm) {
+    std::string o = "{\n  \"schema\": \"cnccomp-verify/1\",\n";
+    o += fmt::format("  \"machine\": {},\n  \"simulated\": {},\n  \"compensation\": {},\n", str(r.machine), str(r.simulated),
+                     str(r.compensation));
+    o += fmt::format("  \"residual_before_um\": {},\n  \"residual_um\": {},\n", um(r.residualBefore), um(r.residual));
+    o += fmt::format("  \"max_residual_um\": {},\n  \"passed\": {},\n", gateUm ? num(*gateUm) : "null",
+                     gateUm ? (r.residual / kUm <= *gateUm ? "true" : "false") : "null");
+    o += "  \"runs\": [\n";
+    for (size_t i = 0; i < r.runs.size(); ++i) {
+        const VerifyRun& run = r.runs[i];
+        o += fmt::format("    {{\"name\": {}, \"type\": {}, \"kind\": {}, \"program\": {}, \"LB_mm\": {}, \"span_before_um\": {}, "
+                         "\"span_after_um\": {},\n     \"passes\": {}}}{}\n",
+                         str(run.name), str(run.type), str(testprog::runKindName(run.kind)), str(run.program), num(run.LB),
+                         um(run.spanBefore()), um(run.spanAfter()),
+                         list(run.passes.size(), [&](size_t k) { return pass(run.passes[k]); }), i + 1 < r.runs.size() ? "," : "");
+    }
+    o += "  ],\n";
+    const VerifyVolumetric& v = r.volumetric;
+    o += fmt::format("  \"volumetric\": {{\"available\": {}, \"note\": {}, \"points\": {}, \"tool_lengths_mm\": {}, "
+                     "\"max_before_um\": {}, \"rms_before_um\": {}, \"max_after_um\": {}, \"rms_after_um\": {}, "
+                     "\"tilt_before_arcsec\": {}, \"tilt_after_arcsec\": {}}},\n",
+                     v.available ? "true" : "false", str(v.note), v.points,
+                     list(v.toolLengths.size(), [&](size_t i) { return num(v.toolLengths[i]); }), um(v.maxBefore), um(v.rmsBefore),
+                     um(v.maxAfter), um(v.rmsAfter), num(v.tiltBefore / kArcsec), num(v.tiltAfter / kArcsec));
+    o += fmt::format("  \"remaining\": {}\n}}\n", list(r.remaining.size(), [&](size_t i) {
+                         const VerifyRemaining& x = r.remaining[i];
+                         return fmt::format("{{\"deviation\": {}, \"reason\": {}, \"value\": {}, \"unit\": {}}}", str(x.deviation),
+                                            str(x.reason), x.valueKnown ? num(x.value) : "null", x.valueKnown ? str(x.unit) : "null");
+                     }));
+    return o;
+}
+
+void writeVerifyJson(const std::string& path, const VerifyResult& result, std::optional<double> gateUm) {
+    const std::string text = formatVerifyJson(result, gateUm);
+    writeFileAtomically(path, [&](std::ostream& s) { s << text; });
+}
+
+}  // namespace cnccomp

@@ -1,0 +1,346 @@
+// Test programs (`cnccomp testprog`): every sample plan in every dialect read back through cnccomp's own reader
+// (`poses`, Klartext included) gives the commands the simulation uses; LinuxCNC's own interpreter reads the
+// RS274NGC programs and its canonical moves agree; travel limits; all-or-nothing writing.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/identification/dbb5_run.hpp"
+#include "cnccomp/identification/rtest_run.hpp"
+#include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/plan_xml.hpp"
+#include "postproc/testprog/read_back.hpp"
+#include "postproc/testprog/test_program.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp {
+namespace {
+
+using testprog::ProgramDialect;
+
+constexpr ProgramDialect kDialects[] = {ProgramDialect::LinuxCnc, ProgramDialect::Fanuc, ProgramDialect::Sinumerik,
+                                        ProgramDialect::Heidenhain};
+
+struct SamplePlan {
+    std::string file;
+    MeasurementPlan plan;
+    MachineModel machine;
+};
+
+/// Every plan in samples/plans with the machine it names.
+const std::vector<SamplePlan>& samplePlans() {
+    static const std::vector<SamplePlan> plans = [] {
+        std::vector<SamplePlan> out;
+        for (const auto& e : std::filesystem::directory_iterator(test::sourcePath("samples/plans"))) {
+            SamplePlan s{e.path().filename().string(), readPlanXml(e.path().string()), MachineModel{}};
+            s.machine = readMachineXml(test::sourcePath("samples/machines/" + s.plan.machine + ".xml"));
+            out.push_back(std::move(s));
+        }
+        std::sort(out.begin(), out.end(), [](const SamplePlan& a, const SamplePlan& b) { return a.file < b.file; });
+        return out;
+    }();
+    return plans;
+}
+
+/// Largest difference per axis kind: mm for linear axes, degrees for rotary axes.
+void expectSamePose(const MachineModel& m, const AxisVector& got, const AxisVector& want, const std::string& where) {
+    for (int a = 0; a < m.axisCount(); ++a) {
+        const bool rotary = m.axisLink(a).kind == AxisKind::Rotary;
+        const double d = std::abs(got[a] - want[a]) / (rotary ? kDeg : 1.0);
+        ASSERT_LE(d, 1e-6) << where << " axis " << m.axisNames[a] << (rotary ? " (deg)" : " (mm)");
+    }
+}
+
+/// The commands the simulation uses, straight from the simulation's own functions (not from RunMotion).
+AxisVector simulationCommands(const MachineModel& m, const testprog::RunMotion& r, double t) {
+    if (r.ballbar) return runCommands(m, *r.ballbar, t * kDeg);
+    if (r.dbb5) return dbb5Commands(m, *r.dbb5, t);
+    static std::map<const RtestRun*, std::vector<AxisVector>> cache;
+    auto it = cache.find(r.rtest);
+    if (it == cache.end()) it = cache.emplace(r.rtest, rtestCommands(m, *r.rtest)).first;
+    return it->second[static_cast<size_t>(t)];
+}
+AxisVector simulationSetup(const MachineModel& m, const testprog::RunMotion& r) {
+    if (r.ballbar) return setupCommands(m, *r.ballbar);
+    if (r.dbb5) return dbb5SetupCommands(m, *r.dbb5);
+    return rtestCommands(m, *r.rtest).front();
+}
+std::vector<double> simulationSamples(const testprog::RunMotion& r) {
+    if (r.ballbar) return r.ballbar->anglesDeg();
+    if (r.dbb5) return r.dbb5->anglesDeg();
+    std::vector<double> t;
+    for (int i = 0; i < r.rtest->sampleCount(); ++i) t.push_back(i);
+    return t;
+}
+
+TEST(TestPrograms, EveryDialectReadsBackToTheSimulationsPosesForEverySamplePlan) {
+    // Round trip through an independent reader path: the program text → `poses` (ISO interpreter or Klartext reader)
+    // → commands, against the commands simulate / simulate-runs evaluate (seed 000 Table 2, seed 003, seed 001/004).
+    ASSERT_GE(samplePlans().size(), 8u);
+    for (const SamplePlan& sp : samplePlans()) {
+        const auto motions = testprog::planMotions(sp.machine, sp.plan);
+        for (ProgramDialect d : kDialects) {
+            testprog::TestProgramOptions o;
+            o.dialect = d;
+            const auto set = testprog::makeTestPrograms(sp.machine, sp.plan, o);
+            ASSERT_EQ(set.programs.size(), motions.size());
+            for (size_t i = 0; i < motions.size(); ++i) {
+                const auto& r = motions[i];
+                const std::string where = sp.file + " " + testprog::programDialectName(d) + " run " + r.name;
+                const auto back = testprog::readTestProgram(sp.machine, r, set.programs[i].text, testprog::readerDialect(d), where);
+                expectSamePose(sp.machine, back.setup, simulationSetup(sp.machine, r), where + " setup");
+                const std::vector<double> samples = simulationSamples(r);
+                ASSERT_EQ(back.passes.size(), 2u) << where;
+                for (const auto& pass : back.passes) {
+                    std::vector<double> t;
+                    std::vector<AxisVector> q;
+                    testprog::passSamples(r, pass, t, q);
+                    ASSERT_EQ(t.size(), samples.size()) << where << " pass " << pass.label;
+                    // Every sample of the simulation once per pass, in one direction.
+                    std::vector<double> sorted = t;
+                    std::sort(sorted.begin(), sorted.end());
+                    std::vector<double> want = samples;
+                    std::sort(want.begin(), want.end());
+                    for (size_t k = 0; k < t.size(); ++k) ASSERT_NEAR(sorted[k], want[k], 1e-12) << where;
+                    for (size_t k = 0; k < t.size(); ++k)
+                        expectSamePose(sp.machine, q[k], simulationCommands(sp.machine, r, t[k]),
+                                       where + " pass " + pass.label + " t=" + std::to_string(t[k]));
+                }
+                // CW then CCW for circles, forward then back otherwise.
+                const std::string first = back.passes[0].label, second = back.passes[1].label;
+                EXPECT_TRUE((first == "CW" && second == "CCW") || (first == "forward" && second == "reverse")) << where;
+            }
+        }
+    }
+}
+
+TEST(TestPrograms, BallBarSweepsAreCircularBlocksCwFirstWithOvershootInsideTheTravel) {
+    const SamplePlan* six = nullptr;
+    for (const auto& sp : samplePlans())
+        if (sp.file == "multitasking-six-circles.xml") six = &sp;
+    ASSERT_TRUE(six);
+    const auto set = testprog::makeTestPrograms(six->machine, six->plan, {});
+    for (const auto& p : set.programs) {
+        EXPECT_TRUE(p.arcs) << p.run;
+        EXPECT_EQ(p.firstPass, "CW") << p.run;
+        // C runs: the full 10°; B runs sweep ±180° on a ±185° axis: 5° left.
+        const double expected = p.run.front() == 'B' ? 5.0 : 10.0;
+        EXPECT_NEAR(p.overshootStart, expected, 1e-9) << p.run;
+        EXPECT_NEAR(p.overshootEnd, expected, 1e-9) << p.run;
+        // The first circular block after the capture stop is a G2 (CW), the sweep has one block per sample.
+        const size_t begin = p.text.find("(CNCCOMP PASS 1 CW BEGIN)");
+        ASSERT_NE(begin, std::string::npos);
+        EXPECT_NE(p.text.find(" G2 ", begin), std::string::npos);
+        EXPECT_NE(p.text.find("(CNCCOMP PASS 2 CCW BEGIN)"), std::string::npos);
+    }
+    // The tilting head's absolute runs use the whole B travel: no overshoot is possible.
+    for (const auto& sp : samplePlans())
+        if (sp.file == "tilting-head-b-seed002.xml")
+            for (const auto& p : testprog::makeTestPrograms(sp.machine, sp.plan, {}).programs) {
+                EXPECT_EQ(p.overshootStart, 0.0) << p.run;
+                EXPECT_EQ(p.overshootEnd, 0.0) << p.run;
+            }
+}
+
+// ---- LinuxCNC's interpreter as the oracle ------------------------------------------------------------------------
+
+std::string rs274Path() {
+    for (const char* p : {"/usr/bin/rs274", "/usr/local/bin/rs274"})
+        if (std::filesystem::exists(p)) return p;
+    return {};
+}
+
+struct CanonMove {
+    long line = 0;
+    std::string kind;  ///< STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED
+    double xyzabc[6] = {};
+    int rotation = 0;
+};
+
+/// Parses rs274's canonical calls (saicanon output): positions of every traverse, feed and arc end.
+std::vector<CanonMove> parseCanon(const std::string& text) {
+    std::vector<CanonMove> out;
+    std::istringstream in(text);
+    std::string l;
+    char plane = 'Z';  // normal of the active plane
+    const std::regex call(R"(^\s*\d+\s+N(\S+)\s+([A-Z_]+)\((.*)\))");
+    while (std::getline(in, l)) {
+        std::smatch m;
+        if (!std::regex_search(l, m, call)) continue;
+        const std::string name = m[2];
+        if (name == "SELECT_PLANE") {
+            const std::string a = m[3];
+            plane = a.find("XZ") != std::string::npos ? 'Y' : a.find("YZ") != std::string::npos ? 'X' : 'Z';
+            continue;
+        }
+        if (name != "STRAIGHT_TRAVERSE" && name != "STRAIGHT_FEED" && name != "ARC_FEED") continue;
+        std::vector<double> v;
+        std::stringstream args(m[3].str());
+        for (std::string cell; std::getline(args, cell, ',');) v.push_back(std::stod(cell));
+        CanonMove c;
+        c.kind = name;
+        if (name == "ARC_FEED") {
+            if (v.size() < 9) continue;
+            // ARC_FEED(first_end, second_end, first_centre, second_centre, rotation, axis_end, a, b, c)
+            const int first = plane == 'Z' ? 0 : plane == 'Y' ? 2 : 1, second = plane == 'Z' ? 1 : plane == 'Y' ? 0 : 2;
+            const int normal = plane == 'Z' ? 2 : plane == 'Y' ? 1 : 0;
+            c.xyzabc[first] = v[0];
+            c.xyzabc[second] = v[1];
+            c.xyzabc[normal] = v[5];
+            c.rotation = static_cast<int>(v[4]);
+            for (int k = 0; k < 3; ++k) c.xyzabc[3 + k] = v[6 + k];
+        } else {
+            if (v.size() < 6) continue;
+            for (int k = 0; k < 6; ++k) c.xyzabc[k] = v[k];
+        }
+        out.push_back(c);
+    }
+    return out;
+}
+
+TEST(TestPrograms, LinuxCncInterpreterReadsEveryProgramAndMakesTheSameMoves) {
+    const std::string rs274 = rs274Path();
+    if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace "
+                                       "(tools/deps.sh installs it)";
+    test::ScratchDir dir("testprog-rs274");
+    const std::string tbl = dir.file("tool.tbl");
+    test::writeText(tbl, "");
+    int programs = 0;
+    for (const SamplePlan& sp : samplePlans()) {
+        // These two repeat run types of multitasking-six-circles (B-X, B-Y, C-axial, C-radial) with other geometry.
+        if (sp.file == "lsq-multitasking-b-runs.xml" || sp.file == "lsq-multitasking-mounting.xml") continue;
+        const auto set = testprog::makeTestPrograms(sp.machine, sp.plan, {});
+        for (const auto& p : set.programs) {
+            const std::string ngc = dir.file(p.file), out = dir.file(p.file + ".canon"), log = dir.file(p.file + ".log");
+            test::writeText(ngc, p.text);
+            const std::string cmd = rs274 + " -t " + tbl + " -g " + ngc + " " + out + " < /dev/null > " + log + " 2>&1";
+            const int status = std::system(cmd.c_str());
+            ASSERT_EQ(status, 0) << sp.file << " " << p.file << ": rs274 failed:\n" << test::readText(log);
+            const std::vector<CanonMove> canon = parseCanon(test::readText(out));
+            const auto rows = testprog::readPoses(sp.machine, p.text, pp::Dialect::Rs274ngc, p.file);
+            ASSERT_EQ(canon.size(), rows.size()) << sp.file << " " << p.file;
+            for (size_t i = 0; i < rows.size(); ++i) {
+                const auto& r = rows[i];
+                const AxisVector c = sp.machine.toController(r.q);
+                for (int k = 0; k < 6; ++k) {
+                    const int a = sp.machine.axisIndex(std::string(1, "XYZABC"[k]));
+                    if (a < 0 || !(r.known & (1u << a))) continue;
+                    const double mine = sp.machine.axisLink(a).kind == AxisKind::Rotary ? c[a] / kDeg : c[a];
+                    // rs274 prints four decimals.
+                    ASSERT_NEAR(canon[i].xyzabc[k], mine, 6e-5) << p.file << " line " << r.line << " axis " << "XYZABC"[k];
+                }
+                if (r.motion == "G2") {
+                    EXPECT_EQ(canon[i].rotation, -1) << p.file << " line " << r.line;
+                } else if (r.motion == "G3") {
+                    EXPECT_EQ(canon[i].rotation, 1) << p.file << " line " << r.line;
+                } else if (r.motion == "G0") {
+                    EXPECT_EQ(canon[i].kind, "STRAIGHT_TRAVERSE") << p.file << " line " << r.line;
+                }
+            }
+            ++programs;
+        }
+    }
+    EXPECT_GE(programs, 35);
+}
+
+// ---- Travel limits and writing -------------------------------------------------------------------------------------
+
+TEST(TestPrograms, ARunOutsideTheTravelNamesRunAndAxisAndWritesNothing) {
+    MachineModel m = test::multitasking();
+    for (auto& l : m.tool.links)
+        if (l.name == "X") l.max = 300.0;  // C-X style runs need more; B-X reaches X = 100 + 360
+    m.finalize();
+    const MeasurementPlan plan = readPlanXml(test::sourcePath("samples/plans/multitasking-six-circles.xml"));
+    try {
+        testprog::makeTestPrograms(m, plan, {});
+        FAIL() << "expected a travel error";
+    } catch (const ModelError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("run 'B-X'"), std::string::npos) << what;
+        EXPECT_NE(what.find("axis X"), std::string::npos) << what;
+        EXPECT_NE(what.find("travel"), std::string::npos) << what;
+    }
+    // Through the CLI: exit status 2, and not one file in the output folder.
+    test::ScratchDir dir("testprog-travel");
+    std::string xml = test::readText(test::sourcePath("samples/machines/multitasking.xml"));
+    const std::string from = "min=\"-700\" max=\"700\"";
+    xml.replace(xml.find(from), from.size(), "min=\"-700\" max=\"300\"");
+    test::writeText(dir.file("m.xml"), xml);
+    const auto r = test::runCli("testprog --machine " + dir.file("m.xml") + " --plan " +
+                                test::sourcePath("samples/plans/multitasking-six-circles.xml") + " --out " + dir.file("out"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("run 'B-X'"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out")) && !std::filesystem::is_empty(dir.file("out")));
+}
+
+TEST(TestPrograms, CliWritesOneProgramPerRunAndAnIndexAllOrNothing) {
+    test::ScratchDir dir("testprog-cli");
+    const std::string plan = test::sourcePath("samples/plans/table-table-ac-rtest.xml");
+    const std::string machine = test::sourcePath("samples/machines/table-table-ac.xml");
+    auto r = test::runCli("testprog --machine " + machine + " --plan " + plan + " --dialect heidenhain --out " + dir.file("h"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const std::string index = test::readText(dir.file("h/index.csv"));
+    EXPECT_NE(index.find("1,XYC,R-test,TP01_XYC.h,72,forward"), std::string::npos) << index;
+    const std::string h = test::readText(dir.file("h/TP05_XYZAC.h"));
+    EXPECT_EQ(h.rfind("0 BEGIN PGM TP05_XYZAC MM", 0), 0u) << h.substr(0, 80);
+    EXPECT_NE(h.find("CYCL DEF 9.1 DWELL 1\n"), std::string::npos);
+    EXPECT_NE(h.find("END PGM TP05_XYZAC MM"), std::string::npos);
+    // A folder standing where a program goes: refused before anything is written.
+    std::filesystem::create_directories(dir.file("f/TP03_XYC_A_45.nc"));
+    r = test::runCli("testprog --machine " + machine + " --plan " + plan + " --dialect fanuc --out " + dir.file("f"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("not a regular file"), std::string::npos) << r.out;
+    size_t files = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("f"))) files += e.is_regular_file();
+    EXPECT_EQ(files, 0u);
+    // Unknown dialect: exit 2, named.
+    r = test::runCli("testprog --machine " + machine + " --plan " + plan + " --dialect okuma --out " + dir.file("o"));
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.out.find("okuma"), std::string::npos);
+}
+
+TEST(TestPrograms, ProgramsStartAndEndInTheirDialectsFrame) {
+    const SamplePlan* six = nullptr;
+    for (const auto& sp : samplePlans())
+        if (sp.file == "multitasking-six-circles.xml") six = &sp;
+    ASSERT_TRUE(six);
+    const auto motions = testprog::planMotions(six->machine, six->plan);
+    const auto text = [&](ProgramDialect d) {
+        testprog::TestProgramOptions o;
+        o.dialect = d;
+        return testprog::makeTestProgram(six->machine, motions[3], 4, o).text;
+    };
+    const std::string fanuc = text(ProgramDialect::Fanuc);
+    EXPECT_EQ(fanuc.rfind("%\nO1004 (TP04_C_RADIAL)\n", 0), 0u) << fanuc.substr(0, 40);
+    EXPECT_NE(fanuc.find("G10 L2 P1 X0.000000 Y0.000000 Z0.000000 B0.000000 C0.000000"), std::string::npos);
+    EXPECT_EQ(fanuc.substr(fanuc.size() - 2), "%\n");
+    const std::string siemens = text(ProgramDialect::Sinumerik);
+    EXPECT_NE(siemens.find("G500"), std::string::npos);
+    EXPECT_NE(siemens.find("; CNCCOMP PASS 1 CW BEGIN"), std::string::npos);
+    const std::string ngc = text(ProgramDialect::LinuxCnc);
+    EXPECT_NE(ngc.find("(MSG, MOUNT THE BAR"), std::string::npos);
+    EXPECT_NE(ngc.find(" G2 X"), std::string::npos) << "C-radial circles: XY plane, CW first";
+    EXPECT_EQ(ngc.find("G18"), std::string::npos);
+    const std::string h = text(ProgramDialect::Heidenhain);
+    EXPECT_EQ(h.find(" CC X"), std::string::npos) << "C turns with the circle: straight blocks on a TNC [G]";
+    EXPECT_NE(h.find(" L X+"), std::string::npos);
+    // A DBB5 linear circle has no rotary axis in it: CC and C blocks, clockwise first.
+    for (const auto& sp : samplePlans())
+        if (sp.file == "dbb5-table-table-ac.xml") {
+            testprog::TestProgramOptions o;
+            o.dialect = ProgramDialect::Heidenhain;
+            const auto p = testprog::makeTestProgram(sp.machine, testprog::planMotions(sp.machine, sp.plan)[0], 1, o);
+            EXPECT_TRUE(p.arcs);
+            EXPECT_NE(p.text.find(" CC X+0.000000 Y+0.000000"), std::string::npos);
+            EXPECT_NE(p.text.find(" DR- R0"), std::string::npos);
+        }
+}
+
+}  // namespace
+}  // namespace cnccomp
