@@ -80,7 +80,7 @@ TEST(Dbb5Circular, NominalMachineGivesZeroAndSquarenessGivesTheEllipse) {
         for (double v : simulateDbb5(Kinematics(mach), r).dL) EXPECT_LT(std::abs(v), 1e-10) << r.name;
     // EC0Y alone: ΔL = (γ·LB/2)·sin 2θ (ISO 230-4 out-of-squareness).
     DeviationSet d(mach);
-    d.set("EC0Y", 10 * kArcsec);
+    d.setLinkValue("EC0Y", 10 * kArcsec);  // the X slide turned by γ (ISO EC0Y = −γ)
     const CircularTestResult r = evaluateCircularTest(simulateDbb5(Kinematics(mach, d), xy), xy.LB);
     EXPECT_NEAR(2 * r.b2 / xy.LB, 10 * kArcsec, 1e-4 * kArcsec);
     EXPECT_NEAR(r.circularity, 10 * kArcsec * xy.LB, 0.001 * kUm);
