@@ -1,209 +1,132 @@
-// cnccomp identify: deviations from ball-bar measurements — general least squares on the raw traces (default,
-// issue 3) or the closed-form formulas of seed 000 (--method closed-form).
+// cnccomp identify: the machine's deviations from any measurement plan. The kinds of runs in the plan choose what is
+// measured (ball-bar circles, head patterns, R-test location or tables, DBB5; --measure overrides), --method how:
+// least squares on the exact model (default, the most accurate) or the formulas of the paper the measurement comes
+// from. Every output is written after every computation succeeded.
 #include <algorithm>
-#include <cmath>
 
 #include <fmt/format.h>
 
 #include "cli/command.hpp"
+#include "cli/identify_methods.hpp"
 #include "cli/print.hpp"
-#include "cnccomp/closed_form.hpp"
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/eccentricity_observation.hpp"
-#include "cnccomp/identification/lsq.hpp"
-#include "cnccomp/identification/parameters.hpp"
-#include "cnccomp/identification/plan_observations.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
-#include "cnccomp/io/eccentricity_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/text_util.hpp"
-#include "cnccomp/io/trace_csv.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string method = "least-squares";
-    std::string machine, eccentricities, traces, plan, out;
-    int refine = 3;
-    // least squares
-    std::string params = "all", report, solver = "lm", bounds, start, observe = "traces";
-    int monteCarlo = 0, maxIterations = 50;
-    unsigned long seed = 1;
-    double rankTolerance = 1e-7;
+    IdentifyRequest request;
+    std::string method = "least-squares", measure, machine, plan, out, report, truth;
+    std::string anglesOut, volumetricOut, isoOut;
 };
 
-void runClosedForm(const Options& o, const MachineModel& m) {
-    refuseToOverwrite(o.out, {o.machine, o.eccentricities, o.plan});
-    std::vector<EccentricityRow> rows;
-    if (!o.eccentricities.empty()) {
-        if (!o.traces.empty()) throw ModelError("give either --eccentricities or --traces with --plan, not both");
-        rows = readEccentricityCsv(o.eccentricities);
-    } else {
-        if (o.traces.empty() || o.plan.empty())
-            throw ModelError("closed form needs --eccentricities E.csv, or --traces DIR with --plan P.xml");
-        const MeasurementPlan plan = readPlanXml(o.plan);
-        rows = eccentricitiesFromTraces(m, plan.runs, readRunTraces(o.traces, plan.runs));
-    }
-    if (o.refine < 0 || o.refine > 20) throw ModelError("--refine takes 0..20 passes");
-    const DeviationSet d = identifyClosedForm(m, rows, {o.refine, 1.0});
-    writeDeviationCsv(o.out, d);
-    fmt::print("identified {} deviations of '{}' (closed form, seed 000 eq. (17)-(28)) -> {}\n",
-               std::count(d.present.begin(), d.present.end(), 1), m.name, o.out);
-    printDeviations(d, nullptr);
-}
-
-/// "dxBT=-20:10, EB0B=-5:5" (µm for lengths, arcsec for angles) → bounds in internal units.
-std::vector<ParameterBound> parseBounds(const MachineModel& m, const std::string& text) {
-    std::vector<ParameterBound> out;
-    size_t pos = 0;
-    while (pos < text.size()) {
-        size_t end = text.find(',', pos);
-        if (end == std::string::npos) end = text.size();
-        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
-        pos = end + 1;
-        if (item.empty()) continue;
-        const size_t eq = item.find('='), colon = item.find(':', eq == std::string::npos ? 0 : eq);
-        if (eq == std::string::npos || colon == std::string::npos)
-            throw ModelError(fmt::format("--bounds item '{}': expected NAME=LOWER:UPPER (um or arcsec)", item));
-        const std::string name(trim(std::string_view(item).substr(0, eq)));
-        const auto lo = parseNumber(trim(std::string_view(item).substr(eq + 1, colon - eq - 1)));
-        const auto hi = parseNumber(trim(std::string_view(item).substr(colon + 1)));
-        if (!lo || !hi) throw ModelError(fmt::format("--bounds item '{}': bounds must be numbers", item));
-        std::string base = name.substr(0, name.find('['));
-        const int di = m.deviationIndex(base);
-        // Nuisance names ("run.xT") are lengths; deviations take their own unit.
-        const double unit = di >= 0 && m.deviations[di].isAngle() ? kArcsec : kUm;
-        if (di < 0 && name.find('.') == std::string::npos)
-            throw ModelError(fmt::format("--bounds: unknown deviation '{}' for machine '{}'", name, m.name));
-        out.push_back({name, *lo * unit, *hi * unit});
-    }
-    return out;
-}
-
-std::string cell(double v, double scale, int width = 10, int prec = 4) {
-    return std::isfinite(v) ? fmt::format("{:{}.{}f}", v / scale, width, prec) : fmt::format("{:>{}}", "-", width);
-}
-
-void printReport(const IdentificationReport& r) {
-    fmt::print("{}: {} after {} iteration(s); cost {:.6g} -> {:.6g} um^2; rank {}/{}, condition number {:.4g}, "
-               "sigma {} um\n",
-               r.solver, r.termination, r.iterations, r.costBefore, r.costAfter, r.rank, r.unknowns,
-               r.conditionNumber, std::isfinite(r.sigma) ? fmt::format("{:.4f}", r.sigma / kUm) : "-");
-    const bool mc = r.monteCarloSamples > 0;
-    fmt::print("{:<14} {:<8} {:>12} {:>10} {:>10} {:>10}{}  {}\n", "name", "alias", "value", "std", "low95", "high95",
-               mc ? fmt::format(" {:>10} {:>10} {:>10}", "mc std", "mc low95", "mc high95") : "", "unit");
-    for (const ParameterEstimate& p : r.parameters) {
-        const double s = p.displayScale();
-        if (!p.identified) {
-            fmt::print("{:<14} {:<8} {:>12} {:>10} {:>10} {:>10}  {}\n", p.name, p.alias, "unidentified", "-", "-", "-",
-                       p.unit());
-            continue;
-        }
-        fmt::print("{:<14} {:<8} {} {} {} {}{}  {}\n", p.name, p.alias, cell(p.value, s, 12), cell(p.stddev, s),
-                   cell(p.lower95, s), cell(p.upper95, s),
-                   mc ? fmt::format(" {} {} {}", cell(p.mcStddev, s), cell(p.mcLower95, s), cell(p.mcUpper95, s)) : "",
-                   p.unit());
-    }
-    if (!r.identifiable.empty()) {
-        fmt::print("identifiable combinations of the unidentified parameters (coefficients in mm, rad):\n");
-        for (const Combination& c : r.identifiable)
-            fmt::print("  {} = {} ± {} {}  (identifiable, not each term)\n", c.text,
-                       cell(c.value, c.angle ? kArcsec : kUm, 0), cell(c.stddev, c.angle ? kArcsec : kUm, 0),
-                       c.angle ? "arcsec" : "um");
-    }
-    if (!r.unobservable.empty()) {
-        fmt::print("directions these measurements cannot see:\n");
-        for (const Combination& c : r.unobservable) fmt::print("  {}\n", c.text);
-    }
-    fmt::print("{:<18} {:>8} {:>14} {:>14}\n", "run", "samples", "rms before um", "rms after um");
-    for (const RunResidual& rr : r.runs)
-        fmt::print("{:<18} {:>8} {:>14.4f} {:>14.4f}\n", rr.run, rr.samples, rr.rmsBefore / kUm, rr.rmsAfter / kUm);
-    for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
-}
-
-void runLeastSquares(const Options& o, const MachineModel& m) {
-    if (!o.eccentricities.empty())
-        throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (eccentricities are "
-                         "for --method closed-form)");
-    if (o.traces.empty() || o.plan.empty()) throw ModelError("least squares needs --traces DIR and --plan P.xml");
-    refuseToOverwrite(o.out, {o.machine, o.plan, o.start});
-    if (!o.report.empty()) {
-        refuseToOverwrite(o.report, {o.machine, o.plan, o.start, o.out});
-    }
-    const MeasurementPlan plan = readPlanXml(o.plan);
-    Observations obs;
-    if (o.observe == "eccentricity") {
-        if (plan.runCount() != plan.runs.size())
-            throw ModelError("--observe eccentricity works on ball-bar <run> elements only");
-        obs = eccentricityObservations(m, plan.runs, readRunTraces(o.traces, plan.runs));
-    } else if (o.observe == "traces") {
-        obs = planObservations(m, plan, o.traces);
-    } else {
-        throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", o.observe));
-    }
-    IdentifyOptions io;
-    io.deviations = parseDeviationList(m, o.params);
-    io.solver = o.solver;
-    io.maxIterations = o.maxIterations;
-    io.rankTolerance = o.rankTolerance;
-    io.monteCarlo = o.monteCarlo;
-    io.seed = o.seed;
-    io.bounds = parseBounds(m, o.bounds);
-    if (!o.start.empty()) io.start = readDeviationCsv(o.start, m);
-    const IdentificationResult r = identify(m, obs, io);
-    writeDeviationCsv(o.out, r.deviations);
-    if (!o.report.empty()) writeReportJson(o.report, r.report);
-    const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
-                                          [&](int i) { return r.deviations.present[i] != 0; });
-    fmt::print("identified {} of {} requested deviations of '{}' (least squares on {} samples of {} runs) -> {}{}\n",
-               identified, io.deviations.size(), m.name, r.report.observations, plan.runCount(), o.out,
-               o.report.empty() ? "" : ", report -> " + o.report);
-    printReport(r.report);
-}
-
-void run(const Options& o) {
+void run(Options o) {
     const MachineModel m = readMachineXml(o.machine);
-    if (o.method == "closed-form") return runClosedForm(o, m);
-    if (o.method != "least-squares" && o.method != "lsq")
-        throw ModelError(fmt::format("unknown --method '{}' (least-squares, closed-form)", o.method));
-    runLeastSquares(o, m);
+    IdentifyRequest& r = o.request;
+    r.machine = &m;
+    if (o.method == "formulas" || o.method == "closed-form") r.formulas = true;
+    else if (o.method != "least-squares" && o.method != "lsq")
+        throw ModelError(fmt::format("unknown --method '{}' (least-squares, formulas)", o.method));
+    std::optional<MeasurementPlan> plan;
+    if (!o.plan.empty()) {
+        plan = readPlanXml(o.plan);
+        r.plan = &*plan;
+        r.kind = choosePlanMethod(*plan, o.measure);
+    } else if (!o.measure.empty() && o.measure != "ball-bar") {
+        throw ModelError("--measure needs the plan (--plan P.xml)");
+    }
+    // Outputs: never an input, never twice.
+    const std::vector<std::pair<std::string, std::string>> outputs{
+        {"--out", o.out}, {"--report", o.report}, {"--angles-out", o.anglesOut}, {"--volumetric-out", o.volumetricOut},
+        {"--iso-out", o.isoOut}};
+    for (size_t i = 0; i < outputs.size(); ++i) {
+        if (outputs[i].second.empty()) continue;
+        refuseToOverwrite(outputs[i].second, {o.machine, o.plan, o.truth, r.start, r.eccentricities});
+        for (size_t j = 0; j < i; ++j)
+            if (outputs[j].second == outputs[i].second)
+                throw ModelError(fmt::format("{} and {} name the same file '{}'", outputs[j].first, outputs[i].first,
+                                             outputs[i].second));
+    }
+    if (!o.volumetricOut.empty() && r.volumetricRun.empty()) throw ModelError("--volumetric-out needs --volumetric RUN");
+    const std::optional<DeviationSet> truth =
+        o.truth.empty() ? std::nullopt : std::optional<DeviationSet>(readDeviationCsv(o.truth, m));
+
+    IdentifyOutcome res = runIdentification(r);
+    if (!o.report.empty() && !res.report)
+        throw ModelError(fmt::format("--report: the {} of '{}' writes no least-squares report",
+                                     r.formulas ? "formulas" : "method", planMethodName(r.kind)));
+    std::vector<std::pair<std::string, const ExtraOutput*>> extras;
+    for (const auto& [option, path] : outputs) {
+        if (path.empty() || option == "--out" || option == "--report") continue;
+        const auto it = std::find_if(res.extras.begin(), res.extras.end(), [&](const ExtraOutput& e) { return e.option == option; });
+        if (it == res.extras.end())
+            throw ModelError(fmt::format("{} does not apply to the {} method", option, planMethodName(r.kind)));
+        extras.emplace_back(path, &*it);
+    }
+
+    // Everything is computed: write.
+    writeDeviationCsv(o.out, res.deviations);
+    if (!o.report.empty()) writeReportJson(o.report, *res.report);
+    for (const auto& [path, e] : extras) e->write(path);
+
+    fmt::print("{} -> {}\n", res.summary, o.out);
+    if (res.report) printReport(*res.report);
+    printDeviations(res.deviations, truth ? &*truth : nullptr);
 }
 
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
-    auto* c = app.add_subcommand("identify", "Identify the machine's deviations from ball-bar measurements");
-    c->add_option("--method", o->method,
-                  "least-squares (exact model, raw traces) or closed-form (seed 000 eq. (17)-(28))")
-        ->capture_default_str();
+    IdentifyRequest& r = o->request;
+    auto* c = app.add_subcommand(
+        "identify",
+        "Identify the machine's deviations from the runs of a plan. The plan's runs choose what is measured: ball-bar "
+        "circles, head patterns (absolute ball bar, two tool lengths), R-test location or tables, DBB5 circles");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
-    c->add_option("--eccentricities", o->eccentricities, "eccentricity CSV (closed form)")->check(CLI::ExistingFile);
-    c->add_option("--traces", o->traces, "folder of trace CSVs, one <run>.csv per run")->check(CLI::ExistingDirectory);
     c->add_option("--plan", o->plan, "measurement plan XML")->check(CLI::ExistingFile);
-    c->add_option("--out", o->out, "deviation CSV to write")->required();
-    c->add_option("--refine", o->refine,
-                  "closed form: defect-correction passes on the exact model (0 = the paper's formulas only)")
+    c->add_option("--traces", r.traces, "folder of the measured runs, one <run>.csv per run")->check(CLI::ExistingDirectory);
+    c->add_option("--out", o->out, "deviation CSV to write (ISO names and values, paper aliases)")->required();
+    c->add_option("--method", o->method,
+                  "least-squares (exact model, every sample; the most accurate) or formulas (the paper's formulas of the "
+                  "measurement, e.g. the ball-bar eccentricity formulas; closed-form is the same)")
         ->capture_default_str();
-    c->add_option("--params", o->params, "least squares: deviations to identify, ISO names or aliases (comma list), or all")
-        ->capture_default_str();
-    c->add_option("--observe", o->observe,
-                  "least squares: traces (every raw sample) or eccentricity (fitted circle centres of ball-bar runs)")
+    c->add_option("--measure", o->measure,
+                  "override what the plan measures: ball-bar, head-patterns, rtest-location, rtest-tables, dbb5, mixed");
+    c->add_option("--eccentricities", r.eccentricities, "ball-bar formulas: eccentricity CSV instead of --traces/--plan")
+        ->check(CLI::ExistingFile);
+    c->add_option("--refine", r.refine,
+                  "formulas: refinement passes on the exact model (0 = the printed formulas; default 3 for ball-bar "
+                  "eccentricities, 4 for R-test and DBB5 fits)");
+    c->add_option("--params", r.params,
+                  "least squares: deviations to identify, ISO names or aliases (comma list) or all; default: all for "
+                  "ball-bar and mixed plans, the eleven location and squareness errors for R-test location and DBB5");
+    c->add_option("--observe", r.observe,
+                  "least squares on ball-bar runs: traces (every raw sample) or eccentricity (fitted circle centres)")
         ->capture_default_str();
     c->add_option("--report", o->report, "least squares: JSON report to write");
-    c->add_option("--solver", o->solver, "least squares: lm (Levenberg-Marquardt) or nlopt:<ALGORITHM>, e.g. nlopt:LD_SLSQP")
+    c->add_option("--solver", r.solver, "least squares: lm (Levenberg-Marquardt) or nlopt:<ALGORITHM>, e.g. nlopt:LD_SLSQP")
         ->capture_default_str();
-    c->add_option("--bounds", o->bounds, "NLopt: NAME=LOWER:UPPER,... in um / arcsec (default +-1000)");
-    c->add_option("--start", o->start,
-                  "least squares: deviation CSV with starting values; deviations not in --params keep these values")
+    c->add_option("--bounds", r.bounds, "NLopt: ISO-NAME=LOWER:UPPER,... in um / arcsec (default +-1000)");
+    c->add_option("--start", r.start, "least squares: deviation CSV with starting values; deviations not estimated keep them")
         ->check(CLI::ExistingFile);
-    c->add_option("--monte-carlo", o->monteCarlo, "least squares: number of resampled solutions for sampled intervals");
-    c->add_option("--seed", o->seed, "random seed for --monte-carlo");
-    c->add_option("--max-iterations", o->maxIterations, "least squares: iteration limit")->capture_default_str();
-    c->add_option("--rank-tolerance", o->rankTolerance,
+    c->add_option("--monte-carlo", r.monteCarlo, "least squares: number of resampled solutions for sampled intervals");
+    c->add_option("--seed", r.seed, "random seed for --monte-carlo");
+    c->add_option("--max-iterations", r.maxIterations, "least squares: iteration limit")->capture_default_str();
+    c->add_option("--rank-tolerance", r.rankTolerance,
                   "relative singular value below which a direction counts as unobservable")
         ->capture_default_str();
+    c->add_option("--outer", r.outer, "R-test / DBB5: tilting (outer) rotary axis (default: the machine's first table axis)");
+    c->add_option("--inner", r.inner, "R-test / DBB5: rotary table (inner) axis (default: the machine's second table axis)");
+    c->add_option("--angles-out", o->anglesOut, "head patterns: CSV of the head's five errors at every measured angle");
+    c->add_option("--volumetric", r.volumetricRun,
+                  "R-test location: run along which to compare the measured displacement with the identified model's");
+    c->add_option("--volumetric-out", o->volumetricOut, "CSV of that comparison");
+    c->add_option("--iso-out", o->isoOut, "DBB5: CSV of the ISO 230-4 figures of every run");
+    c->add_option("--truth", o->truth, "deviation CSV to print next to the result")->check(CLI::ExistingFile);
     c->callback([o] { run(*o); });
 });
 

@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/seed001_axis_line.hpp"
-#include "cnccomp/identification/seed001_refine.hpp"
+#include "cnccomp/identification/axis_line.hpp"
+#include "cnccomp/identification/reading_refinement.hpp"
 
 namespace cnccomp {
 

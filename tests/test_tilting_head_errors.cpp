@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "test_support.hpp"
@@ -28,7 +28,7 @@ struct Fixture {
 const Fixture& seed002() {
     static const Fixture f = [] {
         const MachineModel& m = head();
-        Fixture x{readPlanXml(test::sourcePath("samples/plans/tilting-head-b-seed002.xml")),
+        Fixture x{readPlanXml(test::sourcePath("samples/plans/tilting-head-b-patterns.xml")),
                   readDeviationCsv(test::sourcePath("samples/deviations/tilting-head-b-truth.csv"), m), {}};
         const Kinematics k(m, x.truth);
         for (const BallbarRun& r : x.plan.absoluteRuns) x.traces.push_back(simulateAbsoluteRun(k, r));
@@ -43,7 +43,7 @@ double truthAt(const DeviationSet& t, const std::string& name, double deg) {
     return d.basis.evaluate(deg * kDeg, t.values.data() + d.offset, false);
 }
 
-TEST(Seed002TiltingHead, FirstOrderPatternEquationsHold) {
+TEST(TiltingHeadErrors, FirstOrderPatternEquationsHold) {
     // One error at a time: eq. (4) (Y pattern), (13) (X), (20) (Z) against the exact absolute ΔL.
     const MachineModel& m = head();
     const double L = 250, B = 37 * kDeg, c = std::cos(B), s = std::sin(B);
@@ -79,7 +79,7 @@ TEST(Seed002TiltingHead, FirstOrderPatternEquationsHold) {
     EXPECT_NEAR(dL(withTable("EZB", u), BallbarTest::BZ), c * u, 1e-3 * kUm);
 }
 
-TEST(Seed002TiltingHead, FormulasRecoverTheHeadErrorsAtEveryAngle) {
+TEST(TiltingHeadErrors, FormulasRecoverTheHeadErrorsAtEveryAngle) {
     const Fixture& f = seed002();
     const TiltingHeadResult r = tiltingHeadFormulas(f.plan.absoluteRuns, f.traces);
     ASSERT_EQ(r.angles.size(), 17u);
@@ -102,7 +102,7 @@ TEST(Seed002TiltingHead, FormulasRecoverTheHeadErrorsAtEveryAngle) {
     EXPECT_NEAR(d.values[ey.offset + 8], r.angles[8].ey, 1e-15);  // node 0 deg
 }
 
-TEST(Seed002TiltingHead, LeastSquaresRecoversTheTruthExactly) {
+TEST(TiltingHeadErrors, LeastSquaresRecoversTheTruthExactly) {
     const Fixture& f = seed002();
     const TiltingHeadLsq r = tiltingHeadLeastSquares(head(), f.plan.absoluteRuns, f.traces);
     EXPECT_TRUE(r.engine.report.unidentified.empty());
@@ -126,7 +126,7 @@ TEST(Seed002TiltingHead, LeastSquaresRecoversTheTruthExactly) {
                 0.001 * kArcsec);
 }
 
-TEST(Seed002TiltingHead, MissingPatternIsNamed) {
+TEST(TiltingHeadErrors, MissingPatternIsNamed) {
     const Fixture& f = seed002();
     std::vector<BallbarRun> runs(f.plan.absoluteRuns.begin(), f.plan.absoluteRuns.begin() + 4);
     std::vector<BallbarTrace> traces(f.traces.begin(), f.traces.begin() + 4);
