@@ -16,6 +16,11 @@
 //    the carrier's frame at its zero position (ISO's EX(0A)C notation); a fixed link (spindle, table) relative to
 //    the link it sits on. Then the name's value is the link's own error component.
 // Names that do not follow the pattern, or whose target is not a link, mean the link's own error component.
+// Sources: ISO 230-1:2012 section 3.6.7 (squareness: the difference between the inclinations of the reference straight
+// lines of two axes), as quoted in M.A.V. Chapman, "Calibration of machine squareness", Renishaw white paper TE328;
+// the E<e>0<axis> notation of the location errors as listed in Beckhoff TF5280 "List of parameters supported (DIN ISO
+// 230)" (infosys.beckhoff.com); the rotation sign (right-hand rule) and the X-primary/Y-secondary reference are the
+// usual reading of the standard, not quoted from it [G].
 // The paper aliases are aliasSign × link value (DeviationDef::aliasSign, machine XML `alias-sign`).
 // Component errors (EXX …) are the link's own error functions under either name.
 #include <string>
