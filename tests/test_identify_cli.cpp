@@ -121,6 +121,10 @@ TEST(IdentifyCli, BadInputFailsCleanlyWithoutOutputFiles) {
     r = test::runCli(base + " --bounds dxCZ=5" + outs);
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.out.find("NAME=LOWER:UPPER"), std::string::npos) << r.out;
+    // The unknowns are ISO values: a bound under an alias of another sign (gXY = −EC0Y) is refused, not flipped.
+    r = test::runCli(base + " --solver nlopt:LD_SLSQP --params gXY,dxCZ --bounds gXY=-5:5" + outs);
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("under the ISO name 'EC0Y'"), std::string::npos) << r.out;
     std::filesystem::remove(traces + "/C-axial.csv");
     r = test::runCli(base + outs);
     EXPECT_NE(r.exitCode, 0);
