@@ -43,7 +43,7 @@ inline DeviationSet randomLocationErrors(const MachineModel& m, unsigned seed, d
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
     for (const auto& def : m.deviations)
-        if (def.kind == DeviationKind::Location) d.set(def.name, def.isAngle() ? u(rng) * arcsec * kArcsec : u(rng) * um * kUm);
+        if (def.kind == DeviationKind::Location) d.setLinkValue(def.name, def.isAngle() ? u(rng) * arcsec * kArcsec : u(rng) * um * kUm);
     return d;
 }
 
@@ -93,7 +93,7 @@ inline DeviationSet tableXErrors(const MachineModel& m) {
         const int di = static_cast<int>(&def - m.deviations.data());
         if (def.kind == DeviationKind::Location) {
             const double v = (i % 2 ? -1.0 : 1.0) * (6.0 + 2.0 * i);
-            d.set(def.name, def.isAngle() ? v * kArcsec : v * kUm);
+            d.setLinkValue(def.name, def.isAngle() ? v * kArcsec : v * kUm);
             ++i;
             continue;
         }
@@ -112,7 +112,7 @@ inline DeviationSet patternedLocationErrors(const MachineModel& m) {
     for (const auto& def : m.deviations)
         if (def.kind == DeviationKind::Location) {
             const double v = (i % 2 ? -1.0 : 1.0) * (5.0 + 3.0 * i);
-            d.set(def.name, def.isAngle() ? v * kArcsec : v * kUm);
+            d.setLinkValue(def.name, def.isAngle() ? v * kArcsec : v * kUm);
             ++i;
         }
     return d;

@@ -177,7 +177,7 @@ TEST(ControllerSiemens, CecMinMaxStepMatchThePointCount) {
 TEST(ControllerSiemens, SquarenessIsAStraightLine) {
     const MachineModel& m = test::multitasking();
     DeviationSet d(m);
-    d.set("EC0Y", 10 * kArcsec);
+    d.setLinkValue("EC0Y", 10 * kArcsec);  // the X slide turned by +gamma (ISO EC0Y = -gamma)
     const EmitResult r = siemens().emit({m, d, "EC0Y only", "2024-01-01"});
     const auto tables = siemens::parseCec(m, siemens::kCecFile, file(r, siemens::kCecFile).content);
     ASSERT_EQ(tables.size(), 1u);

@@ -197,10 +197,10 @@ TEST(Dbb5ComponentErrors, CommandLineEndToEnd) {
     writeDeviationCsv(dir.file("truth.csv"), truth);
     const std::string m = test::sourcePath("samples/machines/table-table-bc.xml");
     const std::string p = test::sourcePath("samples/plans/dbb5-table-table-bc.xml");
-    auto r = test::runCli("simulate-runs --machine " + m + " --plan " + p + " --deviations " + dir.file("truth.csv") +
+    auto r = test::runCli("simulate --machine " + m + " --plan " + p + " --deviations " + dir.file("truth.csv") +
                           " --out " + dir.file("traces"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+    r = test::runCli("identify --method formulas --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
                      dir.file("d.csv") + " --components --profile-out " + dir.file("profile.csv"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("XYC test C-XY"), std::string::npos) << r.out;
@@ -213,10 +213,10 @@ TEST(Dbb5ComponentErrors, CommandLineEndToEnd) {
     const std::string profile = test::readText(dir.file("profile.csv"));
     EXPECT_EQ(std::count(profile.begin(), profile.end(), '\n'), 73);
     EXPECT_EQ(profile.rfind("angle_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec,ez_arcsec\n", 0), 0u);
-    r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+    r = test::runCli("identify --method formulas --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
                      dir.file("d2.csv") + " --components --profile-out " + p);
     EXPECT_EQ(r.exitCode, 2) << r.out;
-    r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+    r = test::runCli("identify --method formulas --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
                      dir.file("d3.csv") + " --profile-out " + dir.file("p3.csv"));
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_NE(r.out.find("--profile-out needs --components"), std::string::npos) << r.out;

@@ -105,7 +105,7 @@ TEST(Dbb5Circular, NominalMachineGivesZeroAndSquarenessGivesTheEllipse) {
             for (double v : simulateDbb5(Kinematics(mach), r).dL) EXPECT_LT(std::abs(v), 1e-10) << r.name;
         // EC0Y alone: ΔL = (γ·LB/2)·sin 2θ (ISO 230-4 out-of-squareness).
         DeviationSet d(mach);
-        d.set("EC0Y", 10 * kArcsec);
+        d.setLinkValue("EC0Y", 10 * kArcsec);  // the X slide turned by γ (ISO EC0Y = −γ)
         const CircularTestResult r = evaluateCircularTest(simulateDbb5(Kinematics(mach, d), xy), xy.LB);
         EXPECT_NEAR(2 * r.b2 / xy.LB, 10 * kArcsec, 1e-4 * kArcsec);
         EXPECT_NEAR(r.circularity, 10 * kArcsec * xy.LB, 0.001 * kUm);
@@ -225,19 +225,19 @@ TEST(Dbb5LocationErrors, MissingRunsAndMachinesAreNamed) {
 
 TEST(Dbb5LocationErrors, CommandLineOnTheBcTable) {
     // The paths that failed on B/C before ("needs two B runs with the bar along Y"; --lsq: "no deviation named
-    // 'EY0B'"): formulas (refined) and least squares through `cnccomp dbb5`, read back against the truth.
+    // 'EY0B'"): formulas (refined) and least squares through `cnccomp identify`, read back against the truth.
     test::ScratchDir dir("dbb5-bc-cli");
     const std::string m = test::sourcePath("samples/machines/table-table-bc.xml");
     const std::string p = test::sourcePath("samples/plans/dbb5-table-table-bc.xml");
     const std::string truth = test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv");
-    auto r = test::runCli("simulate-runs --machine " + m + " --plan " + p + " --deviations " + truth + " --out " +
+    auto r = test::runCli("simulate --machine " + m + " --plan " + p + " --deviations " + truth + " --out " +
                           dir.file("traces"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    for (const std::string extra : {"", " --lsq"}) {
-        r = test::runCli("dbb5 --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
+    for (const std::string extra : {" --method formulas", ""}) {
+        r = test::runCli("identify --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
                          dir.file("d.csv") + extra);
         ASSERT_EQ(r.exitCode, 0) << r.out;
-        if (extra.empty()) {
+        if (!extra.empty()) {
             EXPECT_NE(r.out.find("relative to the machine axes (B at 0)"), std::string::npos) << r.out;
         }
         const DeviationSet got = readDeviationCsv(dir.file("d.csv"), *bcCase().machine);

@@ -96,7 +96,7 @@ TEST(DeviationCsv, AcceptsEveryUnitAndEitherColumn) {
     test::ScratchDir dir("dev-units");
     test::writeText(dir.file("d.csv"),
                     "name,alias,value,unit\n,dxBT,0.001,mm\nEZ0C1,,2,um\naBT,,1,deg\n,aXB,10,urad\nbXB,,10,um/m\n"
-                    "gXB,,0.0001,rad\nEC0Y,gXY,3,arcsec\n");
+                    "gXB,,0.0001,rad\nEC0Y,,-3,arcsec\n");
     const DeviationSet d = readDeviationCsv(dir.file("d.csv"), m);
     EXPECT_NEAR(d.get("EX0C1"), 1e-3, 1e-15);
     EXPECT_NEAR(d.get("dzBT"), 2e-3, 1e-15);
@@ -104,7 +104,8 @@ TEST(DeviationCsv, AcceptsEveryUnitAndEitherColumn) {
     EXPECT_NEAR(d.get("aXB"), 1e-5, 1e-18);
     EXPECT_NEAR(d.get("bXB"), 1e-5, 1e-18);
     EXPECT_NEAR(d.get("gXB"), 1e-4, 1e-18);
-    EXPECT_NEAR(d.get("EC0Y"), 3 * kArcsec, 1e-18);
+    EXPECT_NEAR(d.get("EC0Y"), -3 * kArcsec, 1e-18);
+    EXPECT_NEAR(d.get("gXY"), 3 * kArcsec, 1e-18);  // ISO EC0Y = -gXY on this machine
     // A header-only file is the all-zero set.
     test::writeText(dir.file("zero.csv"), "name,alias,value,unit\n");
     EXPECT_EQ(readDeviationCsv(dir.file("zero.csv"), m).values.norm(), 0.0);

@@ -35,6 +35,7 @@ IdentificationReport handMade() {
     a.name = "EX0C1";
     a.alias = "dxBT";
     a.value = 12 * kUm;
+    a.aliasValue = -12 * kUm;  // the value under the alias (here of the opposite sign, as for ISO EC0Y and gXY)
     a.stddev = 0.5 * kUm;
     a.lower95 = 11 * kUm;
     a.upper95 = 13 * kUm;
@@ -92,6 +93,7 @@ const char* kGolden = R"({
       "identified": true,
       "start": 0,
       "value": 12,
+      "alias_value": -12,
       "stddev": 0.5,
       "lower95": 11,
       "upper95": 13
@@ -147,6 +149,7 @@ TEST(LsqReportJson, ReadsBack) {
     EXPECT_TRUE(j["converged"].boolean);
     EXPECT_EQ(j["rank"].num(), 1);
     EXPECT_EQ(j["parameters"][0]["alias"].string, "dxBT");
+    EXPECT_EQ(j["parameters"][0]["alias_value"].num(), -12.0);
     EXPECT_DOUBLE_EQ(j["parameters"][0]["upper95"].num(), 13);
     EXPECT_TRUE(std::isnan(j["parameters"][1]["value"].num()));
     EXPECT_EQ(j["identifiable_combinations"][0]["text"].string, "EX0C1 - 360·EB0B");

@@ -45,8 +45,8 @@ std::vector<BallbarRun> runsNamed(std::initializer_list<const char*> names) {
 
 /// |identified − truth| in µm / arcsec.
 double errorDisplay(const ParameterEstimate& p, const DeviationSet& t, const MachineModel& m) {
-    const int i = m.deviationIndex(p.name);
-    return std::abs(p.value - t.values[m.deviations[i].offset]) / p.displayScale();
+    const int i = m.deviationIndex(p.name);  // report values are ISO values
+    return std::abs(p.value - t.isoValue(i)) / p.displayScale();
 }
 
 const Combination* findCombination(const std::vector<Combination>& list, const std::string& text) {
@@ -185,11 +185,12 @@ TEST(LsqRoundTrip, ConfoundedDeviationsAreReportedAsNamedCombinations) {
     const IdentificationResult r = identify(m, simulate(m, truth(), runsNamed({"B-X", "B-Y"}), 10.0), o);
     const IdentificationReport& rep = r.report;
     EXPECT_EQ(rep.rank, 4);
-    const Combination* c = findCombination(rep.identifiable, "EX0C1 - 360·EB0B - 360·EB0Z");
+    // In ISO names (EB0Z = −βYZ, EA0Z = −αYZ on this machine): δxBT − RB·(βXB + βYZ) = EX0C1 − 360·EB0B + 360·EB0Z.
+    const Combination* c = findCombination(rep.identifiable, "EX0C1 - 360·EB0B + 360·EB0Z");
     ASSERT_TRUE(c) << (rep.identifiable.empty() ? "" : rep.identifiable[0].text);
     const double expect = truth().get("dxBT") - 360.0 * (truth().get("bXB") + truth().get("bYZ"));
     EXPECT_NEAR(c->value, expect, 1e-3 * kUm);
-    const Combination* a = findCombination(rep.identifiable, "EA0B + EA0Z");
+    const Combination* a = findCombination(rep.identifiable, "EA0B - EA0Z");
     ASSERT_TRUE(a);
     EXPECT_NEAR(a->value, truth().get("aXB") + truth().get("aYZ"), 1e-3 * kArcsec);
     for (const char* n : {"EX0C1", "EA0B", "EB0B", "EA0Z", "EB0Z"})

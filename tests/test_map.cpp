@@ -69,7 +69,7 @@ TEST(Map, SquarenessGrowsLinearlyAlongTheAxis) {
     const MachineModel& m = test::multitasking();
     DeviationSet d(m);
     const double g = 20 * kArcsec;
-    d.set("EC0Y", g);
+    d.setLinkValue("EC0Y", g);  // the X slide turned (ISO EC0Y = -g on this machine)
     const VolumetricMap map = computeMap(req(m, d, "X=-200:200:25 Y=-100:100:100 Z=0:100:50", 150.0));
     const int x = m.requireAxis("X");
     for (const MapPoint& p : map.points) {
@@ -165,7 +165,7 @@ TEST(Map, CsvRoundTripAndSvgPicture) {
     const MachineModel& m = test::multitasking();
     DeviationSet d(m);
     d.set("EX0C", 0.01);
-    d.set("EC0Y", 5 * kArcsec);
+    d.setLinkValue("EC0Y", 5 * kArcsec);
     const VolumetricMap map = computeMap(req(m, d, "X=-100:100:20 Y=-60:60:20 Z=0 B=30 C=0:90:90", 100.0));
     test::ScratchDir dir("map_csv");
     writeMapCsv(dir.file("m.csv"), map, m, {m.name, "truth.csv"});

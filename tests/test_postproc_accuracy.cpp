@@ -283,8 +283,8 @@ TEST(PostprocAccuracy, CorrectedArcsStayArcsWhenTheyCan) {
     const std::string program = "G21 G90 G17\nG0 X5 Y0 Z10 B0 C0\nG1 Z0 F100\nG2 X0 Y-5 I-5 J0\nG2 X5 Y0 R-5\n";
     const MachineModel& m = test::multitasking();
     DeviationSet d(m);
-    d.set("EC0Y", 20 * kArcsec);
-    d.set("EB0Z", -15 * kArcsec);
+    d.setLinkValue("EC0Y", 20 * kArcsec);
+    d.setLinkValue("EB0Z", -15 * kArcsec);
     CorrectOptions o;
     o.dialect = Dialect::Rs274ngc;
     o.decimals = 6;

@@ -29,7 +29,7 @@ void expectInputError(F&& f, std::initializer_list<std::string> parts) {
 }
 
 TEST(RtestIo, SamplePlansLoadAndRoundTrip) {
-    for (const char* name : {"table-table-ac-rtest", "table-table-ac-kinematic", "dbb5-table-table-ac", "tilting-head-b-seed002",
+    for (const char* name : {"table-table-ac-rtest", "table-table-ac-kinematic", "dbb5-table-table-ac", "tilting-head-b-patterns",
                              "multitasking-six-circles"}) {
         const MeasurementPlan p = readPlanXml(test::sourcePath(std::string("samples/plans/") + name + ".xml"));
         test::ScratchDir dir("plan-rt");
@@ -47,7 +47,7 @@ TEST(RtestIo, SamplePlansLoadAndRoundTrip) {
     ASSERT_EQ(d.dbb5Runs.size(), 11u);
     EXPECT_EQ(d.dbb5Runs[3].kind, Dbb5Run::Kind::RotaryCircle);
     EXPECT_EQ(d.dbb5Runs[3].barDirection, -Vec3::UnitX());
-    EXPECT_EQ(readPlanXml(test::sourcePath("samples/plans/tilting-head-b-seed002.xml")).absoluteRuns.size(), 6u);
+    EXPECT_EQ(readPlanXml(test::sourcePath("samples/plans/tilting-head-b-patterns.xml")).absoluteRuns.size(), 6u);
 }
 
 TEST(RtestIo, WritersMatchGoldenText) {
@@ -150,27 +150,42 @@ TEST(RtestIo, CommandLineEndToEnd) {
     const std::string m = test::sourcePath("samples/machines/table-table-ac.xml");
     const std::string plan = test::sourcePath("samples/plans/table-table-ac-rtest.xml");
     const std::string truth = test::sourcePath("samples/deviations/table-table-ac-truth.csv");
-    auto r = test::runCli("simulate-runs --machine " + m + " --plan " + plan + " --deviations " + truth + " --out " +
+    auto r = test::runCli("simulate --machine " + m + " --plan " + plan + " --deviations " + truth + " --out " +
                           dir.file("traces"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    r = test::runCli("rtest --machine " + m + " --plan " + plan + " --traces " + dir.file("traces") + " --out " +
-                     dir.file("d.csv") + " --volumetric XYZAC --volumetric-out " + dir.file("v.csv"));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(r.out.find("volumetric error along 'XYZAC'"), std::string::npos) << r.out;
     const MachineModel& mm = tableTable();
-    const DeviationSet got = readDeviationCsv(dir.file("d.csv"), mm), want = readDeviationCsv(truth, mm);
-    for (const char* n : {"EY0A", "EZ0A", "EB0A", "EC0A", "EX0C", "EY0C", "EA0C", "EB0C", "EC0Y", "EB0Z", "EA0Z"}) {
-        const bool angle = mm.deviations[mm.deviationIndex(n)].isAngle();
-        EXPECT_NEAR(got.get(n), want.get(n), angle ? 0.001 * kArcsec : 0.001 * kUm) << n;  // file rounding: 1e-6 µm
+    const DeviationSet want = readDeviationCsv(truth, mm);
+    // The plan's runs (one ball) choose the R-test location method; both the least squares (default) and the
+    // paper's fits (refined) recover the eleven errors under their ISO names.
+    for (const std::string method : {"least-squares", "formulas"}) {
+        r = test::runCli("identify --machine " + m + " --plan " + plan + " --traces " + dir.file("traces") + " --method " +
+                         method + " --out " + dir.file(method + ".csv") + " --volumetric XYZAC --volumetric-out " +
+                         dir.file(method + "-v.csv"));
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+        EXPECT_NE(r.out.find("volumetric error along 'XYZAC'"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("R-test location"), std::string::npos) << r.out;
+        EXPECT_TRUE(std::filesystem::exists(dir.file(method + "-v.csv")));
+        const DeviationSet got = readDeviationCsv(dir.file(method + ".csv"), mm);
+        for (const char* n : {"EY0A", "EZ0A", "EB0A", "EC0A", "EX0C", "EY0C", "EA0C", "EB0C", "EC0Y", "EB0Z", "EA0Z"}) {
+            const bool angle = mm.deviations[mm.deviationIndex(n)].isAngle();
+            EXPECT_NEAR(got.get(n), want.get(n), angle ? 0.001 * kArcsec : 0.001 * kUm) << method << " " << n;
+        }
     }
-    // A missing trace file: exit code 2 and the file's name; no output written.
-    r = test::runCli("rtest --machine " + m + " --plan " + test::sourcePath("samples/plans/table-table-ac-kinematic.xml") +
-                     " --traces " + dir.file("traces") + " --method seed004 --out " + dir.file("k.csv"));
+    // A missing trace file: exit code 2 and the file's name; no output written. (The three-ball plan chooses the
+    // R-test tables method.)
+    r = test::runCli("identify --machine " + m + " --plan " + test::sourcePath("samples/plans/table-table-ac-kinematic.xml") +
+                     " --traces " + dir.file("traces") + " --out " + dir.file("k.csv"));
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_NE(r.out.find("C-ball1.csv"), std::string::npos) << r.out;
     EXPECT_FALSE(std::filesystem::exists(dir.file("k.csv")));
+    // A one-ball plan does not fit the tables method, and says which method it fits.
+    r = test::runCli("identify --machine " + m + " --plan " + plan + " --traces " + dir.file("traces") +
+                     " --measure rtest-tables --out " + dir.file("t.csv"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("fits 'rtest-location'"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("t.csv")));
     // The output must not overwrite an input.
-    r = test::runCli("rtest --machine " + m + " --plan " + plan + " --traces " + dir.file("traces") + " --out " + plan);
+    r = test::runCli("identify --machine " + m + " --plan " + plan + " --traces " + dir.file("traces") + " --out " + plan);
     EXPECT_EQ(r.exitCode, 2) << r.out;
 }
 

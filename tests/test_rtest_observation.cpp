@@ -5,8 +5,8 @@
 #include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/problem.hpp"
 #include "cnccomp/identification/rtest_observation.hpp"
-#include "cnccomp/identification/seed002_observation.hpp"
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/absolute_ballbar_observation.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "test_support.hpp"
@@ -73,7 +73,7 @@ TEST(Dbb5ObservationJacobian, MatchesFiniteDifferences) {
 TEST(AbsoluteBallbarObservationJacobian, MatchesFiniteDifferences) {
     const MachineModel m = readMachineXml(test::sourcePath("samples/machines/tilting-head-b.xml"));
     const DeviationSet at = readDeviationCsv(test::sourcePath("samples/deviations/tilting-head-b-truth.csv"), m);
-    const MeasurementPlan p = readPlanXml(test::sourcePath("samples/plans/tilting-head-b-seed002.xml"));
+    const MeasurementPlan p = readPlanXml(test::sourcePath("samples/plans/tilting-head-b-patterns.xml"));
     std::vector<BallbarRun> runs = {p.absoluteRuns[0], p.absoluteRuns[3], p.absoluteRuns[4]};
     runs[1].estimateWorkBallOffset = true;
     std::vector<BallbarTrace> traces;

@@ -141,7 +141,7 @@ TEST(TestPrograms, BallBarSweepsAreCircularBlocksCwFirstWithOvershootInsideTheTr
     }
     // The tilting head's absolute runs use the whole B travel: no overshoot is possible.
     for (const auto& sp : samplePlans())
-        if (sp.file == "tilting-head-b-seed002.xml")
+        if (sp.file == "tilting-head-b-patterns.xml")
             for (const auto& p : testprog::makeTestPrograms(sp.machine, sp.plan, {}).programs) {
                 EXPECT_EQ(p.overshootStart, 0.0) << p.run;
                 EXPECT_EQ(p.overshootEnd, 0.0) << p.run;

@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "cnccomp/identification/rtest_run.hpp"
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
@@ -25,7 +25,7 @@ struct Sample {
 constexpr Sample kSamples[] = {
     {"multitasking-six-circles.xml", "multitasking", "multitasking-truth.csv"},
     {"lsq-multitasking-planned.xml", "multitasking", "multitasking-truth.csv"},
-    {"tilting-head-b-seed002.xml", "tilting-head-b", "tilting-head-b-truth.csv"},
+    {"tilting-head-b-patterns.xml", "tilting-head-b", "tilting-head-b-truth.csv"},
     {"table-table-ac-rtest.xml", "table-table-ac", "table-table-ac-truth.csv"},
     {"table-table-ac-kinematic.xml", "table-table-ac", "table-table-ac-truth.csv"},
     {"dbb5-table-table-ac.xml", "table-table-ac", "dbb5-truth.csv"},
@@ -154,7 +154,7 @@ TEST(Verify, ADamagedFileFailsTheGateWithExitStatusOne) {
     // ISG files of the tilting head: the B tables are rows of volcomp.csv. Emitted from the truth they pass a 0.1 µm
     // gate; one sign flipped or one row missing does not.
     test::ScratchDir dir("verify-damaged");
-    const std::string m = src("samples/machines/tilting-head-b.xml"), p = src("samples/plans/tilting-head-b-seed002.xml"),
+    const std::string m = src("samples/machines/tilting-head-b.xml"), p = src("samples/plans/tilting-head-b-patterns.xml"),
                       t = src("samples/deviations/tilting-head-b-truth.csv");
     auto r = test::runCli("emit --controller isg --machine " + m + " --deviations " + t + " --out " + dir.file("good"));
     ASSERT_EQ(r.exitCode, 0) << r.out;

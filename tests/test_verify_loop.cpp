@@ -10,7 +10,7 @@
 
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/rtest_observation.hpp"
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/verify.hpp"
@@ -30,7 +30,7 @@ struct Case {
 constexpr Case kCases[] = {
     {"multitasking", "multitasking-six-circles.xml", "multitasking-truth.csv"},  // seed 000, six ball-bar runs
     {"table-table-ac", "table-table-ac-rtest.xml", "table-table-ac-truth.csv"},  // seed 001, R-test, 11 errors
-    {"tilting-head-b", "tilting-head-b-seed002.xml", "tilting-head-b-truth.csv"},  // seed 002, absolute bar, B tables
+    {"tilting-head-b", "tilting-head-b-patterns.xml", "tilting-head-b-truth.csv"},  // head patterns (absolute bar, two tool lengths), B tables
 };
 
 struct Loop {

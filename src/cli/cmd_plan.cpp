@@ -145,7 +145,7 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--mounting", o->mounting, "estimate-mounting of every run: none, tool, work, both")->capture_default_str();
     c->add_option("--observe", o->observe,
                   "what the identification will use: traces (raw samples, least squares) or eccentricity (circle "
-                  "centres, as seed 000's closed form)")
+                  "centres, as the ball-bar eccentricity formulas)")
         ->capture_default_str();
     c->add_option("--max-runs", o->maxRuns, "largest number of runs")->capture_default_str();
     c->add_option("--target-condition", o->targetCondition, "condition number to reach (scaled um / arcsec)")

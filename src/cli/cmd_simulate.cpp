@@ -1,5 +1,10 @@
-// cnccomp simulate: ball-bar traces of a plan on a machine with known deviations.
+// cnccomp simulate: every run of a plan, of every kind (ball bar, absolute ball bar, R-test, DBB5), on a machine with
+// known deviations; one CSV per run (ball-bar runs with their metadata, which the import checks), and eccentricities.csv
+// for the ball-bar runs. Everything is computed, then every file is staged and committed together (io/output_set.hpp):
+// a failing run leaves no output.
+#include <cmath>
 #include <filesystem>
+#include <functional>
 #include <random>
 
 #include <fmt/format.h>
@@ -7,10 +12,13 @@
 #include "cli/command.hpp"
 #include "cnccomp/eccentricity.hpp"
 #include "cnccomp/error.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/eccentricity_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/rtest_csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_csv.hpp"
 
@@ -23,30 +31,62 @@ struct Options {
     unsigned long seed = 1;
 };
 
+/// One output file, computed and waiting to be staged.
+struct Pending {
+    std::string name, run, kind;  ///< file name in the output folder; run name ("" for the eccentricity table)
+    size_t samples = 0;
+    std::function<void(std::ostream&)> write;
+};
+
 void run(const Options& o) {
     const MachineModel m = readMachineXml(o.machine);
     const MeasurementPlan plan = readPlanXml(o.plan);
     const DeviationSet d = o.deviations.empty() ? DeviationSet(m) : readDeviationCsv(o.deviations, m);
-    if (!(o.noiseUm >= 0)) throw ModelError("--noise-um must be zero or positive");
-    std::filesystem::create_directories(o.out);
+    if (!(o.noiseUm >= 0) || !std::isfinite(o.noiseUm)) throw ModelError("--noise-um must be zero or positive");
+    if (plan.runCount() == 0) throw ModelError(fmt::format("plan '{}' has no runs", o.plan));
     const Kinematics k(m, d);
     std::mt19937_64 rng(o.seed);
     std::normal_distribution<double> noise(0.0, o.noiseUm * kUm);
-    std::vector<BallbarTrace> traces;
-    for (const BallbarRun& r : plan.runs) {
-        BallbarTrace t = simulateRun(k, r);
+    std::vector<Pending> pending;
+    std::vector<BallbarTrace> ballbar;
+    const auto addTrace = [&](const std::string& name, BallbarTrace t, const char* kind, const BallbarRun* run) {
         if (o.noiseUm > 0)
             for (double& v : t.dL) v += noise(rng);
-        const std::string path = (std::filesystem::path(o.out) / (r.name + ".csv")).string();
-        refuseToOverwrite(path, {o.machine, o.plan, o.deviations});
-        writeTraceCsv(path, t, r, m.name);  // with the run's metadata, checked when read back
-        traces.push_back(std::move(t));
+        if (std::string(kind) == "ball bar") ballbar.push_back(t);
+        const size_t n = t.dL.size();
+        // Ball-bar runs carry their metadata (run, machine, geometry), which the import checks against the plan.
+        std::string text = formatTraceCsv(t, run, run ? m.name : std::string());
+        pending.push_back({name + ".csv", name, kind, n, [text = std::move(text)](std::ostream& out) { out << text; }});
+    };
+    for (const BallbarRun& r : plan.runs) addTrace(r.name, simulateRun(k, r), "ball bar", &r);
+    for (const BallbarRun& r : plan.absoluteRuns) addTrace(r.name, simulateAbsoluteRun(k, r), "absolute bar", &r);
+    for (const Dbb5Run& r : plan.dbb5Runs) addTrace(r.name, simulateDbb5(k, r), "DBB5", nullptr);
+    for (const RtestRun& r : plan.rtestRuns) {
+        RtestTrace t = simulateRtest(k, r);
+        if (o.noiseUm > 0)
+            for (Vec3& v : t.d) v += Vec3(noise(rng), noise(rng), noise(rng));
+        const size_t n = t.d.size();
+        pending.push_back({r.name + ".csv", r.name, "R-test", n,
+                           [&m, t = std::move(t)](std::ostream& out) { writeRtestCsv(out, m, t); }});
     }
-    const auto rows = eccentricitiesFromTraces(m, plan.runs, traces);
-    const std::string ecc = (std::filesystem::path(o.out) / "eccentricities.csv").string();
-    writeEccentricityCsv(ecc, rows);
-    fmt::print("simulated {} runs on '{}' into {}\n", plan.runs.size(), m.name, o.out);
-    fmt::print("{:<16} {:>10} {:>10} {:>10}   (eccentricity, um)\n", "run", "ex", "ey", "ez");
+    std::vector<EccentricityRow> rows;
+    if (!plan.runs.empty()) {
+        rows = eccentricitiesFromTraces(m, plan.runs, ballbar);
+        pending.push_back({"eccentricities.csv", "", "", rows.size(),
+                           [&rows](std::ostream& out) { writeEccentricityCsv(out, rows); }});
+    }
+    // Every run is computed: stage every file (a run name never leaves the folder), then commit them together.
+    OutputSet staged({o.machine, o.plan, o.deviations});
+    staged.makeFolder(o.out);
+    for (const Pending& p : pending) staged.add(OutputSet::fileIn(o.out, p.name, o.plan), p.write);
+    staged.commit();
+
+    fmt::print("simulated {} runs on '{}' into {}\n", plan.runCount(), m.name, o.out);
+    for (const Pending& p : pending)
+        if (!p.run.empty())
+            fmt::print("{:<16} {:<14} {:>6} {}\n", p.run, p.kind, p.samples, p.kind == "R-test" ? "poses" : "samples");
+    if (rows.empty()) return;
+    fmt::print("{:<16} {:>10} {:>10} {:>10}   (eccentricity of the ball-bar runs, um)\n", "run", "ex", "ey", "ez");
     const auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:10.3f}", v / kUm) : fmt::format("{:>10}", "-"); };
     for (size_t i = 0; i < rows.size(); ++i)
         fmt::print("{:<16} {} {} {}\n", plan.runs[i].name, cell(rows[i].e[0]), cell(rows[i].e[1]), cell(rows[i].e[2]));
@@ -54,12 +94,14 @@ void run(const Options& o) {
 
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
-    auto* c = app.add_subcommand("simulate", "Simulate the ball-bar runs of a plan; write one trace CSV per run and eccentricities.csv");
+    auto* c = app.add_subcommand("simulate",
+                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5): one CSV per run "
+                                 "and eccentricities.csv for ball-bar runs; nothing is written unless every run succeeds");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->required()->check(CLI::ExistingFile);
     c->add_option("--deviations", o->deviations, "deviation set CSV (the truth); none = nominal machine")->check(CLI::ExistingFile);
     c->add_option("--out", o->out, "output folder")->required();
-    c->add_option("--noise-um", o->noiseUm, "Gaussian noise on every ΔL sample, standard deviation in um");
+    c->add_option("--noise-um", o->noiseUm, "Gaussian noise on every ΔL sample / displacement component, σ in um");
     c->add_option("--seed", o->seed, "random seed for the noise");
     c->callback([o] { run(*o); });
 });

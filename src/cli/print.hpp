@@ -4,7 +4,8 @@
 
 namespace cnccomp::cli {
 
-/// Prints the present deviations (um / arcsec); with `truth`, also the truth and the difference.
+/// Prints the present location deviations under their ISO names (ISO values, um / arcsec; the alias column names the
+/// paper symbol); with `truth`, also the truth and the difference.
 /// Returns the largest |difference| in (um, arcsec).
 std::pair<double, double> printDeviations(const DeviationSet& d, const DeviationSet* truth);
 

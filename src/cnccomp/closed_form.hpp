@@ -1,5 +1,7 @@
 #pragma once
-// Closed-form identification of seed 000, section 5: equations (17)–(28) give the 12 identifiable
+// Ball-bar eccentricity formulas (the paper-literal method of `identify --method formulas` on ball-bar plans): the
+// identification of geometric deviations of multi-tasking machine tools with a swivel tool spindle head in a horizontal
+// position by ball-bar measurements (shared/seeds/000, section 5): equations (17)–(28) give the 12 identifiable
 // deviations of the w-C'bZYXB(C1)-t machine from the eccentricities of six ball-bar runs
 // (B-X, B-Y, C-axial, C-radial at (ZC, RB), (ZC', RB), (ZC', RB'')). γXY is not identified.
 #include <vector>
@@ -25,8 +27,9 @@ struct ClosedFormOptions {
     double stepDeg = 1.0;  ///< sweep step of the simulated runs in the refinement
 };
 
-/// Equations (17)–(28). The machine must define the deviations by their seed-000 aliases
-/// (dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ); the result marks those 12 present.
+/// Equations (17)–(28). The machine must define the deviations by the paper's aliases
+/// (dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ, set as the paper's values: alias sign × link value); the
+/// result marks those 12 present.
 DeviationSet identifyClosedForm(const MachineModel& machine, const std::vector<EccentricityRow>& rows,
                                 const ClosedFormOptions& options = {});
 

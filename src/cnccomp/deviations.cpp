@@ -18,18 +18,60 @@ int DeviationSet::require(std::string_view nameOrAlias) const {
     return i;
 }
 
+namespace {
+const DeviationDef& location(const MachineModel& m, int i) {
+    const DeviationDef& d = m.deviations[static_cast<size_t>(i)];
+    if (d.kind != DeviationKind::Location)
+        throw ModelError(fmt::format("deviation '{}' is a component error; use its coefficients", d.name));
+    return d;
+}
+}  // namespace
+
+double DeviationSet::isoValue(int index) const {
+    const DeviationDef& d = location(*machine_, index);
+    double v = 0.0;
+    for (const DeviationTerm& t : d.isoTerms)
+        v += t.coefficient * values[machine_->deviations[static_cast<size_t>(t.deviation)].offset];
+    return v;
+}
+
+double DeviationSet::aliasValue(int index, int k) const {
+    const DeviationDef& d = machine_->deviations.at(static_cast<size_t>(index));
+    return d.aliasSign * values[d.offset + k];
+}
+
+void DeviationSet::setIsoValue(int index, double value) {
+    location(*machine_, index);
+    const double delta = value - isoValue(index);
+    // Column `index` of the inverse relation: how every link value moves when this ISO value alone changes.
+    for (const DeviationDef& o : machine_->deviations)
+        for (const DeviationTerm& t : o.linkTerms)
+            if (t.deviation == index) values[o.offset] += t.coefficient * delta;
+    present[static_cast<size_t>(index)] = 1;
+}
+
 double DeviationSet::get(std::string_view nameOrAlias) const {
-    const auto& d = machine_->deviations[require(nameOrAlias)];
-    return values[d.offset];
+    const int i = require(nameOrAlias);
+    const DeviationDef& d = location(*machine_, i);
+    return d.name == nameOrAlias ? isoValue(i) : aliasValue(i);
 }
 
 void DeviationSet::set(std::string_view nameOrAlias, double value) {
     const int i = require(nameOrAlias);
-    const auto& d = machine_->deviations[i];
-    if (d.kind != DeviationKind::Location)
-        throw ModelError(fmt::format("deviation '{}' is a component error; set its coefficients", d.name));
-    values[d.offset] = value;
-    present[i] = 1;
+    const DeviationDef& d = location(*machine_, i);
+    if (d.name == nameOrAlias) return setIsoValue(i, value);
+    values[d.offset] = d.aliasSign * value;
+    present[static_cast<size_t>(i)] = 1;
+}
+
+double DeviationSet::linkValue(std::string_view nameOrAlias) const {
+    return values[location(*machine_, require(nameOrAlias)).offset];
+}
+
+void DeviationSet::setLinkValue(std::string_view nameOrAlias, double value) {
+    const int i = require(nameOrAlias);
+    values[location(*machine_, i).offset] = value;
+    present[static_cast<size_t>(i)] = 1;
 }
 
 }  // namespace cnccomp

@@ -1,5 +1,7 @@
 #pragma once
-// A deviation set: the machine's named deviation parameters as one flat vector (mm, rad).
+// A deviation set: the machine's named deviation parameters as one flat vector (mm, rad) of link values — the error
+// components of the kinematic chains. Names read and write them in their own conventions (iso_names.hpp): the ISO
+// 230-1 name gives the value the standard defines (reference axis and sign), the paper alias the paper's value.
 #include <string_view>
 #include <vector>
 
@@ -15,17 +17,30 @@ public:
     explicit DeviationSet(const MachineModel& machine);
 
     const MachineModel& machine() const { return *machine_; }
-    /// Flat vector in internal units (mm, rad); entries of DeviationDef::offset .. offset+size().
+    /// Flat vector of link values in internal units (mm, rad); entries DeviationDef::offset .. offset+size().
     Eigen::VectorXd values;
     /// Which deviations were given (read from a file or identified); absent ones are zero.
     std::vector<char> present;
 
-    /// Value of a location deviation by ISO name or alias, internal units. Throws ModelError if unknown.
+    /// Value of a location deviation under `nameOrAlias`, internal units: the ISO 230-1 value for its ISO name, the
+    /// paper's value for its alias. Throws ModelError if unknown.
     double get(std::string_view nameOrAlias) const;
-    /// Set a location deviation by ISO name or alias, internal units; marks it present.
+    /// Sets a location deviation so that its value under `nameOrAlias` is `value` (internal units) and marks it
+    /// present. By ISO name the other deviations keep their ISO values; by alias the other link values stay.
     void set(std::string_view nameOrAlias, double value);
     /// Index of a deviation by name or alias; throws ModelError naming the machine when unknown.
     int require(std::string_view nameOrAlias) const;
+
+    /// ISO value of location deviation `index` (Σ isoTerms · link values).
+    double isoValue(int index) const;
+    /// Value under the alias of deviation `index`, coefficient k (aliasSign × link value).
+    double aliasValue(int index, int k = 0) const;
+    /// Sets the ISO value of location deviation `index`, keeping the other ISO values; marks it present.
+    void setIsoValue(int index, double value);
+    /// Link value of a location deviation (the error component the kinematics use), by name or alias.
+    double linkValue(std::string_view nameOrAlias) const;
+    /// Sets the link value of a location deviation by name or alias and marks it present.
+    void setLinkValue(std::string_view nameOrAlias, double value);
 
 private:
     const MachineModel* machine_;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/iso_names.hpp"
 
 namespace cnccomp {
 
@@ -161,6 +162,10 @@ void MachineModel::finalize() {
                 (!b.alias.empty() && b.alias == a.name))
                 throw ModelError(fmt::format("machine '{}': deviation names '{}' and '{}' clash", name, a.name, b.name));
         }
+    for (const DeviationDef& d : deviations)
+        if (d.aliasSign != 1.0 && d.aliasSign != -1.0)
+            throw ModelError(fmt::format("machine '{}': the alias sign of '{}' must be +1 or -1", name, d.name));
+    deriveIsoMeaning(*this);
 }
 
 }  // namespace cnccomp

@@ -54,12 +54,28 @@ struct ComponentBasis {
     double evaluate(double q, const double* coef, bool moduloAxis) const;
 };
 
+/// One term of a linear relation between deviations: coefficient × (a value of deviation `deviation`).
+struct DeviationTerm {
+    int deviation = -1;
+    double coefficient = 0;
+};
+
 /// One named deviation parameter: which link's error transform it enters, and which of its six
 /// components (0..5 = x y z a b c). Location errors are constants placed before the link's motion;
 /// component errors are functions of the link's own axis position placed after it.
+///
+/// Three values belong to one deviation (see iso_names.hpp): the *link value* (the error component itself, what the
+/// flat deviation vector holds and the kinematics use), the value under the ISO 230-1 `name` (the quantity the
+/// standard defines, with its reference axis and sign: a linear combination of link values) and the value under the
+/// paper `alias` (aliasSign × link value).
 struct DeviationDef {
     std::string name;         ///< ISO 230-1 style, e.g. EX0C, EA0Z, EXC
     std::string alias;        ///< paper symbol in ASCII (δ→d, α→a, β→b, γ→g), may be empty
+    double aliasSign = 1.0;   ///< value under the alias = aliasSign × link value (the paper's own sign)
+    /// Value under the ISO name = Σ coefficient · link value of `deviation` (location errors; filled by finalize()).
+    std::vector<DeviationTerm> isoTerms;
+    /// Inverse: link value = Σ coefficient · ISO value of `deviation` (filled by finalize()).
+    std::vector<DeviationTerm> linkTerms;
     std::string description;
     Side side = Side::Tool;
     int link = 0;             ///< index into the chain's links
@@ -104,7 +120,8 @@ public:
     AxisVector fromController(const AxisVector& p) const;
     /// True when some axis has a non-zero machineZero.
     bool hasMachineZero() const;
-    /// Fill axisNames/axisIndex/offsets and check consistency; throws ModelError.
+    /// Fill axisNames/axisIndex/offsets, derive the ISO meaning of the deviation names (iso_names.hpp) and check
+    /// consistency; throws ModelError.
     void finalize();
 };
 

@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
-#include "cnccomp/identification/seed001_refine.hpp"
+#include "cnccomp/identification/reading_refinement.hpp"
 #include "cnccomp/kinematics.hpp"
 
 namespace cnccomp {

@@ -16,7 +16,7 @@
 //    relative to the outer axis' frame, so e.g. the model's EY0C is the C line's Y position minus what B's location
 //    contributes; squareness with the model's sign) — a change of definitions only, the formulas' first-order mixing
 //    (e.g. squareness of the linear axes moving the rotary runs' readings) is kept;
-//  - `deviations`: Gauss–Newton refinement on the exact model (seed001_refine.hpp) — the errors whose simulated runs
+//  - `deviations`: Gauss–Newton refinement on the exact model (reading_refinement.hpp) — the errors whose simulated runs
 //    give the measured readings; refine = 0 returns `plain`.
 #include <string>
 #include <vector>

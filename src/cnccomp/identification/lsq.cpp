@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/iso_names.hpp"
 #include "cnccomp/identification/identifiability.hpp"
 #include "cnccomp/identification/levenberg_marquardt.hpp"
 #include "cnccomp/identification/nlopt_solver.hpp"
@@ -40,6 +41,12 @@ void boxBounds(const UnknownLayout& L, const IdentifyOptions& o, Eigen::VectorXd
         int found = -1;
         for (int i = 0; i < L.size(); ++i)
             if (L[i].name == b.name || (!L[i].alias.empty() && L[i].alias == b.name)) found = i;
+        if (found >= 0 && !L[found].nuisance && L[found].name != b.name) {
+            const DeviationDef& d = L.machine().deviations[static_cast<size_t>(L[found].deviation)];
+            if (aliasDiffersFromName(L.machine(), L[found].deviation))
+                throw ModelError(fmt::format("bound for '{}': give it under the ISO name '{}' (the unknowns are ISO values)",
+                                             b.name, d.name));
+        }
         if (found < 0) throw ModelError(fmt::format("bound for '{}', which is not an unknown of this problem", b.name));
         if (!(b.lower <= b.upper)) throw ModelError(fmt::format("bound for '{}': lower exceeds upper", b.name));
         lo[found] = b.lower / L[found].scale;
@@ -142,10 +149,18 @@ IdentificationResult identify(const MachineModel& machine, const Observations& o
     for (int di : devs) res.deviations.present[di] = 1;
     for (int i = 0; i < layout.size(); ++i) {
         const UnknownInfo& u = layout[i];
-        if (!u.nuisance && !rep.parameters[i].identified) {
-            res.deviations.present[u.deviation] = 0;
+        if (u.nuisance || rep.parameters[i].identified) continue;
+        if (machine.deviations[static_cast<size_t>(u.deviation)].kind == DeviationKind::Location)
+            res.deviations.setIsoValue(u.deviation, start.isoValue(u.deviation));
+        else
             res.deviations.values[u.flat] = start.values[u.flat];
-        }
+    }
+    for (int i = 0; i < layout.size(); ++i)
+        if (!layout[i].nuisance && !rep.parameters[i].identified) res.deviations.present[layout[i].deviation] = 0;
+    for (int i = 0; i < layout.size(); ++i) {
+        const UnknownInfo& u = layout[i];
+        if (u.nuisance || machine.deviations[static_cast<size_t>(u.deviation)].alias.empty()) continue;
+        rep.parameters[i].aliasValue = res.deviations.aliasValue(u.deviation, u.flat - machine.deviations[static_cast<size_t>(u.deviation)].offset);
     }
     monteCarlo(problem, sub, so.x, options, rep);
     return res;

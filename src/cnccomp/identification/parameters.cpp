@@ -39,6 +39,30 @@ UnknownLayout::UnknownLayout(const MachineModel& machine, const std::vector<int>
             flat_.push_back(u.flat);
         }
     }
+    // Link values moved through another name's reference (linkTerms naming an estimated location error).
+    const int nd = static_cast<int>(unknowns_.size());
+    deviationUnknowns_ = nd;
+    for (const DeviationDef& o : machine.deviations)
+        for (const DeviationTerm& t : o.linkTerms)
+            if (std::find(deviations.begin(), deviations.end(), t.deviation) != deviations.end() &&
+                std::find(flat_.begin(), flat_.end(), o.offset) == flat_.end())
+                flat_.push_back(o.offset);
+    transform_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(flat_.size()), nd);
+    for (int u = 0; u < nd; ++u) {
+        const DeviationDef& d = machine.deviations[static_cast<size_t>(unknowns_[u].deviation)];
+        if (d.kind == DeviationKind::Component) {
+            transform_(u, u) = 1.0;
+            continue;
+        }
+        for (size_t f = 0; f < flat_.size(); ++f) {
+            const auto owner = std::find_if(machine.deviations.begin(), machine.deviations.end(), [&](const DeviationDef& o) {
+                return o.kind == DeviationKind::Location && o.offset == flat_[f];
+            });
+            if (owner == machine.deviations.end()) continue;
+            for (const DeviationTerm& t : owner->linkTerms)
+                if (t.deviation == unknowns_[u].deviation) transform_(static_cast<Eigen::Index>(f), u) = t.coefficient;
+        }
+    }
     for (size_t r = 0; r < observations.size(); ++r) {
         nuisanceStart_.push_back(size());
         const ObservationModel& o = *observations[r];
@@ -59,19 +83,29 @@ UnknownLayout::UnknownLayout(const MachineModel& machine, const std::vector<int>
     }
 }
 
+namespace {
+/// The unknown's value in `set`: the ISO value of a location error, the coefficient of a component error.
+double unknownValue(const MachineModel& m, const DeviationSet& set, const UnknownInfo& u) {
+    return m.deviations[static_cast<size_t>(u.deviation)].kind == DeviationKind::Location ? set.isoValue(u.deviation)
+                                                                                            : set.values[u.flat];
+}
+}  // namespace
+
 void UnknownLayout::unpack(const Eigen::VectorXd& x, DeviationSet& set, Eigen::VectorXd& nuisance) const {
-    for (int i = 0; i < size(); ++i) {
-        const UnknownInfo& u = unknowns_[i];
-        if (u.nuisance) nuisance[i - deviationUnknowns()] = x[i] * u.scale;
-        else set.values[u.flat] = x[i] * u.scale;
-    }
+    const int nd = deviationUnknowns();
+    Eigen::VectorXd delta(nd);
+    for (int i = 0; i < nd; ++i) delta[i] = x[i] * unknowns_[i].scale - unknownValue(*machine_, set, unknowns_[i]);
+    const Eigen::VectorXd move = transform_ * delta;
+    for (size_t f = 0; f < flat_.size(); ++f)
+        if (move[static_cast<Eigen::Index>(f)] != 0.0) set.values[flat_[f]] += move[static_cast<Eigen::Index>(f)];
+    for (int i = nd; i < size(); ++i) nuisance[i - nd] = x[i] * unknowns_[i].scale;
 }
 
 Eigen::VectorXd UnknownLayout::pack(const DeviationSet& set, const Eigen::VectorXd& nuisance) const {
     Eigen::VectorXd x(size());
     for (int i = 0; i < size(); ++i) {
         const UnknownInfo& u = unknowns_[i];
-        x[i] = (u.nuisance ? nuisance[i - deviationUnknowns()] : set.values[u.flat]) / u.scale;
+        x[i] = (u.nuisance ? nuisance[i - deviationUnknowns()] : unknownValue(*machine_, set, u)) / u.scale;
     }
     return x;
 }

@@ -1,6 +1,9 @@
 #pragma once
 // The unknowns of a least-squares identification: a chosen subset of the machine's deviation set (every
-// coefficient of a component error is one unknown) followed by the runs' nuisance parameters. The solver
+// coefficient of a component error is one unknown) followed by the runs' nuisance parameters. A location error is
+// estimated as its ISO value (iso_names.hpp: the value under its ISO name, reference axis and sign included), so
+// values, intervals, covariance and confounded combinations all read in ISO names; deviations that are not estimated
+// keep their ISO values. The solver
 // works in scaled units — µm for lengths, arcsec for angles, and for a polynomial coefficient of degree p the
 // size that moves the error by 1 µm / 1 arcsec at the axis' typical range — so the problem is well conditioned.
 #include <string>
@@ -18,7 +21,7 @@ struct UnknownInfo {
     bool angle = false;      ///< unit arcsec (else µm)
     double scale = kUm;      ///< internal units per solver unit
     int deviation = -1;      ///< index into machine.deviations (-1 for nuisance)
-    int flat = -1;           ///< index into the deviation vector (-1 for nuisance)
+    int flat = -1;           ///< the deviation's own entry of the deviation vector (-1 for nuisance)
     int run = -1;            ///< observation index (nuisance only)
     int nuisanceIndex = -1;  ///< index among the run's nuisance parameters
     /// Display unit: "um" or "arcsec".
@@ -35,11 +38,14 @@ public:
 
     const MachineModel& machine() const { return *machine_; }
     int size() const { return static_cast<int>(unknowns_.size()); }
-    int deviationUnknowns() const { return static_cast<int>(flat_.size()); }
+    int deviationUnknowns() const { return deviationUnknowns_; }
     const std::vector<UnknownInfo>& unknowns() const { return unknowns_; }
     const UnknownInfo& operator[](int i) const { return unknowns_[i]; }
-    /// Flat deviation indices of the deviation unknowns, in order.
+    /// Entries of the deviation vector (link values) the deviation unknowns move: their own entries first, then
+    /// the link values that change with an ISO value through the reference of another name (e.g. aCZ with EA0Z).
     const std::vector<int>& flat() const { return flat_; }
+    /// ∂(link values flat())/∂(deviation unknowns), internal units (flat().size() × deviationUnknowns()).
+    const Eigen::MatrixXd& transform() const { return transform_; }
     /// First unknown of observation r's nuisance parameters.
     int nuisanceStart(int r) const { return nuisanceStart_[r]; }
     const std::vector<int>& deviations() const { return deviations_; }
@@ -54,6 +60,8 @@ private:
     std::vector<int> deviations_;
     std::vector<UnknownInfo> unknowns_;
     std::vector<int> flat_;
+    int deviationUnknowns_ = 0;
+    Eigen::MatrixXd transform_;
     std::vector<int> nuisanceStart_;
 };
 

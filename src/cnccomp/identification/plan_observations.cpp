@@ -5,7 +5,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/rtest_observation.hpp"
-#include "cnccomp/identification/seed002_observation.hpp"
+#include "cnccomp/identification/absolute_ballbar_observation.hpp"
 #include "cnccomp/io/rtest_csv.hpp"
 #include "cnccomp/io/trace_csv.hpp"
 

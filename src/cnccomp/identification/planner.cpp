@@ -122,7 +122,7 @@ PlanProposal proposePlan(const MachineModel& m, const PlannerOptions& o) {
         for (BallbarTest t : kAllBallbarTests)
             if (m.axisIndex(rotatesHead(t) ? "B" : "C") >= 0) types.push_back(t);
     if (!hasXYZ || types.empty())
-        throw ModelError(fmt::format("machine '{}' allows no ball-bar run of seed 000 Table 2 (needs X, Y, Z and a B "
+        throw ModelError(fmt::format("machine '{}' allows no ball-bar run of the twelve run types (needs X, Y, Z and a B "
                                      "head or C table axis)", m.name));
 
     // ---- Candidates: simulate on the nominal machine, differentiate, eliminate mounting offsets.

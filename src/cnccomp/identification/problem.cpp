@@ -108,13 +108,15 @@ void LsqProblem::jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& J) const {
     for (int r = 0; r < static_cast<int>(observations_->size()); ++r) {
         const ObservationModel& o = *(*observations_)[r];
         const int nn = o.nuisanceCount(), n0 = layout_->nuisanceStart(r);
-        Eigen::MatrixXd block(o.size(), nd + nn);
+        const int nf = static_cast<int>(layout_->flat().size());
+        Eigen::MatrixXd block(o.size(), nf + nn);
         if (!o.jacobian(dm, nuis.data() + (n0 - nd), layout_->flat(), block)) {
             numericBlock(x, r, J, 1e-2);
             continue;
         }
-        // d r / d x_scaled = −w · ∂pred/∂internal · scale
-        J.block(rowStart_[r], 0, o.size(), nd) = -o.weight() * block.leftCols(nd) * scale.head(nd).asDiagonal();
+        // d r / d x_scaled = −w · ∂pred/∂(link values) · ∂(link values)/∂(unknowns) · scale
+        J.block(rowStart_[r], 0, o.size(), nd) =
+            -o.weight() * (block.leftCols(nf) * layout_->transform()) * scale.head(nd).asDiagonal();
         if (nn > 0)
             J.block(rowStart_[r], n0, o.size(), nn) =
                 -o.weight() * block.rightCols(nn) * scale.segment(n0, nn).asDiagonal();

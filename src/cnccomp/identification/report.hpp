@@ -18,7 +18,8 @@ struct ParameterEstimate {
     bool nuisance = false;
     bool angle = false;              ///< display unit arcsec, else um
     bool identified = true;          ///< false: lies in an unobservable direction, value meaningless (left at start)
-    double start = 0, value = 0;     ///< mm / rad
+    double start = 0, value = 0;     ///< mm / rad; ISO value of a location error (iso_names.hpp)
+    double aliasValue = kNaN;        ///< value under the paper alias (deviations with an alias), mm / rad
     double stddev = kNaN;            ///< from the residuals (linearised covariance), mm / rad
     double lower95 = kNaN, upper95 = kNaN;
     double mcStddev = kNaN, mcLower95 = kNaN, mcUpper95 = kNaN;  ///< Monte Carlo (when requested)

@@ -5,9 +5,11 @@
 #include <ostream>
 #include <sstream>
 
+#include <Eigen/LU>
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/iso_names.hpp"
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/units.hpp"
@@ -25,20 +27,30 @@ std::pair<std::string, int> splitIndex(const std::string& s, const std::string& 
     return {s.substr(0, open), static_cast<int>(*k)};
 }
 
+struct Given {
+    int line = 0;
+    bool iso = true;        ///< value under the ISO name (else under the alias)
+    double value = 0;       ///< internal units
+    bool hasAliasValue = false;
+    double aliasValue = 0, unit = 1;  ///< internal units; unit = internal units per file unit of the row
+};
+
 }  // namespace
 
 DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machine) {
     const CsvTable t = readCsv(path);
-    const int cName = t.column("name"), cAlias = t.column("alias");
+    const int cName = t.column("name"), cAlias = t.column("alias"), cAliasValue = t.column("alias_value");
     if (cName < 0 && cAlias < 0) throw InputError(path, t.header.line, "header needs a 'name' or 'alias' column");
     const int cValue = t.requireColumn("value"), cUnit = t.requireColumn("unit");
     DeviationSet set(machine);
-    std::map<std::pair<int, int>, int> firstLine;  // (deviation, coefficient) → line: a value given twice is an error
+    std::map<std::pair<int, int>, Given> given;  // (deviation, coefficient) → row
+    int isoRows = 0, aliasRows = 0;
     for (const CsvRow& row : t.rows) {
         const std::string& rawName = t.cell(row, cName);
         const std::string& rawAlias = t.cell(row, cAlias);
         if (rawName.empty() && rawAlias.empty()) throw InputError(path, row.line, "row has neither name nor alias");
         int index = -1, coef = -1;
+        bool iso = true;
         for (const std::string* s : {&rawName, &rawAlias}) {
             if (s->empty()) continue;
             const auto [base, k] = splitIndex(*s, path, row.line);
@@ -49,14 +61,11 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
             if (index >= 0 && (i != index || k != coef))
                 throw InputError(path, row.line, fmt::format("name '{}' and alias '{}' are different deviations",
                                                              rawName, rawAlias));
+            if (index < 0) iso = machine.deviations[static_cast<size_t>(i)].name == base;  // the value's symbol
             index = i;
             coef = k;
         }
-        const DeviationDef& d = machine.deviations[index];
-        if (const auto [it, fresh] = firstLine.emplace(std::pair{index, coef}, row.line); !fresh)
-            throw InputError(path, row.line,
-                             fmt::format("{}{} is given twice (first on line {}); which value is meant?", d.name,
-                                         coef >= 0 ? fmt::format("[{}]", coef) : "", it->second));
+        const DeviationDef& d = machine.deviations[static_cast<size_t>(index)];
         if (d.kind == DeviationKind::Location && coef >= 0)
             throw InputError(path, row.line, fmt::format("'{}' is a location error and takes no [index]", d.name));
         if (d.kind == DeviationKind::Component && (coef < 0 || coef >= d.size()))
@@ -69,28 +78,104 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
         if (unit->quantity != want)
             throw InputError(path, row.line, fmt::format("'{}' is {}; unit '{}' does not fit", d.name,
                                                          d.isAngle() ? "an angle" : "a length", unitText));
-        const double v = t.requireNumber(row, cValue);
-        set.values[d.offset + std::max(coef, 0)] = v * unit->toInternal;
-        set.present[index] = 1;
+        Given g;
+        g.line = row.line;
+        g.iso = iso;
+        g.unit = unit->toInternal;
+        g.value = t.requireNumber(row, cValue) * unit->toInternal;
+        const bool both = !rawName.empty() && !rawAlias.empty();
+        if (const auto av = t.number(row, cAliasValue); av && !d.alias.empty()) {
+            g.hasAliasValue = true;
+            g.aliasValue = *av * unit->toInternal;
+        } else if (both && aliasDiffersFromName(machine, index)) {
+            throw InputError(path, row.line,
+                             fmt::format("'{}' (ISO 230-1) and '{}' (the paper's symbol) give different numbers for "
+                                         "the same geometry ({}{}); give the value under one of them, or add the "
+                                         "alias_value column that cnccomp writes",
+                                         d.name, d.alias,
+                                         d.kind == DeviationKind::Location ? isoMeaningText(machine, index) : d.name,
+                                         d.aliasSign < 0 ? fmt::format("; {} is minus the link value", d.alias) : ""));
+        }
+        const auto key = std::make_pair(index, std::max(coef, 0));
+        if (const auto it = given.find(key); it != given.end())
+            throw InputError(path, row.line,
+                             fmt::format("{}{} is given twice (first on line {}); which value is meant?", d.name,
+                                         coef >= 0 ? fmt::format("[{}]", coef) : "", it->second.line));
+        given[key] = g;
+        (iso ? isoRows : aliasRows) += 1;
+        set.present[static_cast<size_t>(index)] = 1;
+    }
+
+    // Component coefficients: the link value directly.
+    std::vector<int> loc, column(machine.deviations.size(), -1);
+    for (int i = 0; i < static_cast<int>(machine.deviations.size()); ++i) {
+        const DeviationDef& d = machine.deviations[static_cast<size_t>(i)];
+        if (d.kind == DeviationKind::Location) {
+            column[static_cast<size_t>(i)] = static_cast<int>(loc.size());
+            loc.push_back(i);
+            continue;
+        }
+        for (int k = 0; k < d.size(); ++k)
+            if (const auto it = given.find({i, k}); it != given.end())
+                set.values[d.offset + k] = it->second.iso ? it->second.value : it->second.value * d.aliasSign;
+    }
+    // Location errors: one linear equation per deviation — its row, or zero under its ISO name (under its alias when
+    // every row of the file uses an alias).
+    const bool aliasOnly = isoRows == 0 && aliasRows > 0;
+    const int n = static_cast<int>(loc.size());
+    if (n > 0 && !given.empty()) {
+        Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+        Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+        for (int r = 0; r < n; ++r) {
+            const int i = loc[static_cast<size_t>(r)];
+            const DeviationDef& d = machine.deviations[static_cast<size_t>(i)];
+            const auto it = given.find({i, 0});
+            const bool iso = it != given.end() ? it->second.iso : !aliasOnly;
+            if (it != given.end()) b[r] = it->second.value;
+            if (iso)
+                for (const DeviationTerm& term : d.isoTerms) A(r, column[static_cast<size_t>(term.deviation)]) += term.coefficient;
+            else
+                A(r, r) = it != given.end() ? d.aliasSign : 1.0;
+        }
+        const Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
+        if (lu.rank() < n)
+            throw InputError(path, t.header.line,
+                             "the ISO names and aliases given do not determine the deviations; use one kind of name");
+        const Eigen::VectorXd x = lu.solve(b);
+        for (int r = 0; r < n; ++r) set.values[machine.deviations[static_cast<size_t>(loc[static_cast<size_t>(r)])].offset] = x[r];
+    }
+    for (const auto& [key, g] : given) {
+        if (!g.hasAliasValue) continue;
+        const DeviationDef& d = machine.deviations[static_cast<size_t>(key.first)];
+        const double have = set.aliasValue(key.first, key.second);
+        if (std::abs(have - g.aliasValue) > 5e-6 * g.unit + 1e-9 * std::abs(g.aliasValue))
+            throw InputError(path, g.line,
+                             fmt::format("alias_value of '{}' is {:.6f} but the file's values give {:.6f} for '{}'",
+                                         d.name, g.aliasValue / g.unit, have / g.unit, d.alias));
     }
     return set;
 }
 
 std::string formatDeviationCsv(const DeviationSet& set, bool all) {
     std::ostringstream out;
-    out << "name,alias,value,unit\n";
+    out << "name,alias,value,unit,alias_value\n";
     const MachineModel& m = set.machine();
     for (size_t i = 0; i < m.deviations.size(); ++i) {
         if (!all && !set.present[i]) continue;
         const DeviationDef& d = m.deviations[i];
         const double scale = d.isAngle() ? 1.0 / kArcsec : 1.0 / kUm;
         const char* unit = d.isAngle() ? "arcsec" : "um";
+        const int index = static_cast<int>(i);
+        const auto aliasCell = [&](int k) {
+            return d.alias.empty() ? std::string() : fmt::format("{:.6f}", set.aliasValue(index, k) * scale);
+        };
         if (d.kind == DeviationKind::Location) {
-            out << fmt::format("{},{},{:.6f},{}\n", d.name, d.alias, set.values[d.offset] * scale, unit);
+            out << fmt::format("{},{},{:.6f},{},{}\n", d.name, d.alias, set.isoValue(index) * scale, unit, aliasCell(0));
         } else {
             for (int k = 0; k < d.size(); ++k)
-                out << fmt::format("{}[{}],{},{:.6f},{}\n", d.name, k, d.alias.empty() ? "" : d.alias + "[" + std::to_string(k) + "]",
-                                   set.values[d.offset + k] * scale, unit);
+                out << fmt::format("{}[{}],{},{:.6f},{},{}\n", d.name, k,
+                                   d.alias.empty() ? "" : d.alias + "[" + std::to_string(k) + "]",
+                                   set.values[d.offset + k] * scale, unit, aliasCell(k));
         }
     }
     return out.str();

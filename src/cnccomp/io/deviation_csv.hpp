@@ -1,6 +1,11 @@
 #pragma once
-// Deviation files: CSV `name,alias,value,unit`. Readers accept the ISO name or the paper alias in either
-// column; component-error coefficients are rows `NAME[k]` (k from 0). Writers put lengths in um, angles in arcsec.
+// Deviation files: CSV `name,alias,value,unit[,alias_value]`. A row's value is the value under the symbol in its
+// `name` column (or, when that is empty, in its `alias` column): an ISO 230-1 name gives the ISO value (the
+// standard's reference axis and sign), a paper alias the paper's value (iso_names.hpp). When a row names both and
+// the two differ in meaning (e.g. ISO EC0Y = −gXY), the file must carry `alias_value`, which is then checked.
+// Deviations a file does not list are zero under their ISO names (under their aliases when every row uses an
+// alias). Component-error coefficients are rows `NAME[k]` (k from 0). Writers put the ISO name and value first,
+// lengths in um, angles in arcsec, and the paper alias with its value in `alias`, `alias_value`.
 #include <string>
 
 #include "cnccomp/deviations.hpp"

@@ -39,14 +39,16 @@ std::vector<EccentricityRow> readEccentricityCsv(const std::string& path) {
     return rows;
 }
 
-void writeEccentricityCsv(const std::string& path, const std::vector<EccentricityRow>& rows) {
+void writeEccentricityCsv(std::ostream& o, const std::vector<EccentricityRow>& rows) {
     const auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:.6f}", v / kUm) : std::string(); };
-    writeFileAtomically(path, [&](std::ostream& o) {
-        o << "test,LB_mm,RB_mm,RC_mm,ZC_mm,ex_um,ey_um,ez_um\n";
-        for (const auto& r : rows)
-            o << fmt::format("{},{:g},{:g},{:g},{:g},{},{},{}\n", testName(r.test), r.LB, r.RB, r.RC, r.ZC, cell(r.e[0]),
-                             cell(r.e[1]), cell(r.e[2]));
-    });
+    o << "test,LB_mm,RB_mm,RC_mm,ZC_mm,ex_um,ey_um,ez_um\n";
+    for (const auto& r : rows)
+        o << fmt::format("{},{:g},{:g},{:g},{:g},{},{},{}\n", testName(r.test), r.LB, r.RB, r.RC, r.ZC, cell(r.e[0]),
+                         cell(r.e[1]), cell(r.e[2]));
+}
+
+void writeEccentricityCsv(const std::string& path, const std::vector<EccentricityRow>& rows) {
+    writeFileAtomically(path, [&](std::ostream& o) { writeEccentricityCsv(o, rows); });
 }
 
 }  // namespace cnccomp

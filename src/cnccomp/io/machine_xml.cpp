@@ -114,6 +114,11 @@ MachineModel readMachineXml(const std::string& path) {
             else xml::fail(*e, path, "expected <location> or <component>");
             d.name = xml::text(*e, path, "name");
             d.alias = xml::textOr(*e, "alias", "");
+            const std::string sign = xml::textOr(*e, "alias-sign", "+1");
+            if (sign == "+1" || sign == "1") d.aliasSign = 1.0;
+            else if (sign == "-1") d.aliasSign = -1.0;
+            else xml::fail(*e, path, fmt::format("alias-sign '{}': expected +1 or -1", sign));
+            if (d.alias.empty() && e->Attribute("alias-sign")) xml::fail(*e, path, "alias-sign without an alias");
             d.description = xml::textOr(*e, "description", "");
             const std::string link = xml::text(*e, path, "link");
             bool found = false;

@@ -158,6 +158,7 @@ std::string formatReportJson(const IdentificationReport& r) {
         w.field("identified", p.identified);
         w.field("start", p.start / s);
         w.field("value", p.identified ? p.value / s : kNaN);
+        if (!p.alias.empty()) w.field("alias_value", p.identified ? p.aliasValue / s : kNaN);
         w.field("stddev", p.stddev / s);
         w.field("lower95", p.lower95 / s);
         w.field("upper95", p.upper95 / s);

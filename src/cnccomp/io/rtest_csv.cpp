@@ -45,18 +45,21 @@ Parsed parse(const std::string& path, const MachineModel& m) {
 
 RtestTrace readRtestCsv(const std::string& path, const MachineModel& m) { return parse(path, m).trace; }
 
+void writeRtestCsv(std::ostream& o, const MachineModel& m, const RtestTrace& trace) {
+    if (trace.commands.size() != trace.d.size()) throw ModelError("R-test trace: poses and displacements differ");
+    o << "pose";
+    for (int i = 0; i < m.axisCount(); ++i) o << ',' << axisColumn(m, i);
+    o << ",dx_um,dy_um,dz_um\n";
+    for (size_t k = 0; k < trace.d.size(); ++k) {
+        o << k + 1;
+        for (int i = 0; i < m.axisCount(); ++i) o << fmt::format(",{:.9f}", trace.commands[k][i] / axisUnit(m, i));
+        o << fmt::format(",{:.6f},{:.6f},{:.6f}\n", trace.d[k].x() / kUm, trace.d[k].y() / kUm, trace.d[k].z() / kUm);
+    }
+}
+
 void writeRtestCsv(const std::string& path, const MachineModel& m, const RtestTrace& trace) {
     if (trace.commands.size() != trace.d.size()) throw ModelError("R-test trace: poses and displacements differ");
-    writeFileAtomically(path, [&](std::ostream& o) {
-        o << "pose";
-        for (int i = 0; i < m.axisCount(); ++i) o << ',' << axisColumn(m, i);
-        o << ",dx_um,dy_um,dz_um\n";
-        for (size_t k = 0; k < trace.d.size(); ++k) {
-            o << k + 1;
-            for (int i = 0; i < m.axisCount(); ++i) o << fmt::format(",{:.9f}", trace.commands[k][i] / axisUnit(m, i));
-            o << fmt::format(",{:.6f},{:.6f},{:.6f}\n", trace.d[k].x() / kUm, trace.d[k].y() / kUm, trace.d[k].z() / kUm);
-        }
-    });
+    writeFileAtomically(path, [&](std::ostream& o) { writeRtestCsv(o, m, trace); });
 }
 
 std::vector<RtestTrace> readRtestTraces(const std::string& dir, const MachineModel& m, const std::vector<RtestRun>& runs) {

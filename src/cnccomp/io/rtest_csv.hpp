@@ -1,4 +1,5 @@
 #pragma once
+#include <iosfwd>
 // R-test traces: CSV `pose,<axis>_mm|<axis>_deg …,dx_um,dy_um,dz_um`, one file per run: the axis commands of every
 // pose (linear axes in mm, rotary axes in degrees, machine axis order) and the displacement of the ball centre from
 // the nest centre in the tool (sensor) frame, µm.
@@ -12,6 +13,8 @@ namespace cnccomp {
 /// Throws InputError (file:line) for a missing column or file, a non-finite value, or fewer than three poses.
 RtestTrace readRtestCsv(const std::string& path, const MachineModel& machine);
 void writeRtestCsv(const std::string& path, const MachineModel& machine, const RtestTrace& trace);
+/// The same CSV written to a stream (for outputs staged together, io/output_set.hpp).
+void writeRtestCsv(std::ostream& out, const MachineModel& machine, const RtestTrace& trace);
 
 /// Reads DIR/<run>.csv for every run and checks each file against the plan: the same number of poses and the
 /// same commands (to 1e-5 mm / deg; the plan's exact commands are kept). Errors name the file and line.

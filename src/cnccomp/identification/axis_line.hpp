@@ -1,6 +1,6 @@
 #pragma once
 // From a measured rotary-axis line (a point and a direction in the bed frame) to the location errors of that axis
-// in the machine model (ISO 230-1 position and orientation of the axis line, seed 001 "POPPE", seed 003 Table 1).
+// in the machine model (ISO 230-1 position and orientation of the axis line, "POPPE" of the R-test location fits, DBB5 Table 1).
 #include <vector>
 
 #include "cnccomp/deviations.hpp"

@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 
 #include <algorithm>
 #include <array>
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/seed002_observation.hpp"
+#include "cnccomp/identification/absolute_ballbar_observation.hpp"
 
 namespace cnccomp {
 
@@ -56,7 +56,7 @@ std::array<PatternRuns, 3> selectPatterns(const std::vector<BallbarRun>& runs, c
     std::array<PatternRuns, 3> out;
     for (int p = 0; p < 3; ++p) {
         if (found[p].size() != 2)
-            throw ModelError(fmt::format("seed 002 needs two {} runs with different tool lengths RB; the plan has {}",
+            throw ModelError(fmt::format("the head patterns need two {} runs with different tool lengths RB; the plan has {}",
                                          names[p], found[p].size()));
         size_t a = found[p][0], b = found[p][1];
         if (runs[a].RB > runs[b].RB) std::swap(a, b);
@@ -64,7 +64,7 @@ std::array<PatternRuns, 3> selectPatterns(const std::vector<BallbarRun>& runs, c
             throw ModelError(fmt::format("the two {} runs '{}' and '{}' need different tool lengths RB", names[p],
                                          runs[a].name, runs[b].name));
         if (runs[a].headAxis != runs[0].headAxis || runs[b].headAxis != runs[0].headAxis)
-            throw ModelError("seed 002: every pattern must turn the same head axis");
+            throw ModelError("head patterns: every pattern must turn the same head axis");
         out[p].run = {&runs[a], &runs[b]};
         out[p].trace = {&traces[a], &traces[b]};
     }
@@ -96,7 +96,7 @@ TiltingHeadResult tiltingHeadFormulas(const std::vector<BallbarRun>& runs, const
         for (int p = 0; p < 3 && all; ++p)
             for (int l = 0; l < 2 && all; ++l) {
                 const BallbarTrace& t = *pat[p].trace[l];
-                if (t.angleDeg.size() != t.dL.size()) throw ModelError("seed 002: a trace has mismatched columns");
+                if (t.angleDeg.size() != t.dL.size()) throw ModelError("head patterns: a trace has mismatched columns");
                 idx[p * 2 + l] = findAngle(t, a);
                 all = idx[p * 2 + l] >= 0;
             }
@@ -105,7 +105,7 @@ TiltingHeadResult tiltingHeadFormulas(const std::vector<BallbarRun>& runs, const
             angles.push_back(a);
         }
     }
-    if (rows.empty()) throw ModelError("seed 002: the six runs share no sample angle");
+    if (rows.empty()) throw ModelError("head patterns: the six runs share no sample angle");
     const auto delta = [&](int p, int l, size_t row) { return pat[p].trace[l]->dL[static_cast<size_t>(rows[row][p * 2 + l])]; };
     // Eq. (7): Q_j and δy(B_j) from the Y pattern.
     const double Ly1 = pat[kY].run[0]->RB, Ly2 = pat[kY].run[1]->RB;
@@ -115,7 +115,7 @@ TiltingHeadResult tiltingHeadFormulas(const std::vector<BallbarRun>& runs, const
     const auto at = [&](double deg) -> int {
         for (size_t j = 0; j < angles.size(); ++j)
             if (std::abs(std::remainder(angles[j] - deg, 360.0)) < 1e-6) return static_cast<int>(j);
-        throw ModelError(fmt::format("seed 002 eq. (9) needs a common sample at B = {:g} deg", deg));
+        throw ModelError(fmt::format("the head-pattern formula (9) needs a common sample at B = {:g} deg", deg));
     };
     r.eBz = Q[static_cast<size_t>(at(0))];
     r.exB = (Q[static_cast<size_t>(at(270))] - Q[static_cast<size_t>(at(90))]) / 2;
@@ -150,7 +150,7 @@ namespace {
 
 const DeviationDef& requireTable(const MachineModel& m, const std::string& name) {
     const int i = m.deviationIndex(name);
-    if (i < 0) throw ModelError(fmt::format("machine '{}' has no deviation '{}' (seed 002 needs it)", m.name, name));
+    if (i < 0) throw ModelError(fmt::format("machine '{}' has no deviation '{}' (the head-pattern method identifies it)", m.name, name));
     const DeviationDef& d = m.deviations[static_cast<size_t>(i)];
     if (d.kind != DeviationKind::Component || d.basis.type != ComponentBasis::Type::Table)
         throw ModelError(fmt::format("machine '{}': '{}' must be a component error with a table basis", m.name, name));
@@ -165,8 +165,9 @@ std::array<std::string, 5> tableNames(const std::string& head) {
 
 DeviationSet tiltingHeadDeviations(const MachineModel& m, const TiltingHeadResult& r) {
     DeviationSet set(m);
-    set.set("EC0" + r.headAxis, r.exB);
-    set.set("EA0" + r.headAxis, r.eBz);
+    // εxB, εBz are the orientation errors of the head's own link (the paper's matrix), i.e. link values.
+    set.setLinkValue("EC0" + r.headAxis, r.exB);
+    set.setLinkValue("EA0" + r.headAxis, r.eBz);
     const auto names = tableNames(r.headAxis);
     for (int c = 0; c < 5; ++c) {
         const DeviationDef& d = requireTable(m, names[static_cast<size_t>(c)]);
@@ -223,7 +224,7 @@ TiltingHeadLsq tiltingHeadLeastSquares(const MachineModel& m, const std::vector<
     const int axis = m.requireAxis(head);
     const Link& link = m.axisLink(axis);
     const DeviationDef& ex = *defs[3];
-    const Vec3 wls(ls.get("EA0" + head), ls.get("EB0" + head), ls.get("EC0" + head));
+    const Vec3 wls(ls.linkValue("EA0" + head), ls.linkValue("EB0" + head), ls.linkValue("EC0" + head));
     const Vec3 u = m.toolDirection;
     const int ecIndex = m.deviationIndex("EC" + head);
     const auto exAt = [&](const DeviationSet& s, double deg) {
@@ -251,8 +252,8 @@ TiltingHeadLsq tiltingHeadLeastSquares(const MachineModel& m, const std::vector<
             d.values[defs[3]->offset + k] = eNew.x();
             d.values[defs[4]->offset + k] = eNew.y();
         }
-        d.set("EA0" + head, alpha);
-        d.set("EC0" + head, gamma);
+        d.setLinkValue("EA0" + head, alpha);
+        d.setLinkValue("EC0" + head, gamma);
         return d;
     };
     // First-order gauge from Q(B) = εBz cos B − εxB sin B + εx(B), then Newton on the exact gauge conditions

@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed001_axis_line.hpp"
+#include "cnccomp/identification/axis_line.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed001_rtest.hpp"
+#include "cnccomp/identification/rtest_location_fits.hpp"
 
 #include <cmath>
 
@@ -6,8 +6,8 @@
 
 #include "cnccomp/circle_fit.hpp"
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/seed001_axis_line.hpp"
-#include "cnccomp/identification/seed001_refine.hpp"
+#include "cnccomp/identification/axis_line.hpp"
+#include "cnccomp/identification/reading_refinement.hpp"
 
 namespace cnccomp {
 
@@ -20,7 +20,7 @@ struct Roles {
     double phiPlus = 0, phiMinus = 0;  ///< deg
 };
 
-Roles findRoles(const std::vector<RtestRun>& runs, const Seed001Options& o) {
+Roles findRoles(const std::vector<RtestRun>& runs, const RtestLocationOptions& o) {
     Roles r;
     for (size_t i = 0; i < runs.size(); ++i) {
         bool movesOuter = false, movesInner = false, other = false;
@@ -53,16 +53,16 @@ Roles findRoles(const std::vector<RtestRun>& runs, const Seed001Options& o) {
         }
     }
     const auto need = [&](int i, const std::string& what) {
-        if (i < 0) throw ModelError("seed 001 needs an R-test run " + what);
+        if (i < 0) throw ModelError("the R-test location fits need a run " + what);
     };
     need(r.xyc, fmt::format("turning {} alone with {} at 0 (XYC)", o.innerAxis, o.outerAxis));
     need(r.yza, fmt::format("turning {} alone (YZA)", o.outerAxis));
     need(r.tiltPlus, fmt::format("turning {} with {} held at +φ", o.innerAxis, o.outerAxis));
     need(r.tiltMinus, fmt::format("turning {} with {} held at −φ", o.innerAxis, o.outerAxis));
     if (std::abs(r.phiPlus + r.phiMinus) > 1e-9)
-        throw ModelError(fmt::format("seed 001: the tilted runs must be symmetric (+{:g} and {:g} deg)", r.phiPlus, r.phiMinus));
+        throw ModelError(fmt::format("R-test location fits: the tilted runs must be symmetric (+{:g} and {:g} deg)", r.phiPlus, r.phiMinus));
     if (std::abs(std::sin(2 * r.phiPlus * kDeg)) < 0.1)
-        throw ModelError(fmt::format("seed 001: a tilt of {:g} deg cannot show the Y–Z squareness (sin 2φ too small)", r.phiPlus));
+        throw ModelError(fmt::format("R-test location fits: a tilt of {:g} deg cannot show the Y–Z squareness (sin 2φ too small)", r.phiPlus));
     return r;
 }
 
@@ -107,7 +107,7 @@ struct Readings {
 };
 
 Readings readings(const MachineModel& m, const std::vector<RtestRun>& runs, const std::vector<RtestTrace>& traces,
-                  const Roles& r, const Seed001Options& o, const std::vector<int>& devs) {
+                  const Roles& r, const RtestLocationOptions& o, const std::vector<int>& devs) {
     const int ao = m.requireAxis(o.outerAxis), ai = m.requireAxis(o.innerAxis);
     const auto run = [&](int i) -> const RtestRun& { return runs[static_cast<size_t>(i)]; };
     const auto trace = [&](int i) -> const RtestTrace& { return traces[static_cast<size_t>(i)]; };
@@ -151,17 +151,17 @@ Readings readings(const MachineModel& m, const std::vector<RtestRun>& runs, cons
 
 }  // namespace
 
-Seed001Result seed001Formulas(const MachineModel& m, const std::vector<RtestRun>& runs,
-                              const std::vector<RtestTrace>& traces, const Seed001Options& o) {
+RtestLocationResult rtestLocationFits(const MachineModel& m, const std::vector<RtestRun>& runs,
+                              const std::vector<RtestTrace>& traces, const RtestLocationOptions& o) {
     if (runs.size() != traces.size()) throw ModelError(fmt::format("{} R-test runs but {} traces", runs.size(), traces.size()));
-    if (o.refine < 0) throw ModelError("seed 001: the number of refinement steps must not be negative");
+    if (o.refine < 0) throw ModelError("R-test location fits: the number of refinement steps must not be negative");
     const Roles r = findRoles(runs, o);
     const std::string A = o.outerAxis, C = o.innerAxis;
     std::vector<int> devs;
     for (const std::string& n : {std::string("EC0Y"), std::string("EB0Z"), std::string("EA0Z"), "EY0" + A, "EZ0" + A,
                                  "EB0" + A, "EC0" + A, "EX0" + C, "EY0" + C, "EA0" + C, "EB0" + C}) {
         const int i = m.deviationIndex(n);
-        if (i < 0) throw ModelError(fmt::format("machine '{}' has no deviation '{}' (seed 001 identifies it)", m.name, n));
+        if (i < 0) throw ModelError(fmt::format("machine '{}' has no deviation '{}' (the R-test location fits identify it)", m.name, n));
         devs.push_back(i);
     }
     const Readings measured = readings(m, runs, traces, r, o, devs);
@@ -171,14 +171,14 @@ Seed001Result seed001Formulas(const MachineModel& m, const std::vector<RtestRun>
         for (size_t i = 0; i < runs.size(); ++i) t.push_back(simulateRtest(k, runs[i], traces[i].commands));
         return readings(m, runs, t, r, o, devs).values;
     };
-    Seed001Result res{refineReadings(m, devs, simulated, measured.values, o.refine),
+    RtestLocationResult res{refineReadings(m, devs, simulated, measured.values, o.refine),
                       refineReadings(m, devs, simulated, measured.values, 0),
                       measured.outer, measured.inner, measured.xy, measured.cXY, measured.cYZ, measured.cZX,
                       r.phiPlus, o.refine};
     return res;
 }
 
-VolumetricAlongRun seed001Volumetric(const MachineModel& m, const DeviationSet& identified, const RtestRun& run,
+VolumetricAlongRun volumetricErrorAlongRun(const MachineModel& m, const DeviationSet& identified, const RtestRun& run,
                                      const RtestTrace& trace) {
     VolumetricAlongRun v;
     v.measured = trace.d;

@@ -8,7 +8,7 @@
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/parameters.hpp"
 #include "cnccomp/identification/rtest_observation.hpp"
-#include "cnccomp/identification/seed001_rtest.hpp"
+#include "cnccomp/identification/rtest_location_fits.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "test_support.hpp"
@@ -54,7 +54,7 @@ std::pair<double, double> worst(const DeviationSet& est, const DeviationSet& tru
     return {um, as};
 }
 
-TEST(Seed001Rtest, NominalMachineShowsNoDisplacement) {
+TEST(RtestLocationFits, NominalMachineShowsNoDisplacement) {
     const MachineModel& m = tableTable();
     const Kinematics k(m);
     for (const RtestRun& r : seed001().plan.rtestRuns) {
@@ -66,12 +66,12 @@ TEST(Seed001Rtest, NominalMachineShowsNoDisplacement) {
     EXPECT_EQ(seed001().plan.rtestRuns[1].sampleCount(), 37);
 }
 
-TEST(Seed001Rtest, PaperFitsRecoverTheElevenErrors) {
+TEST(RtestLocationFits, PaperFitsRecoverTheElevenErrors) {
     const MachineModel& m = tableTable();
     const Fixture& f = seed001();
     // The plain formulas: each reading taken as its error (first order, the readings mix the errors), then the
     // readings matched on the exact model (default refinement steps).
-    const Seed001Result r = seed001Formulas(m, f.plan.rtestRuns, f.traces);
+    const RtestLocationResult r = rtestLocationFits(m, f.plan.rtestRuns, f.traces);
     const auto [um1, as1] = worst(r.plain, f.truth);
     const auto [um, as] = worst(r.deviations, f.truth);
     std::printf("[ seed 001 ] plain formulas: %.4f um, %.4f arcsec; after %d refinement steps: %.2e um, %.2e arcsec\n",
@@ -86,10 +86,10 @@ TEST(Seed001Rtest, PaperFitsRecoverTheElevenErrors) {
     // The fits themselves: the ball path of XYC is a circle about the C axis, the tool path an ellipse.
     EXPECT_NEAR(r.innerCircle.radius, 150, 0.01);
     EXPECT_NEAR(r.outerCircle.radius, 100, 0.1);
-    EXPECT_NEAR(r.cXY, f.truth.get("EC0Y"), 0.01 * kArcsec);
+    EXPECT_NEAR(r.cXY, f.truth.get("CXY"), 0.01 * kArcsec);  // eq. (2) reads the paper's C_XY = −EC0Y
 }
 
-TEST(Seed001Rtest, LeastSquaresRecoversTheElevenErrorsExactly) {
+TEST(RtestLocationFits, LeastSquaresRecoversTheElevenErrorsExactly) {
     const MachineModel& m = tableTable();
     const Fixture& f = seed001();
     const Observations obs = rtestObservations(m, f.plan.rtestRuns, f.traces);
@@ -103,7 +103,7 @@ TEST(Seed001Rtest, LeastSquaresRecoversTheElevenErrorsExactly) {
     EXPECT_LT(as, 0.001);
 }
 
-TEST(Seed001Rtest, ZeroPositionOfAIsNotIdentifiedByName) {
+TEST(RtestLocationFits, ZeroPositionOfAIsNotIdentifiedByName) {
     // EA0A (zero position of A) turns the ball about A and tilts C like EA0C: the engine must say so.
     const MachineModel& m = tableTable();
     const Fixture& f = seed001();
@@ -118,11 +118,11 @@ TEST(Seed001Rtest, ZeroPositionOfAIsNotIdentifiedByName) {
     EXPECT_NE(std::find(u.begin(), u.end(), "EA0C"), u.end());
 }
 
-TEST(Seed001Rtest, VolumetricErrorAlongXyzacFromTheElevenErrors) {
+TEST(RtestLocationFits, VolumetricErrorAlongXyzacFromTheElevenErrors) {
     const MachineModel& m = tableTable();
     const Fixture& f = seed001();
-    const Seed001Result r = seed001Formulas(m, f.plan.rtestRuns, f.traces);
-    const VolumetricAlongRun v = seed001Volumetric(m, r.deviations, f.plan.rtestRuns[4], f.traces[4]);
+    const RtestLocationResult r = rtestLocationFits(m, f.plan.rtestRuns, f.traces);
+    const VolumetricAlongRun v = volumetricErrorAlongRun(m, r.deviations, f.plan.rtestRuns[4], f.traces[4]);
     std::printf("[ seed 001 ] XYZAC: measured RMS %.3f um, residual RMS %.2e um, max %.2e um\n", v.rmsMeasured / kUm,
                 v.rmsResidual / kUm, v.maxResidual / kUm);
     EXPECT_GT(v.rmsMeasured, 10 * kUm);   // the 11 errors move the ball by tens of µm along the trajectory
@@ -132,7 +132,7 @@ TEST(Seed001Rtest, VolumetricErrorAlongXyzacFromTheElevenErrors) {
     DeviationSet more = f.truth;
     more.set("EA0A", 20 * kArcsec);
     const RtestTrace t = simulateRtest(Kinematics(m, more), f.plan.rtestRuns[4]);
-    const VolumetricAlongRun w = seed001Volumetric(m, f.truth, f.plan.rtestRuns[4], t);
+    const VolumetricAlongRun w = volumetricErrorAlongRun(m, f.truth, f.plan.rtestRuns[4], t);
     EXPECT_GT(w.maxResidual, 5 * kUm);
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Seed 001 (Morávek, Hořejš & Bach): pivot point position and orientation errors (POPPE) of the rotary axes A and
+// R-test location fits: pivot point position and orientation errors (POPPE) of the rotary axes A and
 // C and the three squareness errors of the linear axes of a table-table machine from R-test trajectories, by the
 // paper's fits (section 2.2), then the volumetric error along an XYZAC trajectory from the 11 errors (section 3.2).
 //
@@ -20,9 +20,13 @@
 //  +Y and +X (so a positive EA0Z tilts Z towards −Y and the paper's C_YZ reads −EA0Z).
 // The formulas are first order and each reading also sees the other errors (e.g. the A-axis tilt about Y and the
 // ZX squareness both tilt the ball path of the YZA and tilted runs). `refine` Gauss–Newton steps on the exact model
-// (seed001_refine.hpp) find the errors whose simulated trajectories give the same fit readings as the
+// (reading_refinement.hpp) find the errors whose simulated trajectories give the same fit readings as the
 // measurement — as the paper eliminates known errors with its kinematic model (section 3.1); refine = 0 gives the
 // plain formulas.
+// Source: M. Morávek, O. Hořejš, P. Bach, "Set of geometric errors evaluation based on R-test measurement",
+// MM Science Journal 2019 (DOI 10.17973/MMSJ.2019_03_2018106), shared/seeds/001: section 2.2, eq. (2), section 3.2.
+// Names: ISO 230-1 (iso_names.hpp); the fits produce link values, the squareness readings C of eq. (2) are the
+// aliases CXY, CZX, CYZ of the sample machine (90° minus the angle between the positive directions).
 #include <string>
 #include <vector>
 
@@ -32,12 +36,12 @@
 
 namespace cnccomp {
 
-struct Seed001Options {
+struct RtestLocationOptions {
     std::string outerAxis = "A", innerAxis = "C";
     int refine = 4;  ///< Gauss–Newton steps on the formula readings (0 = the plain formulas)
 };
 
-struct Seed001Result {
+struct RtestLocationResult {
     DeviationSet deviations;         ///< the 11 errors, present
     DeviationSet plain;              ///< the plain formulas (each reading taken as its error)
     Circle3Fit outerCircle, innerCircle;  ///< ball-path circles of the YZA and XYC runs (measured data)
@@ -48,10 +52,10 @@ struct Seed001Result {
 };
 
 /// Finds the runs by what moves: the inner axis alone with the outer at 0 (XYC), at ±φ (tilted XYC), the outer
-/// alone (YZA); runs where both turn are ignored (XYZAC, for seed001Volumetric). Throws ModelError naming what is
+/// alone (YZA); runs where both turn are ignored (XYZAC, for volumetricErrorAlongRun). Throws ModelError naming what is
 /// missing, or when the machine lacks one of the 11 deviations.
-Seed001Result seed001Formulas(const MachineModel& m, const std::vector<RtestRun>& runs,
-                              const std::vector<RtestTrace>& traces, const Seed001Options& options = {});
+RtestLocationResult rtestLocationFits(const MachineModel& m, const std::vector<RtestRun>& runs,
+                              const std::vector<RtestTrace>& traces, const RtestLocationOptions& options = {});
 
 /// Section 3.2: along a (typically XYZAC) run, the measured displacement ("ErrMTCH"), the displacement the
 /// identified deviations predict on the exact model ("ErrCALC") and their difference ("deltaERR").
@@ -60,7 +64,7 @@ struct VolumetricAlongRun {
     double rmsResidual = 0, maxResidual = 0;  ///< of |measured − predicted|, mm
     double rmsMeasured = 0;                   ///< of |measured|, mm
 };
-VolumetricAlongRun seed001Volumetric(const MachineModel& m, const DeviationSet& identified, const RtestRun& run,
+VolumetricAlongRun volumetricErrorAlongRun(const MachineModel& m, const DeviationSet& identified, const RtestRun& run,
                                      const RtestTrace& trace);
 
 }  // namespace cnccomp

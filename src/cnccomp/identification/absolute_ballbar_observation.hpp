@@ -1,5 +1,5 @@
 #pragma once
-// Observation model of an absolute ball-bar run (seed 002): Ball 2 at its nominal position instead of being set on
+// Observation model of an absolute ball-bar run (the head patterns of tilting_head_errors.hpp): Ball 2 at its nominal position instead of being set on
 // Ball 1 at the setup pose, ΔL = |p_T(q) − p_W| − LB with p_W fixed (see simulateAbsoluteRun).
 #include "cnccomp/identification/observation.hpp"
 

@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed004_cradle.hpp"
+#include "cnccomp/identification/rtest_axis_tables.hpp"
 
 #include <algorithm>
 #include <array>
@@ -50,7 +50,7 @@ std::array<const DeviationDef*, 6> axisTables(const MachineModel& m, const std::
     for (int c = 0; c < 6; ++c) {
         const std::string name = kComponents[c] + axis;
         const int i = m.deviationIndex(name);
-        if (i < 0) throw ModelError(fmt::format("machine '{}' has no component error '{}' (seed 004 needs all six of {})", m.name, name, axis));
+        if (i < 0) throw ModelError(fmt::format("machine '{}' has no component error '{}' (the per-angle R-test method needs all six of {})", m.name, name, axis));
         const DeviationDef& d = m.deviations[static_cast<size_t>(i)];
         if (d.kind != DeviationKind::Component || d.basis.type != ComponentBasis::Type::Table)
             throw ModelError(fmt::format("machine '{}': '{}' must be a component error with a table basis", m.name, name));
@@ -195,7 +195,7 @@ DeviationSet cradleDeviations(const MachineModel& m, const std::vector<AxisError
     return set;
 }
 
-DeviationSet seed004Formulas(const MachineModel& m, const std::string& outerAxis, const std::string& innerAxis,
+DeviationSet cradleTablesPerAngle(const MachineModel& m, const std::string& outerAxis, const std::string& innerAxis,
                              const std::vector<RtestRun>& runs, const std::vector<RtestTrace>& traces,
                              std::vector<AxisErrors>* perAngle) {
     const AxisErrors outer = cradleAxisErrors(m, outerAxis, runs, traces);
@@ -249,7 +249,7 @@ CradleLsq cradleLeastSquares(const MachineModel& m, const std::string& outerAxis
     CradleLsq out{IdentificationReport{}, problem.deviations(so.x)};
     IdentificationReport& rep = out.report;
     rep.machine = m.name;
-    rep.method = "least-squares (seed 004 tables, gauge: inner-axis errors zero at 0)";
+    rep.method = "least-squares (six error tables per rotary axis, gauge: inner-axis errors zero at 0)";
     rep.solver = "levenberg-marquardt";
     rep.termination = so.termination;
     rep.converged = so.converged;

@@ -38,7 +38,7 @@ bool contains(const std::vector<std::string>& v, const std::string& s) {
     return std::find(v.begin(), v.end(), s) != v.end();
 }
 
-TEST(PlannerSeed000, AtMostSixRunsIdentifyTheTwelveFromRawTraces) {
+TEST(PlannerMultitasking, AtMostSixRunsIdentifyTheTwelveFromRawTraces) {
     const MachineModel& m = test::multitasking();
     PlannerOptions o;
     o.identify = parseDeviationList(m, kTwelve);
@@ -88,7 +88,7 @@ TEST(PlannerSeed000, AtMostSixRunsIdentifyTheTwelveFromRawTraces) {
     }
 }
 
-TEST(PlannerSeed000, EccentricitiesNeedTheCXRunForSquarenessXY) {
+TEST(PlannerMultitasking, EccentricitiesNeedTheCXRunForSquarenessXY) {
     // Planning for seed 000's closed-form input (circle centres only): six runs still suffice for the twelve, and
     // γXY is seen by a single run type. Seed 000 section 4.2 names the Y-direction run; in the exact model with the
     // W-side ball set on the T-side ball it is the X-direction run (see Table3.SquarenessXYShowsInTheCXRunNotTheCYRun).
@@ -139,7 +139,7 @@ TEST(PlannerSeed000, EccentricitiesNeedTheCXRunForSquarenessXY) {
     EXPECT_NEAR(r.deviations.get("gXY"), truth().get("gXY"), 0.05 * kArcsec);
 }
 
-TEST(PlannerSeed000, WrittenPlanReadsBack) {
+TEST(PlannerMultitasking, WrittenPlanReadsBack) {
     const MachineModel& m = test::multitasking();
     PlannerOptions o;
     o.identify = parseDeviationList(m, "gXB,dzBT");
@@ -159,7 +159,7 @@ TEST(PlannerSeed000, WrittenPlanReadsBack) {
     EXPECT_EQ(back.machine, "multitasking");
 }
 
-TEST(PlannerSeed000, ImpossibleRequestIsNamed) {
+TEST(PlannerMultitasking, ImpossibleRequestIsNamed) {
     // Only B-axis run types: the C-axis location errors cannot be made identifiable.
     const MachineModel& m = test::multitasking();
     PlannerOptions o;
@@ -171,7 +171,7 @@ TEST(PlannerSeed000, ImpossibleRequestIsNamed) {
     for (const DeviationNeed& n : p.needs) EXPECT_EQ(n.identified, n.alias == "gXB") << n.name;
 }
 
-TEST(PlannerSeed000, MountingOffsetsAndBadOptions) {
+TEST(PlannerMultitasking, MountingOffsetsAndBadOptions) {
     const MachineModel& m = test::multitasking();
     PlannerOptions o;
     o.identify = parseDeviationList(m, kTwelve);

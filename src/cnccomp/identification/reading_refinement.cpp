@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed001_refine.hpp"
+#include "cnccomp/identification/reading_refinement.hpp"
 
 #include <Eigen/LU>
 #include <fmt/format.h>

@@ -1,4 +1,4 @@
-#include "cnccomp/identification/seed002_observation.hpp"
+#include "cnccomp/identification/absolute_ballbar_observation.hpp"
 
 #include <cmath>
 

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/seed004_cradle.hpp"
+#include "cnccomp/identification/rtest_axis_tables.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "test_support.hpp"
@@ -62,7 +62,7 @@ std::pair<double, double> worst(const DeviationSet& est, const DeviationSet& tru
     return {um, as};
 }
 
-TEST(Seed004Cradle, SmallAngleModelMatchesExactKinematics) {
+TEST(RtestAxisTables, SmallAngleModelMatchesExactKinematics) {
     const MachineModel& m = tableTable();
     const DeviationSet& t = seed004().truth;
     const Kinematics k(m, t);
@@ -85,7 +85,7 @@ TEST(Seed004Cradle, SmallAngleModelMatchesExactKinematics) {
     EXPECT_LT(worstDiff, 1e-3 * kUm);  // second order: |ξ|²·|W| ≈ 1e-4 µm here
 }
 
-TEST(Seed004Cradle, PerAngleFormulasRecoverTheTables) {
+TEST(RtestAxisTables, PerAngleFormulasRecoverTheTables) {
     const MachineModel& m = tableTable();
     const Fixture& f = seed004();
     // Each axis on its own: the C sweep at A = 0 also sees A's errors at A = 0 and gives them to C.
@@ -97,7 +97,7 @@ TEST(Seed004Cradle, PerAngleFormulasRecoverTheTables) {
     const auto [um0, as0] = worst(cradleDeviations(m, {a, c}), f.truth);
     // A first, then C with A's effect removed.
     std::vector<AxisErrors> perAngle;
-    const DeviationSet d = seed004Formulas(m, "A", "C", f.plan.rtestRuns, f.traces, &perAngle);
+    const DeviationSet d = cradleTablesPerAngle(m, "A", "C", f.plan.rtestRuns, f.traces, &perAngle);
     ASSERT_EQ(perAngle.size(), 2u);
     const auto [um, as] = worst(d, f.truth);
     std::printf("[ seed 004 ] per-angle eq. (1)-(7): axes alone %.4f um, %.4f arcsec; A then C %.5f um, %.5f arcsec\n",
@@ -108,7 +108,7 @@ TEST(Seed004Cradle, PerAngleFormulasRecoverTheTables) {
     EXPECT_GT(um0, 0.1);
 }
 
-TEST(Seed004Cradle, LeastSquaresRecoversTheTablesExactly) {
+TEST(RtestAxisTables, LeastSquaresRecoversTheTablesExactly) {
     const MachineModel& m = tableTable();
     const Fixture& f = seed004();
     const CradleLsq r = cradleLeastSquares(m, "A", "C", f.plan.rtestRuns, f.traces);
@@ -120,7 +120,7 @@ TEST(Seed004Cradle, LeastSquaresRecoversTheTablesExactly) {
     EXPECT_EQ(r.report.unobservable.size(), 6u);  // the constant transform between the A and C frames
 }
 
-TEST(Seed004Cradle, CollinearBallsAreRefused) {
+TEST(RtestAxisTables, CollinearBallsAreRefused) {
     const MachineModel& m = tableTable();
     const Fixture& f = seed004();
     std::vector<RtestRun> runs(f.plan.rtestRuns.begin(), f.plan.rtestRuns.begin() + 2);

@@ -1,11 +1,11 @@
-// The other papers' methods on their sample plans (noise-free data): seed 001 R-test fits with refinement, seed 002
-// tilting-head formulas and least squares, seed 003 DBB5 formulas, seed 004 per-angle and least-squares tables.
+// The identification methods on their sample plans (noise-free data): R-test location fits with refinement, head-pattern
+// formulas and least squares, DBB5 formulas, per-angle and least-squares R-test tables.
 #include <benchmark/benchmark.h>
 
-#include "cnccomp/identification/seed001_rtest.hpp"
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/rtest_location_fits.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/identification/dbb5_location_errors.hpp"
-#include "cnccomp/identification/seed004_cradle.hpp"
+#include "cnccomp/identification/rtest_axis_tables.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -39,7 +39,7 @@ TableTable& tableTable() {
 
 struct Head {
     MachineModel machine = readMachineXml(sample("machines/tilting-head-b.xml"));
-    MeasurementPlan plan = readPlanXml(sample("plans/tilting-head-b-seed002.xml"));
+    MeasurementPlan plan = readPlanXml(sample("plans/tilting-head-b-patterns.xml"));
     std::vector<BallbarTrace> traces;
     Head() {
         const Kinematics k(machine, readDeviationCsv(sample("deviations/tilting-head-b-truth.csv"), machine));
@@ -52,23 +52,23 @@ Head& head() {
     return f;
 }
 
-void BM_Seed001RtestFitsRefined(benchmark::State& state) {
+void BM_RtestLocationFitsRefined(benchmark::State& state) {
     TableTable& f = tableTable();
-    for (auto _ : state) benchmark::DoNotOptimize(seed001Formulas(f.machine, f.rtest.rtestRuns, f.rtestTraces));
+    for (auto _ : state) benchmark::DoNotOptimize(rtestLocationFits(f.machine, f.rtest.rtestRuns, f.rtestTraces));
 }
-BENCHMARK(BM_Seed001RtestFitsRefined)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RtestLocationFitsRefined)->Unit(benchmark::kMillisecond);
 
-void BM_Seed002Formulas(benchmark::State& state) {
+void BM_HeadPatternFormulas(benchmark::State& state) {
     Head& f = head();
     for (auto _ : state) benchmark::DoNotOptimize(tiltingHeadFormulas(f.plan.absoluteRuns, f.traces));
 }
-BENCHMARK(BM_Seed002Formulas)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_HeadPatternFormulas)->Unit(benchmark::kMicrosecond);
 
-void BM_Seed002LeastSquares(benchmark::State& state) {
+void BM_HeadPatternLeastSquares(benchmark::State& state) {
     Head& f = head();
     for (auto _ : state) benchmark::DoNotOptimize(tiltingHeadLeastSquares(f.machine, f.plan.absoluteRuns, f.traces));
 }
-BENCHMARK(BM_Seed002LeastSquares)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HeadPatternLeastSquares)->Unit(benchmark::kMillisecond);
 
 void BM_Dbb5LocationErrorsRefined(benchmark::State& state) {
     TableTable& f = tableTable();
@@ -76,19 +76,19 @@ void BM_Dbb5LocationErrorsRefined(benchmark::State& state) {
 }
 BENCHMARK(BM_Dbb5LocationErrorsRefined)->Unit(benchmark::kMillisecond);
 
-void BM_Seed004PerAngle(benchmark::State& state) {
+void BM_RtestTablesPerAngle(benchmark::State& state) {
     TableTable& f = tableTable();
     for (auto _ : state)
-        benchmark::DoNotOptimize(seed004Formulas(f.machine, "A", "C", f.kinematic.rtestRuns, f.kinematicTraces));
+        benchmark::DoNotOptimize(cradleTablesPerAngle(f.machine, "A", "C", f.kinematic.rtestRuns, f.kinematicTraces));
 }
-BENCHMARK(BM_Seed004PerAngle)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RtestTablesPerAngle)->Unit(benchmark::kMicrosecond);
 
-void BM_Seed004LeastSquares(benchmark::State& state) {
+void BM_RtestTablesLeastSquares(benchmark::State& state) {
     TableTable& f = tableTable();
     for (auto _ : state)
         benchmark::DoNotOptimize(cradleLeastSquares(f.machine, "A", "C", f.kinematic.rtestRuns, f.kinematicTraces));
 }
-BENCHMARK(BM_Seed004LeastSquares)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RtestTablesLeastSquares)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace cnccomp

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/identification/seed002_tilting_head.hpp"
+#include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "test_support.hpp"
@@ -25,10 +25,10 @@ struct Fixture {
     std::vector<BallbarTrace> traces;
 };
 
-const Fixture& seed002() {
+const Fixture& headPatterns() {
     static const Fixture f = [] {
         const MachineModel& m = head();
-        Fixture x{readPlanXml(test::sourcePath("samples/plans/tilting-head-b-seed002.xml")),
+        Fixture x{readPlanXml(test::sourcePath("samples/plans/tilting-head-b-patterns.xml")),
                   readDeviationCsv(test::sourcePath("samples/deviations/tilting-head-b-truth.csv"), m), {}};
         const Kinematics k(m, x.truth);
         for (const BallbarRun& r : x.plan.absoluteRuns) x.traces.push_back(simulateAbsoluteRun(k, r));
@@ -43,7 +43,7 @@ double truthAt(const DeviationSet& t, const std::string& name, double deg) {
     return d.basis.evaluate(deg * kDeg, t.values.data() + d.offset, false);
 }
 
-TEST(Seed002TiltingHead, FirstOrderPatternEquationsHold) {
+TEST(TiltingHeadErrors, FirstOrderPatternEquationsHold) {
     // One error at a time: eq. (4) (Y pattern), (13) (X), (20) (Z) against the exact absolute ΔL.
     const MachineModel& m = head();
     const double L = 250, B = 37 * kDeg, c = std::cos(B), s = std::sin(B);
@@ -79,8 +79,8 @@ TEST(Seed002TiltingHead, FirstOrderPatternEquationsHold) {
     EXPECT_NEAR(dL(withTable("EZB", u), BallbarTest::BZ), c * u, 1e-3 * kUm);
 }
 
-TEST(Seed002TiltingHead, FormulasRecoverTheHeadErrorsAtEveryAngle) {
-    const Fixture& f = seed002();
+TEST(TiltingHeadErrors, FormulasRecoverTheHeadErrorsAtEveryAngle) {
+    const Fixture& f = headPatterns();
     const TiltingHeadResult r = tiltingHeadFormulas(f.plan.absoluteRuns, f.traces);
     ASSERT_EQ(r.angles.size(), 17u);
     double um = 0, as = std::max(std::abs(r.exB - f.truth.get("exB")), std::abs(r.eBz - f.truth.get("eBz"))) / kArcsec;
@@ -102,8 +102,8 @@ TEST(Seed002TiltingHead, FormulasRecoverTheHeadErrorsAtEveryAngle) {
     EXPECT_NEAR(d.values[ey.offset + 8], r.angles[8].ey, 1e-15);  // node 0 deg
 }
 
-TEST(Seed002TiltingHead, LeastSquaresRecoversTheTruthExactly) {
-    const Fixture& f = seed002();
+TEST(TiltingHeadErrors, LeastSquaresRecoversTheTruthExactly) {
+    const Fixture& f = headPatterns();
     const TiltingHeadLsq r = tiltingHeadLeastSquares(head(), f.plan.absoluteRuns, f.traces);
     EXPECT_TRUE(r.engine.report.unidentified.empty());
     double um = 0, as = 0;
@@ -126,8 +126,8 @@ TEST(Seed002TiltingHead, LeastSquaresRecoversTheTruthExactly) {
                 0.001 * kArcsec);
 }
 
-TEST(Seed002TiltingHead, MissingPatternIsNamed) {
-    const Fixture& f = seed002();
+TEST(TiltingHeadErrors, MissingPatternIsNamed) {
+    const Fixture& f = headPatterns();
     std::vector<BallbarRun> runs(f.plan.absoluteRuns.begin(), f.plan.absoluteRuns.begin() + 4);
     std::vector<BallbarTrace> traces(f.traces.begin(), f.traces.begin() + 4);
     try {

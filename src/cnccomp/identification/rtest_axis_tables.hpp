@@ -1,5 +1,6 @@
 #pragma once
-// Seed 004 (Zhang, Fu & Chen): the six kinematic errors of each rotary axis of a cradle (A tilting table carrying a
+// Per-angle R-test tables ("A simple modeling method to identify the kinematic errors of machine tool rotary table",
+// Zhejiang University, shared/seeds/004): the six kinematic errors of each rotary axis of a cradle (A tilting table carrying a
 // C rotary table) as functions of its angle — three linear shifts δ(θ) and three angular errors ξ(θ) of the axis'
 // rotating frame — and the small-angle model of the workpiece point, eq. (1)–(7):
 //   ᶜW = ᶜδ(γ) + R(ᶜξ(γ))·W_N (1),   ᴬW = ᴬδ(α) + R(ᴬξ(α))·(Rot_C(γ)·ᶜW) (4),   W_F = Rot_A(α)·ᴬW,
@@ -49,7 +50,7 @@ DeviationSet cradleDeviations(const MachineModel& m, const std::vector<AxisError
 /// Both axes by the per-angle route: the outer axis first (its sweeps hold the inner axis at 0, where the gauge puts
 /// the inner errors at zero), then the inner axis after removing from its runs the displacement the identified outer
 /// tables cause at the held outer position (exact model). `perAngle` receives the two per-angle results.
-DeviationSet seed004Formulas(const MachineModel& m, const std::string& outerAxis, const std::string& innerAxis,
+DeviationSet cradleTablesPerAngle(const MachineModel& m, const std::string& outerAxis, const std::string& innerAxis,
                              const std::vector<RtestRun>& runs, const std::vector<RtestTrace>& traces,
                              std::vector<AxisErrors>* perAngle = nullptr);
 
