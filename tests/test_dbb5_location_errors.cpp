@@ -167,11 +167,14 @@ TEST(Dbb5LocationErrors, PlainValuesCarryTheirOwnDefinitions) {
         EXPECT_NE(r.formulas[7].definition.find("relative to the machine axes (B at 0)"), std::string::npos)
             << r.formulas[7].definition;
     }
-    // Squareness: the model turns the downstream slide (X about Z by EC0Y, Z about X by EA0Z and about Y by EB0Z), so
-    // 90° − ∠(X,Y) = EC0Y, 90° − ∠(Y,Z) = −EA0Z, 90° − ∠(Z,X) = EB0Z.
+    // Squareness under ISO 230-1 names (X∠Y = 90° + EC0Y, Y∠Z = 90° + EA0Z, Z∠X = 90° − EB0Z), so
+    // 90° − ∠(X,Y) = −EC0Y, 90° − ∠(Y,Z) = −EA0Z, 90° − ∠(Z,X) = EB0Z: the machine's aliases CXY, CYZ, CZX.
     const Dbb5LocationResult r = dbb5LocationErrors(*bcCase().machine, bcCase().plan.dbb5Runs, bcCase().traces);
     const DeviationSet& t = bcCase().truth;
-    EXPECT_NEAR(formula(r, "90deg-angle(X,Y)"), t.get("EC0Y"), 0.001 * kArcsec);
+    EXPECT_NEAR(formula(r, "90deg-angle(X,Y)"), -t.get("EC0Y"), 0.001 * kArcsec);
+    EXPECT_NEAR(formula(r, "90deg-angle(X,Y)"), t.aliasValue(t.require("EC0Y")), 0.001 * kArcsec);
+    EXPECT_NEAR(formula(r, "90deg-angle(Y,Z)"), t.aliasValue(t.require("EA0Z")), 0.001 * kArcsec);
+    EXPECT_NEAR(formula(r, "90deg-angle(Z,X)"), t.aliasValue(t.require("EB0Z")), 0.001 * kArcsec);
     EXPECT_NEAR(formula(r, "90deg-angle(Y,Z)"), -t.get("EA0Z"), 0.001 * kArcsec);
     EXPECT_NEAR(formula(r, "90deg-angle(Z,X)"), t.get("EB0Z"), 0.001 * kArcsec);
     // The geometric readings of the converted set reproduce the formula values (the conversion is exact).

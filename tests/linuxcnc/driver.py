@@ -14,6 +14,7 @@ Any LinuxCNC error (error channel) or timeout ends the run with exit code 1 and 
 Needs /usr/bin/python3 (the linuxcnc and hal modules of the Debian package live in the system dist-packages).
 """
 import os
+import re
 import sys
 import time
 
@@ -100,6 +101,10 @@ def main():
     command.home(-1)
     command.wait_complete()
     wait(lambda: all(stat.homed[j] for j in range(JOINTS)), 10, "homing")
+    # The tool table reaches task through iocontrol, which may still be loading it on a busy machine ("Requested tool
+    # N not found in the tool table" on the first T word): wait until every tool the job names is there.
+    tools = {int(n) for step in JOB for n in re.findall(r"\bT(\d+)", step)}
+    wait(lambda: tools <= {t.id for t in stat.tool_table}, 30, "the tool table (tools %s)" % sorted(tools))
     command.mode(linuxcnc.MODE_MDI)
     command.wait_complete()
     lines = []
