@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -50,6 +51,9 @@ std::optional<pp::Dialect> dialectOf(const std::string& name) {
 }
 
 void run(const Options& o) {
+    // Outputs first: a folder, a device or a missing folder as --out / --report fails before any work.
+    checkOutputPath(o.out);
+    if (!o.report.empty()) checkOutputPath(o.report);
     const MachineModel m = readMachineXml(o.machine);
     const DeviationSet d = readDeviationCsv(o.deviations, m);
     refuseToOverwrite(o.out, {o.in, o.machine, o.deviations, o.setup});
@@ -80,26 +84,21 @@ void run(const Options& o) {
                          static_cast<int>(100.0 * std::min<double>(1.0, double(done) / double(total))));
             std::fflush(stderr);
         };
-    // The report streams to a temporary file, renamed only when the correction succeeded.
-    std::ofstream report;
-    std::string reportTmp;
+    // Both files are written atomically: temporary files beside the targets, renamed only when the correction succeeded.
+    std::optional<AtomicFile> report;
     if (!o.report.empty()) {
-        reportTmp = o.report + ".tmp" + std::to_string(::getpid());
-        report.open(reportTmp, std::ios::binary | std::ios::trunc);
-        if (!report) throw InputError(o.report, 0, "cannot create the report file");
-        report << "line,kind,message\n";
-        co.report = &report;
+        report.emplace(o.report);
+        report->stream() << "line,kind,message\n";
+        co.report = &report->stream();
     }
     pp::CorrectSummary summary;
     try {
-        writeFileAtomically(o.out, [&](std::ostream& out) { summary = pp::correctProgram(m, d, in, out, co); });
-        if (!o.report.empty()) {
-            report.close();
-            std::filesystem::rename(reportTmp, o.report);
-        }
+        AtomicFile out(o.out);
+        summary = pp::correctProgram(m, d, in, out.stream(), co);
+        out.commit();
+        if (report) report->commit();
     } catch (...) {
         if (bar) std::fprintf(stderr, "\n");
-        if (!reportTmp.empty()) std::filesystem::remove(reportTmp, ec);
         throw;
     }
     if (bar) std::fprintf(stderr, "\r%60s\r", "");

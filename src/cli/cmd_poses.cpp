@@ -20,6 +20,7 @@ struct Options {
 };
 
 void run(const Options& o) {
+    if (!o.out.empty()) checkOutputPath(o.out);  // a folder or a device as --out fails before any work
     pp::PosesOptions po;
     if (o.dialect != "auto") {
         po.dialect = pp::parseDialect(o.dialect);
