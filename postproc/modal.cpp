@@ -274,6 +274,32 @@ void Interpreter::forgetAll(BlockResult& r, const char* reason) {
     motion_ = Motion::Unknown;
 }
 
+bool Interpreter::forgetOverlong(const OverlongLine& l, BlockResult& r) {
+    static constexpr char kModal[] = "GMOLPQHDTEUVWIJKR";
+    bool modal = l.other;
+    for (const char* c = kModal; *c && !modal; ++c)
+        if (layout_.axis(*c) < 0 && l.has(*c)) modal = true;
+    const char* why = "line longer than the read buffer";
+    if (modal) {
+        forgetAll(r, why);
+        return true;
+    }
+    AxisMask named = 0;
+    for (int a = 0; a < layout_.count; ++a)
+        if (l.has(layout_.letter[a])) named |= 1u << a;
+    r = BlockResult{};
+    r.start = pos_;
+    r.end = pos_;
+    r.startKnown = known_;
+    r.axisWord.fill(-1);
+    passThrough(r, why, 0);
+    known_ &= ~named;
+    assumed_ &= ~named;
+    r.endKnown = known_;
+    r.words = named;
+    return false;
+}
+
 bool Interpreter::isDimensionLetter(char c) const {
     return layout_.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || c == 'U' || c == 'V' || c == 'W';
 }
@@ -627,7 +653,7 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         unknownAll(r);
         return;
     }
-    constexpr uint32_t kValueFlags = kExpression | kVariable | kAssignment | kMissingValue | kBadNumber;
+    constexpr uint32_t kValueFlags = kExpression | kVariable | kAssignment | kMissingValue | kBadNumber | kExponent;
     if (flags & kNotEvaluable & ~kValueFlags) {
         passThrough(r, lexFlagReason(flags & kNotEvaluable & ~kValueFlags), 0);
         unknownAll(r);

@@ -116,6 +116,10 @@ public:
     void interpret(std::string_view line, const LexedBlock& block, BlockResult& result);
     /// A line the caller could not lex (overlong): everything becomes unknown.
     void forgetAll(BlockResult& result, const char* reason);
+    /// A line the caller could not lex because it is longer than its buffer (gathered in `line`): the axes it names
+    /// become unknown; when it holds G/M/O … codes or anything but plain words, every position and the motion mode
+    /// do. Returns true in that second case. Comment-only lines change nothing (call only when line.code).
+    bool forgetOverlong(const OverlongLine& line, BlockResult& result);
 
     const AxisLayout& layout() const { return layout_; }
     const AxisVector& position() const { return pos_; }

@@ -23,19 +23,22 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
     LexedBlock b;
     BlockResult r;
     Line line;
-    uint64_t no = 0;
-    bool inLong = false;
+    OverlongLine overlong;
     static constexpr char kColumns[] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
     fmt::memory_buffer row;
     while (reader.next(line)) {
-        ++no;
-        ++s.lines;
+        const uint64_t no = line.number;
+        if (line.firstPiece) ++s.lines;
         if (line.partial) {
-            if (!inLong) interp.forgetAll(r, "line longer than the read buffer");
-            inLong = line.eol.empty();
+            // The same rule as `correct`: an overlong line forgets what it may change, nothing more.
+            if (line.firstPiece) overlong.reset();
+            overlong.feed(line.text);
+            if (line.lastPiece && overlong.code) {
+                ++s.passedThrough;
+                interp.forgetOverlong(overlong, r);
+            }
             continue;
         }
-        inLong = false;
         lexBlock(line.text, s.dialect, b, no == 1);
         interp.interpret(line.text, b, r);
         const bool moveRow = r.kind == BlockKind::Move;

@@ -74,10 +74,11 @@ public:
         all_ = layout_.all();
     }
 
-    void line(const Line& ln, uint64_t no);
+    void line(const Line& ln);
 
 private:
     void notice(bool warning, uint64_t line, std::string message);
+    void overlong(uint64_t no);
     void updateStyles(const LexedBlock& b);
     void warnings(uint64_t no);
     void passThrough(const Line& ln, uint64_t no);
@@ -115,7 +116,8 @@ private:
     AxisMask outKnown_ = 0, all_ = 0;
     Motion outMotion_ = Motion::Unknown;
     std::vector<Piece> pieces_;
-    bool inLong_ = false;
+    OverlongLine long_;
+    bool warnedCr_ = false;
     bool warnedDecimals_ = false;
     std::string lastEol_ = "\n";
 };
@@ -595,23 +597,42 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     outMotion_ = arcToLines ? Motion::Linear : r_.motion;
 }
 
-void ProgramCorrector::line(const Line& ln, uint64_t no) {
-    if (!ln.partial || !inLong_) ++summary_.lines;  // the pieces of an overlong line count as one line
+void ProgramCorrector::overlong(uint64_t no) {
+    if (!long_.code) return;  // white space and comments only: nothing it could change
+    ++summary_.blocks;
+    ++summary_.passedThrough;
+    const bool modal = interp_.forgetOverlong(long_, r_);
+    std::string axes;
+    for (int a = 0; a < layout_.count; ++a)
+        if (r_.words & (1u << a)) axes.push_back(layout_.letter[a]);
+    if (modal) {
+        outKnown_ = 0;
+        outMotion_ = Motion::Unknown;
+    } else {
+        outKnown_ &= ~r_.words;
+    }
+    notice(false, no,
+           fmt::format("line longer than {} bytes: passed through unparsed; {}", options_.bufferSize,
+                       modal ? "it holds codes that may change any mode: every position is unknown afterwards"
+                             : axes.empty() ? "it names no axis: positions kept"
+                                            : fmt::format("positions of {} unknown afterwards", axes)));
+}
+
+void ProgramCorrector::line(const Line& ln) {
+    const uint64_t no = ln.number;
+    if (ln.firstPiece) ++summary_.lines;  // the pieces of an overlong line count as one line
+    if (ln.eol.size() == 1 && ln.eol[0] == '\r' && !warnedCr_) {
+        warnedCr_ = true;
+        notice(true, no, "lines end with a lone CR (classic Mac OS line ends): read as line ends and kept");
+    }
     if (ln.partial) {
         out_.write(ln.text);
         out_.write(ln.eol);
-        if (!inLong_) {
-            ++summary_.blocks;
-            ++summary_.passedThrough;
-            interp_.forgetAll(r_, "line longer than the read buffer");
-            outKnown_ = 0;
-            outMotion_ = Motion::Unknown;
-            notice(false, no, fmt::format("line longer than {} bytes: passed through unparsed", options_.bufferSize));
-        }
-        inLong_ = ln.eol.empty();
+        if (ln.firstPiece) long_.reset();
+        long_.feed(ln.text);
+        if (ln.lastPiece) overlong(no);
         return;
     }
-    inLong_ = false;
     lexBlock(ln.text, dialect_, b_, no == 1);
     updateStyles(b_);
     interp_.interpret(ln.text, b_, r_);
@@ -664,10 +685,9 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     OutputBuffer buffer(out);
     ProgramCorrector pc(machine, deviations, options, s.dialect, s, buffer);
     Line line;
-    uint64_t no = 0;
     while (reader.next(line)) {
-        pc.line(line, ++no);
-        if (options.progress && (no & 0x1fff) == 0) options.progress(reader.bytesConsumed());
+        pc.line(line);
+        if (options.progress && (line.number & 0x1fff) == 0 && line.lastPiece) options.progress(reader.bytesConsumed());
     }
     buffer.flush();
     if (options.progress) options.progress(reader.bytesConsumed());
