@@ -293,9 +293,36 @@ void lexBlock(std::string_view s, Dialect dialect, LexedBlock& b, bool firstLine
                             w.kind = ValueKind::Exponent;  // its value is not the number's: never used
                         }
                     }
-                    // A number directly followed by '=' is an assignment target (R1=…, #1=…).
+                    // A number directly followed by '=' is an assignment target (R1=…, #1=…), or on Sinumerik an
+                    // address with an extension and a plain number: A3=0.5 (orientation vector component).
                     size_t k = j;
                     while (k < n && isSpace(s[k])) ++k;
+                    if (k < n && s[k] == '=' && dialect == Dialect::Sinumerik && !w.point && !w.plus &&
+                        (w.letter == 'A' || w.letter == 'B' || w.letter == 'C') &&
+                        s[w.valueBegin] != '-' && w.value >= 1 && w.value <= 9 && w.valueBegin == i + 1) {
+                        size_t m = k + 1;
+                        while (m < n && (s[m] == ' ' || s[m] == '\t')) ++m;
+                        Word v;
+                        bool badValue = false;
+                        const size_t e2 = scanNumber(s, m, v, badValue);
+                        const bool ends = e2 >= n || isSpace(s[e2]) || s[e2] == ';' || s[e2] == '(';
+                        if (e2 > m && !badValue && ends) {
+                            const auto ext = static_cast<uint8_t>(w.value);
+                            const uint32_t wordBegin = w.begin;
+                            const bool wasLower = w.lower;
+                            w = v;
+                            w.begin = wordBegin;
+                            w.letter = upper(c);
+                            w.lower = wasLower;
+                            w.ext = ext;
+                            w.valueBegin = static_cast<uint32_t>(m);
+                            w.end = static_cast<uint32_t>(e2);
+                            ++b.count;
+                            i = e2;
+                            endToken(i);
+                            continue;
+                        }
+                    }
                     if (k < n && s[k] == '=') {
                         w.end = static_cast<uint32_t>(n);
                         ++b.count;

@@ -54,6 +54,7 @@ struct Word {
     bool trailingZero = false;  ///< the fraction ends in '0' (fixed-width style)
     uint8_t decimals = 0;       ///< digits after the point
     uint8_t digitsBefore = 0;   ///< digits before the point (leading zeros included)
+    uint8_t ext = 0;            ///< Sinumerik address extension: A3=0.5 is letter A, ext 3 (0: a plain word)
 };
 
 struct Span {

@@ -136,26 +136,34 @@ TEST(PostprocSplit, RotaryMovesAreSplitUntilMidpointsMeetTheTolerance) {
     std::vector<Piece> pieces;
     SplitStats stats;
     const MovePath path = MovePath::line(a, b);
-    corrector.split(path, qa, qb, 100, true, pieces, stats);
+    PathContext ctx;
+    ctx.space.toolLength = 100;
+    ctx.outStart.p = qa;
+    ctx.tolerance = o.toleranceMm;
+    ctx.guess = a;
+    ProgramPoint end;
+    end.p = qb;
+    corrector.split(path, ctx, end, true, pieces, stats);
     ASSERT_GT(pieces.size(), 2u);
     EXPECT_FALSE(stats.limited);
     EXPECT_DOUBLE_EQ(pieces.back().t, 1.0);
     // Independent re-check of every piece's midpoint (and a quarter point, which the splitter never looked at).
-    AxisVector prev = qa, qn;
+    AxisVector prev = qa;
+    ProgramPoint qn;
     double prevT = 0, worst = 0;
     for (const Piece& p : pieces) {
         for (double f : {0.25, 0.5, 0.75}) {
             path.at(prevT + f * (p.t - prevT), qn);
-            worst = std::max(worst, corrector.tipDeviation(qn, prev + f * (p.q - prev), 100));
+            worst = std::max(worst, corrector.tipDeviation(qn.p, prev + f * (p.q.p - prev), 100));
         }
-        prev = p.q;
+        prev = p.q.p;
         prevT = p.t;
     }
     EXPECT_LT(worst, 0.5e-3 * 1.2);
     // Without subdivision the same move is far off.
     std::vector<Piece> one;
     SplitStats single;
-    corrector.split(path, qa, qb, 100, false, one, single);
+    corrector.split(path, ctx, end, false, one, single);
     EXPECT_EQ(one.size(), 1u);
     EXPECT_GT(single.maxDeviation, 2 * 0.5e-3);
 }
