@@ -22,12 +22,13 @@ inline void rotateAboutUnit(Mat3& R, int k, double angle) {
 CompiledKinematics::CompiledKinematics(const MachineModel& machine, const DeviationSet* deviations)
     : machine_(&machine),
       values_(deviations ? deviations->values : Eigen::VectorXd::Zero(machine.parameterCount())) {
-    compile(machine.workpiece, Side::Workpiece, workpiece_);
-    compile(machine.tool, Side::Tool, tool_);
+    compile(machine.workpiece, Side::Workpiece, workpiece_, workpieceAxes_);
+    compile(machine.tool, Side::Tool, tool_, toolAxes_);
 }
 
-void CompiledKinematics::compile(const Chain& chain, Side side, std::vector<Op>& ops) {
+void CompiledKinematics::compile(const Chain& chain, Side side, std::vector<Op>& ops, std::vector<int>& axes) {
     ops.clear();
+    axes.clear();
     Frame pending;  // constant transforms not emitted yet
     auto flush = [&]() {
         if (isIdentity(pending.R, pending.t)) return;
@@ -58,6 +59,7 @@ void CompiledKinematics::compile(const Chain& chain, Side side, std::vector<Op>&
         pending.t = pending.R * placed.translation() + pending.t;
         pending.R = pending.R * placed.linear();
         if (l.kind == AxisKind::Fixed) continue;
+        axes.push_back(l.axisIndex);
         flush();
         Op op;
         op.kind = l.kind == AxisKind::Linear ? OpKind::Linear : OpKind::Rotary;
@@ -112,10 +114,34 @@ void CompiledKinematics::evaluate(const std::vector<Op>& ops, const AxisVector& 
     }
 }
 
+void CompiledKinematics::cached(const std::vector<Op>& ops, const std::vector<int>& axes, ChainCache& cache,
+                                const AxisVector& q, Frame& f, Lines* lines) const {
+    bool hit = cache.valid && (cache.hasLines || !lines);
+    for (size_t k = 0; k < axes.size() && hit; ++k) hit = cache.key[k] == q[axes[k]];
+    if (hit) {
+        f = cache.frame;
+        if (lines) {
+            for (int k = 0; k < cache.lines.count; ++k) lines->items[lines->count++] = cache.lines.items[k];
+        }
+        return;
+    }
+    if (lines) {
+        cache.lines.count = 0;
+        evaluate(ops, q, f, &cache.lines);
+        for (int k = 0; k < cache.lines.count; ++k) lines->items[lines->count++] = cache.lines.items[k];
+    } else {
+        evaluate(ops, q, f, nullptr);
+    }
+    cache.frame = f;
+    cache.hasLines = lines != nullptr;
+    cache.valid = true;
+    for (size_t k = 0; k < axes.size(); ++k) cache.key[k] = q[axes[k]];
+}
+
 void CompiledKinematics::toolPose(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
     Frame w, t;
-    evaluate(workpiece_, q, w, nullptr);
-    evaluate(tool_, q, t, nullptr);
+    cached(workpiece_, workpieceAxes_, workpieceCache_, q, w, nullptr);
+    cached(tool_, toolAxes_, toolCache_, q, t, nullptr);
     const Vec3 dirB = t.R * machine_->toolDirection;
     tip = w.R.transpose() * (t.t + length * dirB - w.t);
     axis = w.R.transpose() * dirB;
@@ -130,9 +156,9 @@ Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {
 void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const {
     Lines lines;
     Frame w, t;
-    evaluate(workpiece_, q, w, &lines);
+    cached(workpiece_, workpieceAxes_, workpieceCache_, q, w, &lines);
     const int workpieceLines = lines.count;
-    evaluate(tool_, q, t, &lines);
+    cached(tool_, toolAxes_, toolCache_, q, t, &lines);
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
     const Mat3 wRb = w.R.transpose();
@@ -155,13 +181,13 @@ void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobi
 
 Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const {
     Frame f;
-    evaluate(workpiece_, q, f, nullptr);
+    cached(workpiece_, workpieceAxes_, workpieceCache_, q, f, nullptr);
     return f;
 }
 
 Frame CompiledKinematics::baseToTool(const AxisVector& q) const {
     Frame f;
-    evaluate(tool_, q, f, nullptr);
+    cached(tool_, toolAxes_, toolCache_, q, f, nullptr);
     return f;
 }
 

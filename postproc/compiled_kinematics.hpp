@@ -54,12 +54,24 @@ private:
         JointLine items[kMaxAxes];
         int count = 0;
     };
-    void compile(const Chain& chain, Side side, std::vector<Op>& ops);
+    /// The last evaluation of a chain, reused while the positions of its own axes are unchanged (consecutive
+    /// evaluations often share the rotary positions: the nominal target, the TCP world point, the check).
+    struct ChainCache {
+        bool valid = false, hasLines = false;
+        double key[kMaxAxes] = {};
+        Frame frame;
+        Lines lines;
+    };
+    void compile(const Chain& chain, Side side, std::vector<Op>& ops, std::vector<int>& axes);
     void evaluate(const std::vector<Op>& ops, const AxisVector& q, Frame& f, Lines* lines) const;
+    void cached(const std::vector<Op>& ops, const std::vector<int>& axes, ChainCache& cache, const AxisVector& q,
+                Frame& f, Lines* lines) const;
 
     const MachineModel* machine_;
     Eigen::VectorXd values_;
     std::vector<Op> workpiece_, tool_;
+    std::vector<int> workpieceAxes_, toolAxes_;
+    mutable ChainCache workpieceCache_, toolCache_;  ///< not thread-safe: one object per thread
 };
 
 }  // namespace cnccomp::pp

@@ -93,7 +93,8 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
             const Vec3 point = tcp_.pointFromWorld(Vec3(p.p[lx], p.p[ly], p.p[lz]));
             const Vec3 axis = tcp_.axisFromWorld(p.v.normalized());
             const AxisMask all = (1u << p.p.size()) - 1u;
-            const SolveResult r = solveOn(nominal_, nominalCache_, point, axis, s.controlLength, guess, guess, all, c);
+            const double lam2 = options_.rotaryDamping * options_.rotaryDamping;
+            const SolveResult r = solveOn(nominal_, nominalCache_, point, axis, s.controlLength, guess, guess, lam2, all, c);
             return r.converged && r.tipError < 1e-6 && r.axisError < 1e-6;
         }
     }
@@ -119,8 +120,9 @@ void Corrector::toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint&
     }
 }
 
-bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength) const {
-    if (!cache.valid || cache.toolLength != toolLength || cache.q.size() != q.size()) return false;
+bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength, double lambda2) const {
+    if (!cache.valid || cache.toolLength != toolLength || cache.lambda2 != lambda2 || cache.q.size() != q.size())
+        return false;
     for (int i = 0; i < q.size(); ++i) {
         const double d = std::fabs(q[i] - cache.q[i]);
         if ((rotary_ & (1u << i)) ? d > 0.5 * kDeg : d > 10.0) return false;
@@ -129,9 +131,9 @@ bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, dou
 }
 
 void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength,
-                                AxisMask free) const {
+                                double lam2, AxisMask free) const {
     const int n = static_cast<int>(q.size());
-    const double w = options_.axisWeight, lam2 = options_.rotaryDamping * options_.rotaryDamping;
+    const double w = options_.axisWeight;
     Vec3 tip, axis;
     k.jacobian(q, toolLength, cache.J, tip, axis);
     cache.J.bottomRows<3>() *= w;
@@ -154,22 +156,23 @@ void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cach
         if (!(free & (1u << i))) cache.gain.row(i).setZero();
     cache.q = q;
     cache.toolLength = toolLength;
+    cache.lambda2 = lam2;
     cache.valid = true;
 }
 
 SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip,
                                const Vec3& targetAxis, double toolLength, const AxisVector& start,
-                               const AxisVector& reference, AxisMask free, AxisVector& c) const {
+                               const AxisVector& reference, double lam2, AxisMask free, AxisVector& c) const {
     SolveResult res;
     const int n = static_cast<int>(start.size());
     AxisVector q = start + zero_;
     const AxisVector ref = reference + zero_;
-    const double w = options_.axisWeight, lam2 = options_.rotaryDamping * options_.rotaryDamping;
+    const double w = options_.axisWeight;
     AxisVector g(n), step(n);
     Eigen::Matrix<double, 6, 1> r;
     bool fresh = false;
-    if (!cacheUsable(cache, q, toolLength)) {
-        refreshJacobian(k, cache, q, toolLength, free);
+    if (!cacheUsable(cache, q, toolLength, lam2)) {
+        refreshJacobian(k, cache, q, toolLength, lam2, free);
         fresh = true;
     }
     double lastStep = HUGE_VAL, linStep = 0.0, rotStep = 0.0;
@@ -199,7 +202,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
         double size = newtonStep();
         // Chord method: the kept Jacobian while the steps shrink fast, a fresh one when they do not.
         if (!fresh && size > 0.25 * lastStep) {
-            refreshJacobian(k, cache, q, toolLength, free);
+            refreshJacobian(k, cache, q, toolLength, lam2, free);
             fresh = true;
             size = newtonStep();
         }
@@ -221,7 +224,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
 }
 
 SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
-                             const AxisVector* reference) const {
+                             const AxisVector* neighbourDelta, const Vec3& tipShift) const {
     const int n = static_cast<int>(cNom.size());
     if (identity_) {
         c = cNom;
@@ -236,14 +239,24 @@ SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const Ax
         for (int i = 0; i < n; ++i)
             if (rotary_ & (1u << i)) s[i] = cNom[i];
     }
+    // Two pulls on the rotary corrections d = c − cNom: λp²|d|² + λc²|d − dNeighbour|² = (λp² + λc²)|d − dRef|² + const,
+    // dRef = λc² dNeighbour / (λp² + λc²).
+    const double lp2 = options_.rotaryDamping * options_.rotaryDamping, lc2 = options_.continuity * options_.continuity;
+    double lam2 = lp2;
+    AxisVector reference = cNom;
+    if (neighbourDelta && lc2 > 0) {
+        lam2 = lp2 + lc2;
+        for (int i = 0; i < n; ++i)
+            if (rotary_ & (1u << i)) reference[i] += (lc2 / lam2) * (*neighbourDelta)[i];
+    }
     Vec3 tip, axis;
     nominal_.toolPose(cNom + zero_, toolLength, tip, axis);
-    return solveOn(actual_, cache_, tip, axis, toolLength, s, reference ? *reference : cNom, free, c);
+    return solveOn(actual_, cache_, tip + tipShift, axis, toolLength, s, reference, lam2, free, c);
 }
 
 SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess,
-                               const AxisVector& start, const AxisVector* reference, AxisVector& cNom, AxisVector& c,
-                               ProgramPoint& out) const {
+                               const AxisVector& start, const AxisVector* neighbourDelta, AxisVector& cNom, AxisVector& c,
+                               ProgramPoint& out, const Vec3& tipShift) const {
     SolveResult res;
     if (!toJoints(s, nominal, guess, cNom)) {
         c = guess;
@@ -256,7 +269,7 @@ SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, 
         res.converged = true;
         return res;
     }
-    res = solve(cNom, s.toolLength, start, c, reference);
+    res = solve(cNom, s.toolLength, start, c, neighbourDelta, tipShift);
     toProgram(s, c, out);
     if (s.mode == ProgramMode::TcpVector && options_.tipOnly) out.v = nominal.v;
     return res;
@@ -276,7 +289,11 @@ void Corrector::correctedAt(const MovePath& path, const PathContext& ctx, double
     path.at(t, pn);
     AxisVector cNom, c, start;
     if (!toJoints(ctx.space, near, ctx.guess, start)) start = ctx.guess;
-    correct(ctx.space, pn, ctx.guess, start, nullptr, cNom, c, out);
+    if (!toJoints(ctx.space, pn, ctx.guess, cNom)) cNom = start;
+    // The rotary corrections of the interpolation between the corrected ends are this point's neighbours.
+    const AxisVector neighbour = start - cNom;
+    // On the path with the start offset blended out, like every check.
+    correct(ctx.space, pn, ctx.guess, start, &neighbour, cNom, c, out, (1.0 - t) * ctx.startOffset);
     ++stats.solves;
 }
 
@@ -348,7 +365,7 @@ ArcFit Corrector::fitArc(const MovePath& path, const PathContext& ctx, const Pro
     {
         AxisVector cNom, c, start;
         if (!toJoints(ctx.space, pc, ctx.guess, start)) return fit;
-        correct(ctx.space, pc, ctx.guess, start, nullptr, cNom, c, pcStar);
+        correct(ctx.space, pc, ctx.guess, start, nullptr, cNom, c, pcStar, 0.5 * ctx.startOffset);
     }
     double c0 = pcStar.p[a0], c1 = pcStar.p[a1];
     // Onto the bisector of the corrected end points, so that start and end radius agree.

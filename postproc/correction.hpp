@@ -18,8 +18,11 @@ namespace cnccomp::pp {
 struct CorrectorOptions {
     double toleranceMm = 1e-3;     ///< largest allowed distance of the tool tip from the nominal path
     bool tipOnly = false;          ///< rotary axes keep their commands; only the tool tip is corrected
-    double rotaryDamping = 1.0;    ///< mm (weighted residual) per rad of rotary motion away from the reference: keeps
-                                   ///< rotary corrections bounded where the tool axis cannot be corrected (singular poses)
+    double rotaryDamping = 5.0;    ///< mm (weighted residual) per rad of rotary correction: a rotary axis corrects at most
+                                   ///< about axisWeight / (2 · rotaryDamping) = 10 times the tool-axis error it removes,
+                                   ///< so near a singular pose (tool axis along a rotary axis) it does not swing
+    double continuity = 20.0;      ///< mm per rad of change of a rotary correction from the previous end point: keeps the
+                                   ///< solution on the branch of the previous block (see Corrector::solve)
     double axisWeight = 100.0;     ///< mm per rad: how much a tool-axis error counts against a tip error
     double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (and 1e-9 rad)
     int maxIterations = 30;
@@ -112,10 +115,14 @@ public:
 
     /// Machine coordinates `c` near `start` at which the erroneous machine puts the point at `toolLength` along the
     /// tool, and the tool axis, where the nominal machine puts them at `cNom`. Regularised Gauss–Newton on the exact
-    /// model: the tip is matched exactly (linear axes are free), the tool axis in the least-squares sense with rotary
-    /// positions pulled towards `reference` (default cNom) by options().rotaryDamping (exact away from singular poses).
+    /// model: the tip is matched exactly (linear axes are free), the tool axis in the least-squares sense with the rotary
+    /// corrections (c − cNom) pulled towards 0 by options().rotaryDamping and, given `neighbour` (the corrected
+    /// rotary positions next to this point: the previous end point, or the interpolation of a move's corrected ends),
+    /// towards neighbour − its nominal by options().continuity. Exact away from singular poses; near them the rotary
+    /// axes stay on the branch of their neighbours and of the programmed value instead of swinging.
+    /// `tipShift` moves the target tip (a point of a path whose start offset is blended out).
     SolveResult solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
-                      const AxisVector* reference = nullptr) const;
+                      const AxisVector* neighbourDelta = nullptr, const Vec3& tipShift = Vec3::Zero()) const;
 
     /// Tip (at `toolLength`) of the nominal machine at cNom minus that of the erroneous machine at c.
     Vec3 tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const;
@@ -129,7 +136,8 @@ public:
     /// Corrected program position for the nominal one: joints `cNom` (out), solved joints `c` (start `start`,
     /// reference rotary positions `reference`), the program position `out`.
     SolveResult correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess, const AxisVector& start,
-                        const AxisVector* reference, AxisVector& cNom, AxisVector& c, ProgramPoint& out) const;
+                        const AxisVector* neighbourDelta, AxisVector& cNom, AxisVector& c, ProgramPoint& out,
+                        const Vec3& tipShift = Vec3::Zero()) const;
 
     /// Appends pieces (ending at t = 1 with `end`) so that the controller's interpolation between consecutive
     /// corrected positions, starting from ctx.outStart, stays within ctx.tolerance of `path` at every checked
@@ -155,18 +163,18 @@ private:
     /// commands stay close (chord Newton): consecutive program points differ little.
     struct JacobianCache {
         bool valid = false;
-        double toolLength = 0;
+        double toolLength = 0, lambda2 = 0;
         AxisVector q;
         PoseJacobian J;
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes> A, Ainv;  ///< normal matrix, inverse
         Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxAxes, 6> gain;  ///< Ainv · Jᵀ (n × 6)
     };
     SolveResult solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
-                        double toolLength, const AxisVector& start, const AxisVector& reference, AxisMask free,
-                        AxisVector& c) const;
+                        double toolLength, const AxisVector& start, const AxisVector& reference, double lambda2,
+                        AxisMask free, AxisVector& c) const;
     void refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength,
-                         AxisMask free) const;
-    bool cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength) const;
+                         double lambda2, AxisMask free) const;
+    bool cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength, double lambda2) const;
     void splitRecursive(const MovePath& path, const PathContext& ctx, double t0, const ProgramPoint& q0, double t1,
                         const ProgramPoint& q1, int depth, std::vector<Piece>& pieces, SplitStats& stats) const;
     /// Corrected program position of the nominal path at t, started near `near` (program space).

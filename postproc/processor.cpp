@@ -80,8 +80,6 @@ public:
         const int n = layout_.count;
         outPos_ = AxisVector::Zero(n);
         lastDelta_ = AxisVector::Zero(n);
-        nomJoints_ = AxisVector::Zero(n);
-        outJoints_ = AxisVector::Zero(n);
         pieces_.reserve(static_cast<size_t>(o.corrector.maxPieces) + 4);
         all_ = layout_.all();
         for (int a = 0; a < n; ++a) {
@@ -144,19 +142,28 @@ private:
     std::array<char, 8> programSep_{{' '}};  ///< separator of the last block with two words or more
     size_t programSepLen_ = 1;
     std::string_view lineText_;  ///< the current block's text
-    int posGap_ = -1, negGap_ = -1;
+    bool sawNegative_ = false;
     // Output program: position in program space as written (read back from the written digits), tool vector, joints.
     AxisVector outPos_;
     AxisMask outKnown_ = 0, all_ = 0;
-    Vec3 outVector_ = Vec3(0, 0, -1);
+    Vec3 outVector_ = Vec3(0, 0, -1);  ///< tool vector as written (vector mode), world, spindle → tip
     bool outVectorKnown_ = false;
-    AxisVector outJoints_;       ///< corrected machine coordinates the output program is at (unrounded)
-    bool outJointsKnown_ = false;
-    // Nominal program: machine coordinates of the current position and the correction there.
-    AxisVector nomJoints_, lastDelta_;
-    bool nomJointsKnown_ = false;
-    Vec3 nomVector_ = Vec3(0, 0, -1);
-    bool nomVectorKnown_ = false;
+    /// Where the nominal program and the output program are (unrounded), in the space they were read in; machine
+    /// coordinates and the tool vector there are computed when needed.
+    struct Where {
+        bool known = false;
+        MoveSpace space;
+        ProgramPoint point;
+        AxisVector joints;
+        bool jointsValid = false;
+        Vec3 vector = Vec3(0, 0, -1);
+        bool vectorValid = false;
+    };
+    Where nomAt_, outAt_;
+    bool jointsOf(Where& w, const AxisVector& guess);
+    bool vectorOf(Where& w, const AxisVector& guess);
+    AxisVector lastDelta_;
+    bool haveDelta_ = false;     ///< lastDelta_ is the correction at the previous end point (continuity)
     bool offCourse_ = true;      ///< the output's position is not the corrected nominal one (start, after pass-through)
     Motion outMotion_ = Motion::Unknown;
     std::vector<Piece> pieces_;
@@ -196,13 +203,24 @@ void ProgramCorrector::updateStyles(const LexedBlock& b, std::string_view text) 
             if (s.maxDecimals < 0) s.maxDecimals = 0;
         }
         if (w.letter == 'G' && w.digitsBefore == 2 && w.value < 10) gPadded_ = true;
-        if (layout_.axis(w.letter) >= 0 && !w.ext) {
-            // Spaces between letter and number: a column aligned for the sign shows one more before positive numbers.
-            const int gap = static_cast<int>(w.valueBegin - w.begin) - 1;
-            const bool neg = text[w.valueBegin] == '-';
-            (neg ? negGap_ : posGap_) = gap;
-            if (posGap_ >= 0 && negGap_ >= 0) alignSign_ = posGap_ == negGap_ + 1;
-        }
+    }
+    // A sign column ("X  1.0  Y -2.0"): in a block, a positive number has one space more than a negative one; before
+    // any negative number is seen, two spaces or more before a positive one. Words without spaces say nothing.
+    int pos = -1, neg = -1;
+    for (int i = 0; i < b.count; ++i) {
+        const Word& w = b.words[i];
+        if (w.kind != ValueKind::Number || w.ext || layout_.axis(w.letter) < 0) continue;
+        const int gap = static_cast<int>(w.valueBegin - w.begin) - 1;
+        if (gap <= 0 && text[w.valueBegin] != '-') continue;
+        (text[w.valueBegin] == '-' ? neg : pos) = gap;
+    }
+    if (pos >= 0 && neg >= 0) {
+        alignSign_ = pos == neg + 1;
+        sawNegative_ = true;
+    } else if (neg >= 0) {
+        sawNegative_ = true;
+    } else if (pos >= 0 && !sawNegative_) {
+        alignSign_ = pos >= 2;
     }
 }
 
@@ -242,8 +260,9 @@ size_t ProgramCorrector::composeWord(char letter, const char* num, size_t n, int
     } else {
         int gap = style_.valueGap;
         if (alignSign_) {
+            // The sign takes a space of the column; a block that separates letter and number keeps one at least.
             const int width = gap + (style_.anchorNeg ? 1 : 0);
-            gap = std::max(0, width - ((n > 0 && num[0] == '-') ? 1 : 0));
+            gap = std::max(style_.valueGap > 0 || style_.anchorNeg ? 1 : 0, width - ((n > 0 && num[0] == '-') ? 1 : 0));
         }
         for (int k = 0; k < gap && k < 8; ++k) out[len++] = ' ';
     }
@@ -457,14 +476,13 @@ void ProgramCorrector::updateOutputAfterPassThrough() {
     // The machine is where the nominal program puts it (joint mode); in TCP mode its joints are not followed.
     if (r_.words || r_.vectorGiven) {
         offCourse_ = true;
+        outVectorKnown_ = false;
         if (tcp) {
-            outJointsKnown_ = nomJointsKnown_ = false;
-            outVectorKnown_ = nomVectorKnown_ = false;
+            nomAt_.known = outAt_.known = false;
         } else {
-            nomJoints_ = r_.end;
-            nomJointsKnown_ = (r_.endKnown & all_) == all_;
-            outJoints_ = outPos_;
-            outJointsKnown_ = (outKnown_ & all_) == all_;
+            const MoveSpace joints{ProgramMode::Joints, 0.0, r_.tipLength};
+            nomAt_ = Where{(r_.endKnown & all_) == all_, joints, ProgramPoint{r_.end, Vec3(0, 0, -1)}, r_.end, true};
+            outAt_ = Where{(outKnown_ & all_) == all_, joints, ProgramPoint{outPos_, Vec3(0, 0, -1)}, outPos_, true};
         }
     }
 }
@@ -501,7 +519,7 @@ void ProgramCorrector::passThrough(const Line& ln, uint64_t no) {
     if (r_.modeSwitch) {
         // A move in the block that switches TCP mode: positions unknown in the new mode.
         outKnown_ = 0;
-        outJointsKnown_ = nomJointsKnown_ = outVectorKnown_ = nomVectorKnown_ = false;
+        nomAt_.known = outAt_.known = outVectorKnown_ = false;
     }
 }
 
@@ -601,38 +619,61 @@ void ProgramCorrector::checkTravel(const AxisVector& cNom, const AxisVector& c, 
     if (outside) ++summary_.outsideTravel;
 }
 
+bool ProgramCorrector::jointsOf(Where& w, const AxisVector& guess) {
+    if (!w.known) return false;
+    if (!w.jointsValid) w.jointsValid = corrector_.toJoints(w.space, w.point, guess, w.joints);
+    return w.jointsValid;
+}
+
+bool ProgramCorrector::vectorOf(Where& w, const AxisVector& guess) {
+    if (!w.known) return false;
+    if (w.vectorValid) return true;
+    if (w.space.mode == ProgramMode::TcpVector) {
+        w.vector = w.point.v;
+    } else {
+        if (!jointsOf(w, guess)) return false;
+        ProgramPoint p;
+        corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, w.space.controlLength, w.space.toolLength}, w.joints, p);
+        w.vector = p.v;
+    }
+    w.vectorValid = true;
+    return true;
+}
+
 void ProgramCorrector::switchMode() {
     // The controller's position is the same machine; what the program's numbers mean changes (LinuxCNC re-reads the
     // world position of the new kinematics at the switch: M66 E0 L0 in the M428/M429 remaps).
     const MoveSpace space{r_.mode, r_.controlLength, r_.tipLength};
-    if (nomJointsKnown_) {
-        ProgramPoint p;
-        corrector_.toProgram(space, nomJoints_, p);
-        interp_.setPosition(p.p, all_);
-        if (space.mode != ProgramMode::Joints) {
-            corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, r_.controlLength, r_.tipLength}, nomJoints_, p);
-            nomVector_ = p.v;
-            nomVectorKnown_ = true;
+    AxisMask rotary = 0;
+    for (int a = 0; a < layout_.count; ++a)
+        if (layout_.rotary[a]) rotary |= 1u << a;
+    const AxisVector guess = r_.end;
+    auto convert = [&](Where& w) {
+        if (!jointsOf(w, guess)) {
+            w.known = false;
+            return false;
         }
+        const AxisVector joints = w.joints;
+        w.space = space;
+        corrector_.toProgram(space, joints, w.point);
+        w.joints = joints;
+        w.jointsValid = true;
+        w.vectorValid = false;
+        return true;
+    };
+    if (convert(nomAt_)) {
+        interp_.setPosition(nomAt_.point.p, all_);
     } else {
         // Rotary angles are the same numbers in both modes; the linear positions are not known in the new one.
-        AxisMask rotary = 0;
-        for (int a = 0; a < layout_.count; ++a)
-            if (layout_.rotary[a]) rotary |= 1u << a;
         interp_.setPosition(interp_.position(), interp_.known() & rotary);
+    }
+    if (convert(outAt_)) {
+        outPos_ = outAt_.point.p;
+        outKnown_ = all_;
+    } else {
         outKnown_ &= rotary;
     }
-    if (outJointsKnown_) {
-        ProgramPoint p;
-        corrector_.toProgram(space, outJoints_, p);
-        outPos_ = p.p;
-        outKnown_ = all_;
-        if (space.mode != ProgramMode::Joints) {
-            corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, r_.controlLength, r_.tipLength}, outJoints_, p);
-            outVector_ = p.v;
-            outVectorKnown_ = true;
-        }
-    }
+    outVectorKnown_ = false;
     offCourse_ = true;
 }
 
@@ -654,19 +695,23 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     const bool vector = space.mode == ProgramMode::TcpVector;
     bool outStartKnown = (outKnown_ & all_) == all_;
     bool nomStartKnown = (r_.startKnown & all_) == all_;
-    if (vector) {
-        outStartKnown = outStartKnown && outVectorKnown_;
-        nomStartKnown = nomStartKnown && nomVectorKnown_;
-    }
+    const AxisVector guess = nomAt_.known && nomAt_.jointsValid ? nomAt_.joints : r_.end;
 
     // Nominal end point in program space (vector mode: the programmed vector, tip → spindle, or the kept one).
     ProgramPoint nomEnd, nomStart;
     nomEnd.p = r_.end;
     nomStart.p = r_.start;
     if (vector) {
-        nomStart.v = nomVector_;
-        nomEnd.v = r_.vectorGiven ? Vec3(-r_.vector[0], -r_.vector[1], -r_.vector[2]).normalized() : nomVector_;
-        if (!r_.vectorGiven && !nomVectorKnown_) {
+        const bool nomVector = nomStartKnown && vectorOf(nomAt_, guess);
+        outStartKnown = outStartKnown && (outVectorKnown_ || vectorOf(outAt_, guess));
+        if (outStartKnown && !outVectorKnown_) {
+            outVector_ = outAt_.vector;
+            outVectorKnown_ = true;
+        }
+        nomStartKnown = nomStartKnown && nomVector;
+        nomStart.v = nomAt_.vector;
+        nomEnd.v = r_.vectorGiven ? Vec3(-r_.vector[0], -r_.vector[1], -r_.vector[2]).normalized() : nomAt_.vector;
+        if (!r_.vectorGiven && !nomVector) {
             r_.kind = BlockKind::PassThrough;
             r_.reason = "tool vector not known yet (no I J K / A3 B3 C3 given since TCP was switched on)";
             r_.report = true;
@@ -676,12 +721,13 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     }
     ++summary_.moves;
     if (tcp) ++summary_.tcpMoves;
-    const AxisVector guess = nomJointsKnown_ ? nomJoints_ : r_.end;
 
     // Corrected end point: nominal machine coordinates, the erroneous machine's solution, its program position.
     AxisVector cNom, cEnd;
     ProgramPoint qEnd;
-    if (!corrector_.toJoints(space, nomEnd, guess, cNom)) {
+    if (identity && !vector) {
+        cNom = r_.end;  // not the machine coordinates in TCP mode: not used for anything but guesses
+    } else if (!corrector_.toJoints(space, nomEnd, guess, cNom)) {
         r_.kind = BlockKind::PassThrough;
         r_.reason = "the controller's TCP kinematics cannot reach this tool vector (no rotary solution)";
         r_.report = true;
@@ -693,7 +739,9 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         cEnd = cNom;
         qEnd = nomEnd;
     } else {
-        const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd);
+        // Near the previous end point's correction (continuity) and the programmed value.
+        const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd,
+                                               haveDelta_ ? &lastDelta_ : nullptr);
         summary_.maxTipResidual = std::max(summary_.maxTipResidual, s.tipError);
         summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, s.axisError);
         if (!s.converged || !(s.tipError < 1e-5)) {
@@ -704,6 +752,7 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
             qEnd = nomEnd;
         } else {
             lastDelta_ = cEnd - cNom;
+            haveDelta_ = true;
             corrector_.toProgram(space, cEnd, qEnd);
         }
         for (int a = 0; a < n; ++a) {
@@ -715,7 +764,7 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
             }
         }
     }
-    checkTravel(cNom, cEnd, no);
+    if (!(identity && tcp && !vector)) checkTravel(cNom, cEnd, no);
 
     // Pieces.
     pieces_.clear();
@@ -916,22 +965,11 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     out_.write(ln.eol);
     outMotion_ = arcToLines ? Motion::Linear : r_.motion;
     // Where the nominal and the output programs now are.
-    nomJoints_ = cNom;
-    nomJointsKnown_ = true;
-    outJoints_ = cEnd;
-    outJointsKnown_ = outStartKnown || (r_.absolute && !isArc);
-    if (vector) {
-        nomVector_ = nomEnd.v;
-        nomVectorKnown_ = true;
-    } else if (tcp) {
-        ProgramPoint p;
-        corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, space.controlLength, space.toolLength}, cNom, p);
-        nomVector_ = p.v;
-        nomVectorKnown_ = true;
-        corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, space.controlLength, space.toolLength}, cEnd, p);
-        outVector_ = p.v;
-        outVectorKnown_ = true;
-    }
+    const bool jointsComputed = !identity || vector || !tcp;
+    nomAt_ = Where{true, space, nomEnd, cNom, jointsComputed, nomEnd.v, vector};
+    outAt_ = Where{outStartKnown || (r_.absolute && !isArc), space, pieces_.back().q, cEnd, jointsComputed && !isArc,
+                 pieces_.back().q.v, vector};
+    if (!vector) outVectorKnown_ = false;
     offCourse_ = false;
 }
 
@@ -950,7 +988,7 @@ void ProgramCorrector::overlong(uint64_t no) {
         outKnown_ &= ~r_.words;
     }
     if (modal || r_.words) {
-        outJointsKnown_ = nomJointsKnown_ = false;
+        nomAt_.known = outAt_.known = outVectorKnown_ = false;
         offCourse_ = true;
     }
     notice(false, no,
@@ -1056,7 +1094,17 @@ std::string formatSummary(const CorrectSummary& s, size_t maxListed) {
                      s.maxLinearCorrection / kUm, s.maxLinearLine, s.maxRotaryCorrection / kArcsec, s.maxRotaryLine);
     t += fmt::format("largest residual: {:.2g} um at endpoints, {:.3f} um on the path (checked midpoints), tool axis {:.3f} arcsec\n",
                      s.maxTipResidual / kUm, s.maxPathDeviation / kUm, s.maxAxisResidual / kArcsec);
+    if (s.tcpMoves) t += fmt::format("moves in tool-tip (TCP) mode: {}\n", s.tcpMoves);
     if (s.unconverged) t += fmt::format("endpoints not converged (left unchanged): {}\n", s.unconverged);
+    if (s.limited) t += fmt::format("moves over the tolerance after the subdivision limit: {}\n", s.limited);
+    if (s.outsideTravel) t += fmt::format("moves outside the travel of an axis: {} (see the warnings)\n", s.outsideTravel);
+    if (s.clampedTolerance)
+        t += fmt::format("tolerance raised to {:.3g} um on {} moves: the written digits cannot hold less\n",
+                         s.toleranceFloor / kUm, s.clampedTolerance);
+    if (s.offPathStarts)
+        t += fmt::format("moves starting off the nominal path after a block passed through: {} (offset blended out, "
+                         "not split for)\n",
+                         s.offPathStarts);
     if (!s.passThrough.empty()) {
         t += "not evaluated (passed through):\n";
         for (size_t i = 0; i < s.passThrough.size() && i < maxListed; ++i)

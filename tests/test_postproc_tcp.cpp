@@ -282,8 +282,8 @@ TcpCheck checkTcp(const std::string& original, const std::string& corrected, dou
         }
         c.maxTip = std::max(c.maxTip, bestEnd);
         c.maxMid = std::max(c.maxMid, bestMid);
-        // Near A = 0 the tool axis is parallel to C: a tilt of C (EB0C) cannot be corrected there.
-        if (std::fabs(b.to.a) >= 5) c.maxAxisArcsec = std::max(c.maxAxisArcsec, bestAxis);
+        // Near A = 0 the tool axis is parallel to C: a tilt of C (EB0C) cannot be corrected there (see above).
+        if (std::fabs(b.to.a) >= 10) c.maxAxisArcsec = std::max(c.maxAxisArcsec, bestAxis);
         s = bestIndex;
     }
     // The same program uncorrected on the erroneous machine (end points), and the tool axis of the corrected one.
@@ -354,8 +354,10 @@ TEST(PostprocTcp, ControllerModelMatchesLinuxCncTrtKinematics) {
 
 void expectTcpAccurate(const std::string& name, const std::string& program, double L, size_t minMoves,
                        uint64_t passThrough) {
-    // Tool axis: half a written digit (1e-4 deg) of A and of C is 0.18 arcsec each.
-    const double maxAxisArcsec = 0.75;
+    // Tool axis, 10 deg or more away from the singular pose A = 0: half a written digit (1e-4 deg) of A and of C is
+    // 0.18 arcsec each; closer to A = 0 the C correction a tilt of C needs grows as 1/sin A and is limited (rotary
+    // corrections at most ~10 times the axis error they remove, changes between blocks damped: CorrectorOptions).
+    const double maxAxisArcsec = 1.5;
     SimFiles st;
     CorrectSummary s;
     const std::string out = correctTcp(program, st, L, s);
