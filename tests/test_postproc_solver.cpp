@@ -56,12 +56,16 @@ TEST_P(PostprocSolver, AgreesWithSolveToolPoseAwayFromSingularities) {
         EXPECT_LT((reached.tip - target.tip).norm(), 1e-6) << "tip, trial " << trial;  // mm
         const IkResult ref = solveToolPose(actual, target, tip, q);
         ASSERT_TRUE(ref.converged);
-        // The tool axis as well as the reference solver meets it, within 3e-7 rad (0.06 arcsec, 36 nm at the 120 mm
-        // tool): the fast corrector settles at up to 1.3e-7 rad, the reference (regularised, then polished) below 1e-11;
-        // on the four-axis head neither can meet it and both give the same least-squares compromise.
-        EXPECT_LT((reached.axis - target.axis).norm(), ref.axisError + 3e-7) << "axis, trial " << trial;  // rad
+        // The tool axis nearly as well as the reference solver (undamped at regular poses, polished) meets it: the
+        // corrector damps rotary corrections (CorrectorOptions::rotaryDamping 5 mm/rad against axisWeight 100 mm/rad, so
+        // that they stay bounded and continuous near singular poses), which leaves about (5 / (100 s))^2 of a rotary
+        // correction undone, s = sine of the angle between the tool axis and that rotary axis: with these 20 arcsec
+        // errors and rotary axes at 20 deg or more, up to 3e-6 rad (0.6 arcsec) of tool axis; the commands differ
+        // accordingly (the tip is exact for both, so the slides follow the rotary difference: < 2 um). On the
+        // four-axis head neither can meet the axis and both give the same least-squares compromise.
+        EXPECT_LT((reached.axis - target.axis).norm(), ref.axisError + 3e-6) << "axis, trial " << trial;  // rad
         for (int i = 0; i < m.axisCount(); ++i)
-            EXPECT_NEAR(qStar[i], ref.q[i], m.axisLink(i).kind == AxisKind::Rotary ? 1e-6 : 1e-4)
+            EXPECT_NEAR(qStar[i], ref.q[i], m.axisLink(i).kind == AxisKind::Rotary ? 1e-5 : 2e-3)
                 << GetParam() << " axis " << m.axisNames[i];
     }
 }
