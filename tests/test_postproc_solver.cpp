@@ -60,10 +60,10 @@ TEST_P(PostprocSolver, AgreesWithSolveToolPoseAwayFromSingularities) {
         // corrector damps rotary corrections (CorrectorOptions::rotaryDamping 5 mm/rad against axisWeight 100 mm/rad, so
         // that they stay bounded and continuous near singular poses), which leaves about (5 / (100 s))^2 of a rotary
         // correction undone, s = sine of the angle between the tool axis and that rotary axis: with these 20 arcsec
-        // errors and rotary axes at 20 deg or more, up to 3e-6 rad (0.6 arcsec) of tool axis; the commands differ
+        // errors and rotary axes at 20 deg or more, up to 4e-6 rad (0.8 arcsec) of tool axis; the commands differ
         // accordingly (the tip is exact for both, so the slides follow the rotary difference: < 2 um). On the
         // four-axis head neither can meet the axis and both give the same least-squares compromise.
-        EXPECT_LT((reached.axis - target.axis).norm(), ref.axisError + 3e-6) << "axis, trial " << trial;  // rad
+        EXPECT_LT((reached.axis - target.axis).norm(), ref.axisError + 4e-6) << "axis, trial " << trial;  // rad
         for (int i = 0; i < m.axisCount(); ++i)
             EXPECT_NEAR(qStar[i], ref.q[i], m.axisLink(i).kind == AxisKind::Rotary ? 1e-5 : 2e-3)
                 << GetParam() << " axis " << m.axisNames[i];
