@@ -89,13 +89,65 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
             tcp_.toJoints(p.p, s.controlLength, c);
             return c.allFinite();
         case ProgramMode::TcpVector: {
-            const int lx = tcp_.linearAxis(0), ly = tcp_.linearAxis(1), lz = tcp_.linearAxis(2);
-            const Vec3 point = tcp_.pointFromWorld(Vec3(p.p[lx], p.p[ly], p.p[lz]));
-            const Vec3 axis = tcp_.axisFromWorld(p.v.normalized());
-            const AxisMask all = (1u << p.p.size()) - 1u;
-            const double lam2 = options_.rotaryDamping * options_.rotaryDamping;
-            const SolveResult r = solveOn(nominal_, nominalCache_, point, axis, s.controlLength, guess, guess, lam2, all, c);
-            return r.converged && r.tipError < 1e-6 && r.axisError < 1e-6;
+            // The tool axis depends on the rotary axes only: Gauss–Newton on them (fresh Jacobian, limited steps),
+            // then the linear axes exactly for the point, as in angles mode.
+            const Vec3 target = tcp_.axisFromWorld(p.v.normalized());
+            const int n = static_cast<int>(p.p.size());
+            auto angles = [&](AxisVector& q) {
+                PoseJacobian J;
+                Vec3 tip, axis;
+                for (int it = 0; it < 60; ++it) {
+                    nominal_.jacobian(q + zero_, s.controlLength, J, tip, axis);
+                    const Vec3 r = target - axis;
+                    if (r.norm() < 1e-13) return true;
+                    Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxAxes> Jr(3, 0);
+                    int cols[kMaxAxes], m = 0;
+                    for (int i = 0; i < n; ++i)
+                        if (rotary_ & (1u << i)) cols[m++] = i;
+                    Jr.resize(3, m);
+                    for (int k = 0; k < m; ++k) Jr.col(k) = J.block<3, 1>(3, cols[k]);
+                    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes> A = Jr.transpose() * Jr;
+                    A.diagonal().array() += 1e-10;
+                    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxAxes, 1> d = A.ldlt().solve(Jr.transpose() * r);
+                    const double big = d.cwiseAbs().maxCoeff();
+                    if (big > 0.3) d *= 0.3 / big;
+                    for (int k = 0; k < m; ++k) q[cols[k]] += d[k];
+                    if (big < 1e-14) break;
+                }
+                nominal_.toolPose(q + zero_, s.controlLength, tip, axis);
+                return (target - axis).norm() < 1e-9;
+            };
+            // The controller takes the solution nearest its position (the branch of the previous block) [G]: Newton
+            // from there finds it when the orientation changes little; from far or from a singular start (tool axis
+            // along a rotary axis) it may reach another branch: then other starts, the nearest wins.
+            AxisVector best, q = guess;
+            double bestDistance = HUGE_VAL;
+            auto consider = [&](const AxisVector& start) {
+                q = start;
+                if (!angles(q)) return;
+                const double dist = (q - guess).cwiseAbs().maxCoeff();
+                if (dist < bestDistance) bestDistance = dist, best = q;
+            };
+            consider(guess);
+            if (!(bestDistance < kPi / 6)) {
+                static constexpr double kFirst[4] = {-60, -20, 20, 60}, kOther[4] = {-135, -45, 45, 135};  // deg
+                for (int k = 0; k < 16; ++k) {
+                    AxisVector start = guess;
+                    int bits = k, which = 0;
+                    for (int i = 0; i < n; ++i)
+                        if (rotary_ & (1u << i)) {
+                            start[i] = guess[i] + (which++ == 0 ? kFirst[bits & 3] : kOther[bits & 3]) * kDeg;
+                            bits >>= 2;
+                        }
+                    consider(start);
+                }
+            }
+            if (bestDistance == HUGE_VAL) return false;
+            AxisVector withAngles = p.p;
+            for (int i = 0; i < n; ++i)
+                if (rotary_ & (1u << i)) withAngles[i] = best[i];
+            tcp_.toJoints(withAngles, s.controlLength, c);
+            return c.allFinite();
         }
     }
     return false;

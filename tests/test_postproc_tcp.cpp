@@ -20,6 +20,7 @@
 
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
+#include "postproc/correction.hpp"
 #include "postproc/processor.hpp"
 #include "test_support.hpp"
 
@@ -418,6 +419,147 @@ TEST(PostprocTcp, IdentityKeepsTcpProgramsByteForByte) {
     EXPECT_EQ(s.tcpMoves, s.moves);
     EXPECT_GE(s.tcpMoves, 4400u);
 }
+
+// --- Vector programs (Fanuc G43.5 I J K, Sinumerik TRAORI A3= B3= C3=) on the same machine --------------------------
+// The vector points from the tip towards the spindle (Fanuc A-79348E p. 9 "tool axis direction"; Sinumerik PGA
+// 6FC5398-2BP10 7-20 "the vector points towards the tool adapter"). On this table it is
+// v = Rz(-C) Rx(-A) (0, 0, 1) = (sin C sin A, cos C sin A, cos A); A < 0 is the branch used here.
+World anglesOf(const Vec3& tipWorld, Vec3 v, double cNear) {
+    v.normalize();
+    World w{tipWorld.x(), tipWorld.y(), tipWorld.z(), -std::acos(std::clamp(v.z(), -1.0, 1.0)) / kDeg, 0};
+    double c = std::atan2(-v.x(), -v.y()) / kDeg;
+    c += 360.0 * std::round((cNear - c) / 360.0);
+    w.c = c;
+    return w;
+}
+
+struct VectorBlock {
+    Vec3 tip, v;
+    int motion = 1;
+};
+
+std::vector<VectorBlock> vectorMoves(const std::string& program, bool sinumerik) {
+    std::vector<VectorBlock> out;
+    std::istringstream in(program);
+    std::string s;
+    VectorBlock b;
+    bool tcp = false;
+    while (std::getline(in, s)) {
+        if (s.find(sinumerik ? "TRAORI" : "G43.5") != std::string::npos) tcp = true;
+        if (!tcp) continue;
+        bool any = false, vec = false;
+        Vec3 v = Vec3::Zero();
+        for (size_t k = 0; k < s.size();) {
+            const char c = s[k];
+            if (!std::isalpha(static_cast<unsigned char>(c))) {
+                ++k;
+                continue;
+            }
+            size_t e = k + 1;
+            int idx = -1;
+            if (sinumerik && (c == 'A' || c == 'B' || c == 'C') && e + 1 < s.size() && s[e] == '3' && s[e + 1] == '=')
+                idx = c - 'A', e += 2;
+            else if (!sinumerik && (c == 'I' || c == 'J' || c == 'K'))
+                idx = c - 'I';
+            size_t used = 0;
+            double val = 0;
+            try {
+                val = std::stod(s.substr(e), &used);
+            } catch (...) {
+                k = e;
+                continue;
+            }
+            k = e + used;
+            if (idx >= 0) v[idx] = val, vec = true;
+            if (c == 'X') b.tip.x() = val, any = true;
+            if (c == 'Y') b.tip.y() = val, any = true;
+            if (c == 'Z') b.tip.z() = val, any = true;
+            if (c == 'G' && (val == 0 || val == 1)) b.motion = static_cast<int>(val);
+        }
+        if (vec) b.v = v.normalized();
+        if (any || vec) out.push_back(b);
+    }
+    return out;
+}
+
+std::string vectorProgram(bool sinumerik) {
+    std::string p = sinumerik ? "G90 G71\nTRAORI\n" : "G21 G90\nG43.5 H1\n";
+    char buf[200];
+    for (int k = 0; k <= 40; ++k) {
+        const double a = (-30.0 - 12.0 * std::sin(k * 0.08)) * kDeg, c = (10.0 + 1.5 * k) * kDeg;
+        const Vec3 v(std::sin(c) * std::sin(a), std::cos(c) * std::sin(a), std::cos(a));
+        const double x = -20 + k, y = 5 + 3 * std::sin(k * 0.1), z = 10 - 0.1 * k;
+        if (sinumerik)
+            std::snprintf(buf, sizeof buf, "G%d X%.4f Y%.4f Z%.4f A3=%.7f B3=%.7f C3=%.7f%s\n", k == 0 ? 0 : 1, x, y, z,
+                          v.x(), v.y(), v.z(), k == 1 ? " F300" : "");
+        else
+            std::snprintf(buf, sizeof buf, "G%d X%.4f Y%.4f Z%.4f I%.7f J%.7f K%.7f%s\n", k == 0 ? 0 : 1, x, y, z, v.x(),
+                          v.y(), v.z(), k == 1 ? " F300." : "");
+        p += buf;
+    }
+    return p + (sinumerik ? "TRAFOOF\nM30\n" : "G49\nM30\n");
+}
+
+/// The tool tip (at L, the programmed point's tool length) of a vector block through the controller and a machine.
+Vec3 vectorTip(const Vec3& tip, const Vec3& v, double& cNear, double L, const Errors* e) {
+    const World w = anglesOf(tip, v, cNear);
+    cNear = w.c;
+    World lc = w;
+    lc.z += L;  // LinuxCNC's world carries the tool offset in Z (see ControllerModelMatchesLinuxCncTrtKinematics)
+    return machineTip(trtInverse(lc, L), L, e).tip;
+}
+
+void expectVectorProgramAccurate(bool sinumerik) {
+    SimFiles st;
+    const MachineModel m = readMachineXml(st.machine);
+    const DeviationSet d = readDeviationCsv(st.deviations, m);
+    const double L = 30.0;
+    CorrectOptions o;
+    o.dialect = sinumerik ? Dialect::Sinumerik : Dialect::Fanuc;
+    o.setup.addToolLength(sinumerik ? "30" : "H1=30");
+    o.corrector.toleranceMm = 0.5 * kUm;
+    const std::string program = vectorProgram(sinumerik);
+    std::istringstream in(program);
+    std::ostringstream out;
+    const CorrectSummary s = correctProgram(m, d, in, out, o);
+    EXPECT_EQ(s.passedThrough, 0u) << formatSummary(s) << out.str();
+    EXPECT_EQ(s.tcpMoves, 41u) << formatSummary(s);
+    const auto nom = vectorMoves(program, sinumerik), act = vectorMoves(out.str(), sinumerik);
+    ASSERT_EQ(nom.size(), 41u);
+    ASSERT_GE(act.size(), nom.size()) << out.str();
+    // Nominal tip path: the programmed points (at L = the controlled length) joined by straight lines.
+    auto distance = [&](const Vec3& p) {
+        double best = HUGE_VAL;
+        for (size_t k = 1; k < nom.size(); ++k) {
+            const Vec3 a = nom[k - 1].tip, b = nom[k].tip;
+            const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+            best = std::min(best, (a + t * (b - a) - p).norm());
+        }
+        return best;
+    };
+    const Errors errors;
+    double cNear = 0, worstEnd = 0, worstMid = 0, uncorrected = 0;
+    for (size_t k = 0; k < act.size(); ++k) {
+        worstEnd = std::max(worstEnd, distance(vectorTip(act[k].tip, act[k].v, cNear, L, &errors)));
+        if (k > 0 && act[k].motion == 1) {
+            // The controller interpolates the tip linearly and turns the vector in the plane of its ends [G].
+            double c = cNear;
+            const Vec3 mid = vectorTip(0.5 * (act[k - 1].tip + act[k].tip), slerpVector(act[k - 1].v, act[k].v, 0.5), c,
+                                       L, &errors);
+            worstMid = std::max(worstMid, distance(mid));
+        }
+    }
+    cNear = 0;
+    for (const auto& b : nom) uncorrected = std::max(uncorrected, distance(vectorTip(b.tip, b.v, cNear, L, &errors)));
+    std::printf("[ tcp      ] %s vector program: end points %.4f um, midpoints %.4f um (uncorrected %.2f um)\n",
+                sinumerik ? "Sinumerik A3/B3/C3" : "Fanuc G43.5 IJK", worstEnd / kUm, worstMid / kUm, uncorrected / kUm);
+    EXPECT_GT(uncorrected, 10 * kUm);
+    EXPECT_LE(worstEnd, 0.5 * kUm);
+    EXPECT_LE(worstMid, 0.5 * kUm);
+}
+
+TEST(PostprocTcp, FanucG435VectorProgram) { expectVectorProgramAccurate(false); }
+TEST(PostprocTcp, SinumerikTraoriVectorProgram) { expectVectorProgramAccurate(true); }
 
 }  // namespace
 }  // namespace cnccomp::pp
