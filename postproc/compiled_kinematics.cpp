@@ -179,6 +179,27 @@ void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobi
     }
 }
 
+void CompiledKinematics::pointJacobian(const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const {
+    Lines lines;
+    Frame w, t;
+    cached(workpiece_, workpieceAxes_, workpieceCache_, q, w, &lines);
+    const int workpieceLines = lines.count;
+    cached(tool_, toolAxes_, toolCache_, q, t, &lines);
+    const Vec3 dirB = t.R * machine_->toolDirection;
+    const Vec3 tipB = t.t + length * dirB;
+    const Mat3 wRb = w.R.transpose();
+    tip = wRb * (tipB - w.t);
+    J.setZero();
+    for (int k = 0; k < lines.count; ++k) {
+        const JointLine& j = lines.items[k];
+        for (int c = 0; c < 3; ++c) {
+            if (axes[c] != j.axis) continue;
+            const double sign = k < workpieceLines ? -1.0 : 1.0;
+            J.col(c) = sign * (wRb * (j.rotary ? j.direction.cross(tipB - j.point) : j.direction));
+        }
+    }
+}
+
 Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const {
     Frame f;
     cached(workpiece_, workpieceAxes_, workpieceCache_, q, f, nullptr);

@@ -30,6 +30,8 @@ public:
     Vec3 toolTip(const AxisVector& q, double length) const;
     /// d(tip, axis)/dq (6 × n, workpiece frame, rows as cnccomp::toolPoseJacobian); also the pose at q.
     void jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const;
+    /// The tool point at q and its derivatives by the three axes `axes` (linear axes: constant in them).
+    void pointJacobian(const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const;
     Frame baseToWorkpiece(const AxisVector& q) const;
     Frame baseToTool(const AxisVector& q) const;
 

@@ -1,6 +1,6 @@
 #include "postproc/tcp_model.hpp"
 
-#include <Eigen/LU>
+#include <Eigen/LU>  // Matrix3d::inverse
 
 namespace cnccomp::pp {
 
@@ -42,14 +42,13 @@ void TcpModel::toProgram(const AxisVector& c, double length, AxisVector& p) cons
 void TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c) const {
     c = p;  // rotary angles as programmed; linear axes start at the world coordinates
     const AxisVector q = c + zero_;
-    PoseJacobian J;
-    Vec3 tip, axis;
-    nominal_.jacobian(q, length, J, tip, axis);
-    Mat3 A;
-    for (int k = 0; k < 3; ++k) A.col(k) = R0_ * J.block<3, 1>(0, lin_[k]);
+    Mat3 J;
+    Vec3 tip;
+    nominal_.pointJacobian(q, length, lin_, J, tip);
+    const Mat3 A = R0_ * J;
     const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
     const Vec3 have = R0_ * tip + t0_;
-    const Vec3 d = A.partialPivLu().solve(want - have);
+    const Vec3 d = A.inverse() * (want - have);  // 3 x 3, well conditioned (the slides are orthogonal nominally)
     for (int k = 0; k < 3; ++k) c[lin_[k]] += d[k];
 }
 
