@@ -17,7 +17,8 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
     const std::string_view head = reader.head();
     checkTextHead(head, options.inputName);
     s.dialect = options.dialect ? *options.dialect : detectDialect(head).dialect;
-    Interpreter interp(layout, InterpreterOptions{s.dialect, options.setup, options.rotaryShortest});
+    Interpreter interp(layout, InterpreterOptions{s.dialect, options.setup, options.rotaryShortest, options.tcpOnM,
+                                                  options.tcpOffM});
     OutputBuffer out(csv);
     out.write("line,motion,X,Y,Z,A,B,C\n");
     LexedBlock b;
@@ -41,6 +42,14 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
         }
         lexBlock(line.text, s.dialect, b, no == 1);
         interp.interpret(line.text, b, r);
+        if (r.modeSwitch) {
+            // Without the machine's kinematics the position cannot be carried into the other mode: rotary angles are
+            // the same numbers in both, the linear positions are unknown until the program names them.
+            AxisMask rotary = 0;
+            for (int a = 0; a < layout.count; ++a)
+                if (layout.rotary[a]) rotary |= 1u << a;
+            interp.setPosition(interp.position(), interp.known() & rotary);
+        }
         const bool moveRow = r.kind == BlockKind::Move;
         if (r.kind == BlockKind::PassThrough) ++s.passedThrough;
         if (!moveRow && !(r.kind == BlockKind::PassThrough && r.words)) continue;
@@ -50,7 +59,7 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
         const char* motion = "-";
         if (moveRow) motion = r.motion == Motion::Rapid ? "G0" : r.motion == Motion::Linear ? "G1" : r.motion == Motion::ArcCw ? "G2" : "G3";
         if (r.machineCoordinates) motion = "G53";
-        fmt::format_to(std::back_inserter(row), "{},{}", no, motion);
+        fmt::format_to(std::back_inserter(row), "{},{}{}", no, motion, moveRow && r.mode != ProgramMode::Joints ? " TCP" : "");
         for (char c : kColumns) {
             const int a = layout.axis(c);
             if (a < 0 || !(r.endKnown & (1u << a))) {
