@@ -9,7 +9,20 @@ namespace cnccomp::pp {
 
 namespace {
 constexpr double kTwoPi = 2.0 * kPi;
+
+void lerpPoint(const ProgramPoint& a, const ProgramPoint& b, double t, bool vector, ProgramPoint& out) {
+    out.p = a.p + t * (b.p - a.p);
+    if (vector) out.v = slerpVector(a.v, b.v, t);
+}
 }  // namespace
+
+Vec3 slerpVector(const Vec3& a, const Vec3& b, double t) {
+    const double d = std::clamp(a.dot(b), -1.0, 1.0);
+    const double angle = std::acos(d);
+    if (angle < 1e-12) return (a + t * (b - a)).normalized();
+    const double s = std::sin(angle);
+    return (std::sin((1 - t) * angle) / s) * a + (std::sin(t * angle) / s) * b;
+}
 
 MovePath MovePath::line(const AxisVector& start, const AxisVector& end) {
     MovePath p;
@@ -34,16 +47,21 @@ MovePath MovePath::arc(const AxisVector& start, const AxisVector& end, const Arc
     return p;
 }
 
-void MovePath::at(double t, AxisVector& q) const {
-    q = start + t * (end - start);
+void MovePath::at(double t, ProgramPoint& q) const {
+    q.p = start + t * (end - start);
+    if (vector) q.v = slerpVector(v0, v1, t);
     if (!circular) return;
     const double th = theta0 + t * sweep, r = r0 + t * (r1 - r0);
-    q[axis0] = c0 + r * std::cos(th);
-    q[axis1] = c1 + r * std::sin(th);
+    q.p[axis0] = c0 + r * std::cos(th);
+    q.p[axis1] = c1 + r * std::sin(th);
 }
 
 Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations, const CorrectorOptions& options)
-    : machine_(machine), nominal_(machine), actual_(machine, deviations), options_(options) {
+    : machine_(machine),
+      nominal_(machine, nullptr),
+      actual_(machine, &deviations),
+      tcp_(nominal_),
+      options_(options) {
     identity_ = deviations.values.size() == 0 || deviations.values.cwiseAbs().maxCoeff() == 0.0;
     affine_ = true;
     for (const DeviationDef& d : machine.deviations)
@@ -52,102 +70,191 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
                 if (deviations.values[d.offset + k] != 0.0) affine_ = false;
     for (int i = 0; i < machine.axisCount(); ++i)
         if (machine.axisLink(i).kind == AxisKind::Rotary) rotary_ |= 1u << i;
+    zero_ = machine.fromController(AxisVector::Zero(machine.axisCount()));
 }
 
-double Corrector::tipDeviation(const AxisVector& qNom, const AxisVector& q, double toolLength) const {
-    const Vec3 tip = nominal_.toolPoint(toolLength);
-    const Vec3 a = nominal_.toolPointInWorkpiece(qNom, tip);
-    const Vec3 b = actual_.toolPointInWorkpiece(q, tip);
-    return (a - b).norm();
+Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) const { return actual_.toolTip(c + zero_, toolLength); }
+Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) const { return nominal_.toolTip(c + zero_, toolLength); }
+
+Vec3 Corrector::tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const {
+    return nominalTip(cNom, toolLength) - actualTip(c, toolLength);
 }
 
-bool Corrector::cacheUsable(const AxisVector& q, double toolLength) const {
-    if (!cache_.valid || cache_.toolLength != toolLength || cache_.q.size() != q.size()) return false;
+bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c) const {
+    switch (s.mode) {
+        case ProgramMode::Joints:
+            c = p.p;
+            return true;
+        case ProgramMode::TcpAngles:
+            tcp_.toJoints(p.p, s.controlLength, c);
+            return c.allFinite();
+        case ProgramMode::TcpVector: {
+            // The tool axis depends on the rotary axes only: Gauss–Newton on them (fresh Jacobian, limited steps),
+            // then the linear axes exactly for the point, as in angles mode.
+            const Vec3 target = tcp_.axisFromWorld(p.v.normalized());
+            const int n = static_cast<int>(p.p.size());
+            auto angles = [&](AxisVector& q) {
+                PoseJacobian J;
+                Vec3 tip, axis;
+                for (int it = 0; it < 60; ++it) {
+                    nominal_.jacobian(q + zero_, s.controlLength, J, tip, axis);
+                    const Vec3 r = target - axis;
+                    if (r.norm() < 1e-13) return true;
+                    Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxAxes> Jr(3, 0);
+                    int cols[kMaxAxes], m = 0;
+                    for (int i = 0; i < n; ++i)
+                        if (rotary_ & (1u << i)) cols[m++] = i;
+                    Jr.resize(3, m);
+                    for (int k = 0; k < m; ++k) Jr.col(k) = J.block<3, 1>(3, cols[k]);
+                    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes> A = Jr.transpose() * Jr;
+                    A.diagonal().array() += 1e-10;
+                    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxAxes, 1> d = A.ldlt().solve(Jr.transpose() * r);
+                    const double big = d.cwiseAbs().maxCoeff();
+                    if (big > 0.3) d *= 0.3 / big;
+                    for (int k = 0; k < m; ++k) q[cols[k]] += d[k];
+                    if (big < 1e-14) break;
+                }
+                nominal_.toolPose(q + zero_, s.controlLength, tip, axis);
+                return (target - axis).norm() < 1e-9;
+            };
+            // The controller takes the solution nearest its position (the branch of the previous block) [G]: Newton
+            // from there finds it when the orientation changes little; from far or from a singular start (tool axis
+            // along a rotary axis) it may reach another branch: then other starts, the nearest wins.
+            AxisVector best, q = guess;
+            double bestDistance = HUGE_VAL;
+            auto consider = [&](const AxisVector& start) {
+                q = start;
+                if (!angles(q)) return;
+                const double dist = (q - guess).cwiseAbs().maxCoeff();
+                if (dist < bestDistance) bestDistance = dist, best = q;
+            };
+            consider(guess);
+            if (!(bestDistance < kPi / 6)) {
+                static constexpr double kFirst[4] = {-60, -20, 20, 60}, kOther[4] = {-135, -45, 45, 135};  // deg
+                for (int k = 0; k < 16; ++k) {
+                    AxisVector start = guess;
+                    int bits = k, which = 0;
+                    for (int i = 0; i < n; ++i)
+                        if (rotary_ & (1u << i)) {
+                            start[i] = guess[i] + (which++ == 0 ? kFirst[bits & 3] : kOther[bits & 3]) * kDeg;
+                            bits >>= 2;
+                        }
+                    consider(start);
+                }
+            }
+            if (bestDistance == HUGE_VAL) return false;
+            AxisVector withAngles = p.p;
+            for (int i = 0; i < n; ++i)
+                if (rotary_ & (1u << i)) withAngles[i] = best[i];
+            tcp_.toJoints(withAngles, s.controlLength, c);
+            return c.allFinite();
+        }
+    }
+    return false;
+}
+
+void Corrector::toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) const {
+    switch (s.mode) {
+        case ProgramMode::Joints:
+            p.p = c;
+            return;
+        case ProgramMode::TcpAngles:
+            tcp_.toProgram(c, s.controlLength, p.p);
+            return;
+        case ProgramMode::TcpVector: {
+            Vec3 point, axis;
+            tcp_.forward(c, s.controlLength, point, axis);
+            p.p = c;
+            for (int k = 0; k < 3; ++k) p.p[tcp_.linearAxis(k)] = point[k];
+            p.v = axis;
+            return;
+        }
+    }
+}
+
+bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength, double lambda2) const {
+    if (!cache.valid || cache.toolLength != toolLength || cache.lambda2 != lambda2 || cache.q.size() != q.size())
+        return false;
     for (int i = 0; i < q.size(); ++i) {
-        const double d = std::fabs(q[i] - cache_.q[i]);
+        const double d = std::fabs(q[i] - cache.q[i]);
         if ((rotary_ & (1u << i)) ? d > 0.5 * kDeg : d > 10.0) return false;
     }
     return true;
 }
 
-void Corrector::refreshJacobian(const AxisVector& q, double toolLength, const Vec3& tip) const {
+void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength,
+                                double lam2, AxisMask free) const {
     const int n = static_cast<int>(q.size());
-    const double w = options_.axisWeight, lam2 = options_.rotaryDamping * options_.rotaryDamping;
-    AxisMask free = (1u << n) - 1u;
-    if (options_.tipOnly) free &= ~rotary_;
-    toolPoseJacobian(actual_, q, tip, cache_.J);
-    cache_.J.bottomRows<3>() *= w;
-    cache_.A.resize(n, n);
-    cache_.A.noalias() = cache_.J.transpose() * cache_.J;
+    const double w = options_.axisWeight;
+    Vec3 tip, axis;
+    k.jacobian(q, toolLength, cache.J, tip, axis);
+    cache.J.bottomRows<3>() *= w;
+    cache.A.resize(n, n);
+    cache.A.noalias() = cache.J.transpose() * cache.J;
     for (int i = 0; i < n; ++i) {
         if (!(free & (1u << i))) {
-            cache_.A.row(i).setZero();
-            cache_.A.col(i).setZero();
-            cache_.A(i, i) = 1.0;
+            cache.A.row(i).setZero();
+            cache.A.col(i).setZero();
+            cache.A(i, i) = 1.0;
         } else if (rotary_ & (1u << i)) {
-            cache_.A(i, i) += lam2;
+            cache.A(i, i) += lam2;
         }
-        cache_.A(i, i) += 1e-12 * (1.0 + cache_.A(i, i));
+        cache.A(i, i) += 1e-12 * (1.0 + cache.A(i, i));
     }
     // n ≤ 9: an explicit inverse makes every chord step two small matrix-vector products.
-    cache_.Ainv = cache_.A.llt().solve(decltype(cache_.A)::Identity(n, n));
-    cache_.gain.noalias() = cache_.Ainv * cache_.J.transpose();
-    cache_.q = q;
-    cache_.toolLength = toolLength;
-    cache_.valid = true;
+    cache.Ainv = cache.A.llt().solve(decltype(cache.A)::Identity(n, n));
+    cache.gain.noalias() = cache.Ainv * cache.J.transpose();
+    for (int i = 0; i < n; ++i)
+        if (!(free & (1u << i))) cache.gain.row(i).setZero();
+    cache.q = q;
+    cache.toolLength = toolLength;
+    cache.lambda2 = lam2;
+    cache.valid = true;
 }
 
-SolveResult Corrector::solve(const AxisVector& qNom, double toolLength, const AxisVector& start, AxisVector& q) const {
+SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip,
+                               const Vec3& targetAxis, double toolLength, const AxisVector& start,
+                               const AxisVector& reference, double lam2, AxisMask free, AxisVector& c) const {
     SolveResult res;
-    const int n = static_cast<int>(qNom.size());
-    q = start;
-    if (identity_) {
-        q = qNom;
-        res.converged = true;
-        return res;
-    }
-    const Vec3 tip = nominal_.toolPoint(toolLength);
-    const ToolPose target = toolPose(nominal_, qNom, tip);
-    const double w = options_.axisWeight, lam2 = options_.rotaryDamping * options_.rotaryDamping;
-    AxisMask free = (1u << n) - 1u;
-    if (options_.tipOnly) {
-        free &= ~rotary_;
-        for (int i = 0; i < n; ++i)
-            if (rotary_ & (1u << i)) q[i] = qNom[i];
-    }
+    const int n = static_cast<int>(start.size());
+    AxisVector q = start + zero_;
+    const AxisVector ref = reference + zero_;
+    const double w = options_.axisWeight;
     AxisVector g(n), step(n);
     Eigen::Matrix<double, 6, 1> r;
     bool fresh = false;
-    if (!cacheUsable(q, toolLength)) {
-        refreshJacobian(q, toolLength, tip);
+    if (!cacheUsable(cache, q, toolLength, lam2)) {
+        refreshJacobian(k, cache, q, toolLength, lam2, free);
         fresh = true;
     }
     double lastStep = HUGE_VAL, linStep = 0.0, rotStep = 0.0;
     auto newtonStep = [&]() {
-        // step = A⁻¹ (Jᵀ r − λ² S (q − qNom)); fixed axes have zero rows in A⁻¹ Jᵀ.
-        step.noalias() = cache_.gain * r;
-        for (int i = 0; i < n; ++i) g[i] = (free & rotary_ & (1u << i)) ? lam2 * (q[i] - qNom[i]) : 0.0;
-        if (rotary_ & free) step.noalias() -= cache_.Ainv * g;
-        for (int i = 0; i < n; ++i)
-            if (!(free & (1u << i))) step[i] = 0.0;
+        // step = A⁻¹ (Jᵀ r − λ² S (q − ref)); fixed axes have zero rows in A⁻¹ Jᵀ.
+        step.noalias() = cache.gain * r;
+        if (rotary_ & free) {
+            for (int i = 0; i < n; ++i) g[i] = (free & rotary_ & (1u << i)) ? lam2 * (q[i] - ref[i]) : 0.0;
+            step.noalias() -= cache.Ainv * g;
+        }
         linStep = rotStep = 0.0;
         for (int i = 0; i < n; ++i) {
+            if (!(free & (1u << i))) step[i] = 0.0;
             if (rotary_ & (1u << i)) rotStep = std::max(rotStep, std::fabs(step[i]));
             else linStep = std::max(linStep, std::fabs(step[i]));
         }
         return linStep + 100.0 * rotStep;
     };
+    Vec3 tip, axis;
     for (res.iterations = 0; res.iterations < options_.maxIterations; ++res.iterations) {
-        const ToolPose p = toolPose(actual_, q, tip);
-        r.head<3>() = target.tip - p.tip;
-        r.tail<3>() = (target.axis - p.axis) * w;
+        k.toolPose(q, toolLength, tip, axis);
+        r.head<3>() = targetTip - tip;
+        r.tail<3>() = (targetAxis - axis) * w;
         res.tipError = r.head<3>().norm();
-        res.axisError = (target.axis - p.axis).norm();
+        res.axisError = (targetAxis - axis).norm();
         if (!std::isfinite(res.tipError)) break;
         double size = newtonStep();
         // Chord method: the kept Jacobian while the steps shrink fast, a fresh one when they do not.
         if (!fresh && size > 0.25 * lastStep) {
-            refreshJacobian(q, toolLength, tip);
+            refreshJacobian(k, cache, q, toolLength, lam2, free);
             fresh = true;
             size = newtonStep();
         }
@@ -162,63 +269,137 @@ SolveResult Corrector::solve(const AxisVector& qNom, double toolLength, const Ax
     }
     if (!std::isfinite(res.tipError) || !q.allFinite()) {
         res.converged = false;
-        cache_.valid = false;
+        cache.valid = false;
     }
+    c = q - zero_;
     return res;
 }
 
-void Corrector::split(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
-                      bool subdivide, std::vector<Piece>& pieces, SplitStats& stats) const {
+SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
+                             const AxisVector* neighbourDelta, const Vec3& tipShift) const {
+    const int n = static_cast<int>(cNom.size());
     if (identity_) {
-        pieces.push_back({1.0, qEnd});
+        c = cNom;
+        SolveResult res;
+        res.converged = true;
+        return res;
+    }
+    AxisMask free = (1u << n) - 1u;
+    AxisVector s = start;
+    if (options_.tipOnly) {
+        free &= ~rotary_;
+        for (int i = 0; i < n; ++i)
+            if (rotary_ & (1u << i)) s[i] = cNom[i];
+    }
+    // Two pulls on the rotary corrections d = c − cNom: λp²|d|² + λc²|d − dNeighbour|² = (λp² + λc²)|d − dRef|² + const,
+    // dRef = λc² dNeighbour / (λp² + λc²).
+    const double lp2 = options_.rotaryDamping * options_.rotaryDamping, lc2 = options_.continuity * options_.continuity;
+    double lam2 = lp2;
+    AxisVector reference = cNom;
+    if (neighbourDelta && lc2 > 0) {
+        lam2 = lp2 + lc2;
+        for (int i = 0; i < n; ++i)
+            if (rotary_ & (1u << i)) reference[i] += (lc2 / lam2) * (*neighbourDelta)[i];
+    }
+    Vec3 tip, axis;
+    nominal_.toolPose(cNom + zero_, toolLength, tip, axis);
+    return solveOn(actual_, cache_, tip + tipShift, axis, toolLength, s, reference, lam2, free, c);
+}
+
+SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess,
+                               const AxisVector& start, const AxisVector* neighbourDelta, AxisVector& cNom, AxisVector& c,
+                               ProgramPoint& out, const Vec3& tipShift) const {
+    SolveResult res;
+    if (!toJoints(s, nominal, guess, cNom)) {
+        c = guess;
+        out = nominal;
+        return res;  // not converged
+    }
+    if (identity_) {
+        c = cNom;
+        out = nominal;
+        res.converged = true;
+        return res;
+    }
+    res = solve(cNom, s.toolLength, start, c, neighbourDelta, tipShift);
+    toProgram(s, c, out);
+    if (s.mode == ProgramMode::TcpVector && options_.tipOnly) out.v = nominal.v;
+    return res;
+}
+
+double Corrector::deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected,
+                              double t) const {
+    AxisVector cn, cc;
+    if (!toJoints(ctx.space, nominal, ctx.guess, cn) || !toJoints(ctx.space, corrected, ctx.guess, cc)) return HUGE_VAL;
+    const Vec3 e = actualTip(cc, ctx.space.toolLength) - nominalTip(cn, ctx.space.toolLength) - (1.0 - t) * ctx.startOffset;
+    return e.norm();
+}
+
+void Corrector::correctedAt(const MovePath& path, const PathContext& ctx, double t, const ProgramPoint& near,
+                            ProgramPoint& out, SplitStats& stats) const {
+    ProgramPoint pn;
+    path.at(t, pn);
+    AxisVector cNom, c, start;
+    if (!toJoints(ctx.space, near, ctx.guess, start)) start = ctx.guess;
+    if (!toJoints(ctx.space, pn, ctx.guess, cNom)) cNom = start;
+    // The rotary corrections of the interpolation between the corrected ends are this point's neighbours.
+    const AxisVector neighbour = start - cNom;
+    // On the path with the start offset blended out, like every check.
+    correct(ctx.space, pn, ctx.guess, start, &neighbour, cNom, c, out, (1.0 - t) * ctx.startOffset);
+    ++stats.solves;
+}
+
+void Corrector::split(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool subdivide,
+                      std::vector<Piece>& pieces, SplitStats& stats) const {
+    if (identity_) {
+        pieces.push_back({1.0, end});
         return;
     }
-    if (affine_ && !path.circular) {
-        // Location errors only and no rotary motion: the actual tip is an affine function of the linear axes,
-        // so straight interpolation of corrected end points stays on the nominal line; nothing to check.
+    if (affine_ && !path.circular && !path.vector) {
+        // Location errors only and no rotary motion: the actual tip is an affine function of the linear axes (of the
+        // world point, in TCP mode), so straight interpolation of corrected end points stays on the nominal line
+        // (with a start offset blended out linearly); nothing to check.
         bool rotaryFixed = true;
         for (int i = 0; i < path.start.size() && rotaryFixed; ++i)
             if (rotary_ & (1u << i))
-                rotaryFixed = path.start[i] == path.end[i] && std::fabs(outStart[i] - qEnd[i]) < 1e-6;
+                rotaryFixed = path.start[i] == path.end[i] && std::fabs(ctx.outStart.p[i] - end.p[i]) < 1e-6;
         if (rotaryFixed) {
-            pieces.push_back({1.0, qEnd});
+            pieces.push_back({1.0, end});
             return;
         }
     }
     if (!subdivide) {
-        AxisVector qn, qo;
-        path.at(0.5, qn);
-        qo = 0.5 * (outStart + qEnd);
-        stats.maxDeviation = std::max(stats.maxDeviation, tipDeviation(qn, qo, toolLength));
-        pieces.push_back({1.0, qEnd});
+        ProgramPoint pn, pc;
+        path.at(0.5, pn);
+        lerpPoint(ctx.outStart, end, 0.5, path.vector, pc);
+        stats.maxDeviation = std::max(stats.maxDeviation, deviationAt(ctx, pn, pc, 0.5));
+        pieces.push_back({1.0, end});
         return;
     }
-    splitRecursive(path, 0.0, outStart, 1.0, qEnd, toolLength, 0, pieces, stats);
+    splitRecursive(path, ctx, 0.0, ctx.outStart, 1.0, end, 0, pieces, stats);
 }
 
-void Corrector::splitRecursive(const MovePath& path, double t0, const AxisVector& q0, double t1, const AxisVector& q1,
-                               double toolLength, int depth, std::vector<Piece>& pieces, SplitStats& stats) const {
+void Corrector::splitRecursive(const MovePath& path, const PathContext& ctx, double t0, const ProgramPoint& q0,
+                               double t1, const ProgramPoint& q1, int depth, std::vector<Piece>& pieces,
+                               SplitStats& stats) const {
     const double tm = 0.5 * (t0 + t1);
-    AxisVector qn, qo;
-    path.at(tm, qn);
-    qo = 0.5 * (q0 + q1);
-    const double dev = tipDeviation(qn, qo, toolLength);
-    if (dev <= options_.toleranceMm || depth >= options_.maxDepth ||
-        static_cast<int>(pieces.size()) + 2 > options_.maxPieces) {
-        if (dev > options_.toleranceMm) stats.limited = true;
+    ProgramPoint pn, pc;
+    path.at(tm, pn);
+    lerpPoint(q0, q1, 0.5, path.vector, pc);
+    const double dev = deviationAt(ctx, pn, pc, tm);
+    if (dev <= ctx.tolerance || depth >= options_.maxDepth || static_cast<int>(pieces.size()) + 2 > options_.maxPieces) {
+        if (dev > ctx.tolerance) stats.limited = true;
         stats.maxDeviation = std::max(stats.maxDeviation, dev);
         pieces.push_back({t1, q1});
         return;
     }
-    AxisVector qm;
-    solve(qn, toolLength, qo, qm);
-    ++stats.solves;
-    splitRecursive(path, t0, q0, tm, qm, toolLength, depth + 1, pieces, stats);
-    splitRecursive(path, tm, qm, t1, q1, toolLength, depth + 1, pieces, stats);
+    ProgramPoint qm;
+    correctedAt(path, ctx, tm, pc, qm, stats);
+    splitRecursive(path, ctx, t0, q0, tm, qm, depth + 1, pieces, stats);
+    splitRecursive(path, ctx, tm, qm, t1, q1, depth + 1, pieces, stats);
 }
 
-ArcFit Corrector::fitArc(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
-                         bool closed) const {
+ArcFit Corrector::fitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool closed) const {
     ArcFit fit;
     const int a0 = path.axis0, a1 = path.axis1;
     if (identity_) {
@@ -228,16 +409,20 @@ ArcFit Corrector::fitArc(const MovePath& path, const AxisVector& outStart, const
         fit.sweep = path.sweep;
         return fit;
     }
-    // Correction at the centre (other axes at mid-move): the corrected arc's centre.
-    AxisVector qc, qcStar;
-    path.at(0.5, qc);
-    qc[a0] = path.c0;
-    qc[a1] = path.c1;
-    AxisVector start = qc + (qEnd - path.end);
-    solve(qc, toolLength, start, qcStar);
-    double c0 = qcStar[a0], c1 = qcStar[a1];
+    // Correction at the centre (other coordinates at mid-move): the corrected arc's centre.
+    ProgramPoint pc, pcStar;
+    path.at(0.5, pc);
+    pc.p[a0] = path.c0;
+    pc.p[a1] = path.c1;
+    {
+        AxisVector cNom, c, start;
+        if (!toJoints(ctx.space, pc, ctx.guess, start)) return fit;
+        correct(ctx.space, pc, ctx.guess, start, nullptr, cNom, c, pcStar, 0.5 * ctx.startOffset);
+    }
+    double c0 = pcStar.p[a0], c1 = pcStar.p[a1];
     // Onto the bisector of the corrected end points, so that start and end radius agree.
-    const double s0 = outStart[a0], s1 = outStart[a1], e0 = qEnd[a0], e1 = qEnd[a1];
+    const AxisVector& outStart = ctx.outStart.p;
+    const double s0 = outStart[a0], s1 = outStart[a1], e0 = end.p[a0], e1 = end.p[a1];
     const double d0 = e0 - s0, d1 = e1 - s1, d = std::hypot(d0, d1);
     if (!closed && d > 1e-9) {
         const double u0 = d0 / d, u1 = d1 / d, m0 = 0.5 * (s0 + e0), m1 = 0.5 * (s1 + e1);
@@ -269,42 +454,43 @@ ArcFit Corrector::fitArc(const MovePath& path, const AxisVector& outStart, const
     fit.c1 = c1;
     fit.sweep = sweep;
     const int samples = std::max(4, static_cast<int>(std::ceil(std::fabs(sweep) / (kPi / 8))));
-    AxisVector qn, qo;
+    ProgramPoint pn, po;
     for (int k = 0; k < samples; ++k) {
         const double t = (k + 0.5) / samples;
-        path.at(t, qn);
-        qo = outStart + t * (qEnd - outStart);
+        path.at(t, pn);
+        lerpPoint(ctx.outStart, end, t, path.vector, po);
         const double th = th0 + t * sweep;
-        qo[a0] = c0 + r * std::cos(th);
-        qo[a1] = c1 + r * std::sin(th);
-        fit.maxDeviation = std::max(fit.maxDeviation, tipDeviation(qn, qo, toolLength));
+        po.p[a0] = c0 + r * std::cos(th);
+        po.p[a1] = c1 + r * std::sin(th);
+        fit.maxDeviation = std::max(fit.maxDeviation, deviationAt(ctx, pn, po, t));
     }
-    fit.ok = fit.maxDeviation <= options_.toleranceMm;
+    fit.ok = fit.maxDeviation <= ctx.tolerance;
     return fit;
 }
 
-void Corrector::splitArc(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
+void Corrector::splitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end,
                          std::vector<Piece>& pieces, SplitStats& stats) const {
     // Chords whose sagitta stays below half the tolerance; the midpoint checks split further where needed.
     const double r = std::max(path.r0, path.r1);
-    const double tol = options_.toleranceMm * 0.5;
+    const double tol = ctx.tolerance * 0.5;
     int chords = 1;
     if (r > tol) {
         const double maxAngle = 2.0 * std::acos(1.0 - tol / r);
         chords = static_cast<int>(std::ceil(std::fabs(path.sweep) / maxAngle));
     }
     chords = std::clamp(chords, 2, std::max(2, options_.maxPieces / 2));
-    AxisVector q0 = outStart, qn, q1;
+    ProgramPoint q0 = ctx.outStart, q1, pn;
     for (int k = 1; k <= chords; ++k) {
         const double t0 = static_cast<double>(k - 1) / chords, t1 = static_cast<double>(k) / chords;
         if (k == chords) {
-            q1 = qEnd;
+            q1 = end;
         } else {
-            path.at(t1, qn);
-            solve(qn, toolLength, qn + (qEnd - path.end), q1);
-            ++stats.solves;
+            path.at(t1, pn);
+            ProgramPoint near = pn;
+            near.p += end.p - path.end;
+            correctedAt(path, ctx, t1, near, q1, stats);
         }
-        splitRecursive(path, t0, q0, t1, q1, toolLength, 0, pieces, stats);
+        splitRecursive(path, ctx, t0, q0, t1, q1, 0, pieces, stats);
         q0 = q1;
     }
 }

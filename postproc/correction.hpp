@@ -1,25 +1,30 @@
 #pragma once
-// Correction of motion endpoints and paths: axis commands that make the erroneous machine
-// (Kinematics(m, d)) put its tool where the nominal machine (Kinematics(m)) would, and the subdivision of
-// moves where the straight (or circular) interpolation of corrected commands would leave the nominal path
-// by more than a tolerance. Allocation free in the hot path.
+// Correction of motion endpoints and paths: positions that make the erroneous machine (the deviation set) put its
+// tool where the nominal machine would, and the subdivision of moves where the interpolation of corrected positions
+// would leave the nominal path by more than a tolerance. Allocation free in the hot path.
+//
+// Positions are "program space": what the controller interpolates between block endpoints, in its machine units
+// (mm, rad) after work offsets — its machine coordinates (joint mode), or in TCP mode the world point of the tool and
+// the rotary angles / tool vector (postproc/tcp_model.hpp). Machine coordinates are the controller's: the model's
+// commands are machine coordinates + machine-zero (MachineModel::fromController), converted here where they meet it.
 #include <vector>
 
-#include <Eigen/Cholesky>
-
-#include "cnccomp/inverse_kinematics.hpp"
+#include "postproc/compiled_kinematics.hpp"
 #include "postproc/modal.hpp"
+#include "postproc/tcp_model.hpp"
 
 namespace cnccomp::pp {
 
 struct CorrectorOptions {
     double toleranceMm = 1e-3;     ///< largest allowed distance of the tool tip from the nominal path
     bool tipOnly = false;          ///< rotary axes keep their commands; only the tool tip is corrected
-    double rotaryDamping = 1.0;    ///< mm (weighted residual) per rad of extra rotary motion: keeps rotary
-                                   ///< corrections bounded where the tool axis cannot be corrected (singular poses)
+    double rotaryDamping = 5.0;    ///< mm (weighted residual) per rad of rotary correction: a rotary axis corrects at most
+                                   ///< about axisWeight / (2 · rotaryDamping) = 10 times the tool-axis error it removes,
+                                   ///< so near a singular pose (tool axis along a rotary axis) it does not swing
+    double continuity = 20.0;      ///< mm per rad of change of a rotary correction from the previous end point: keeps the
+                                   ///< solution on the branch of the previous block (see Corrector::solve)
     double axisWeight = 100.0;     ///< mm per rad: how much a tool-axis error counts against a tip error
-    double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (and 1e-9 rad); the
-                                   ///< residual left is far smaller (quadratic / fast linear convergence)
+    double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (and 1e-9 rad)
     int maxIterations = 30;
     int maxDepth = 14;             ///< subdivision levels per move
     int maxPieces = 16384;         ///< pieces per move
@@ -32,23 +37,40 @@ struct SolveResult {
     bool converged = false;
 };
 
-/// Nominal path of one move in machine coordinates, t ∈ [0, 1]: straight in every axis (G0/G1), or a circle
-/// (spiral when start and end radius differ, as RS274NGC interpolates) in the plane axes with the other
-/// axes straight (G2/G3, helices).
+/// What a move's program positions are, and which tool point is matched.
+struct MoveSpace {
+    ProgramMode mode = ProgramMode::Joints;
+    double controlLength = 0.0;  ///< mm, TCP: the controller's tool length (the programmed point is there)
+    double toolLength = 0.0;     ///< mm: the tool point whose position is corrected exactly (and the tool axis)
+};
+
+/// A position in program space: the axis vector, and in vector mode the tool vector (world, spindle → tip).
+struct ProgramPoint {
+    AxisVector p;
+    Vec3 v = Vec3(0, 0, -1);
+};
+
+/// Nominal path of one move in program space, t ∈ [0, 1]: straight in every coordinate (G0/G1), or a circle (spiral
+/// when start and end radius differ, as RS274NGC interpolates) in the plane coordinates with the others straight
+/// (G2/G3, helices). In vector mode the tool vector turns in the plane of its end vectors at a constant rate [G].
 struct MovePath {
-    bool circular = false;
+    bool circular = false, vector = false;
     AxisVector start, end;
+    Vec3 v0 = Vec3(0, 0, -1), v1 = Vec3(0, 0, -1);
     int axis0 = -1, axis1 = -1;
     double c0 = 0, c1 = 0, r0 = 0, r1 = 0, theta0 = 0, sweep = 0;
 
     static MovePath line(const AxisVector& start, const AxisVector& end);
     static MovePath arc(const AxisVector& start, const AxisVector& end, const ArcGeometry& g);
-    void at(double t, AxisVector& q) const;
+    void at(double t, ProgramPoint& q) const;
 };
+
+/// Tool vector at fraction t between unit vectors a and b, turning in their plane at a constant rate.
+Vec3 slerpVector(const Vec3& a, const Vec3& b, double t);
 
 struct Piece {
     double t = 1.0;  ///< parameter on the nominal path the piece ends at
-    AxisVector q;    ///< corrected commands at its end
+    ProgramPoint q;  ///< corrected program position at its end
 };
 
 struct SplitStats {
@@ -59,68 +81,115 @@ struct SplitStats {
 
 struct ArcFit {
     bool ok = false;
-    double c0 = 0, c1 = 0;      ///< centre of the corrected arc, machine coordinates (plane axes)
+    double c0 = 0, c1 = 0;      ///< centre of the corrected arc, program space (plane coordinates)
     double sweep = 0;           ///< signed sweep of the corrected arc
     double maxDeviation = 0.0;  ///< mm, at the sampled points
+};
+
+/// Everything a path check needs about one move: its space, its corrected start (program space) and the tip
+/// offset of that start from the nominal path's start (non-zero after a block passed through uncorrected: splitting
+/// cannot remove it, so it is blended out linearly along the move and not counted as deviation).
+struct PathContext {
+    MoveSpace space;
+    ProgramPoint outStart;
+    Vec3 startOffset = Vec3::Zero();
+    double tolerance = 1e-3;
+    AxisVector guess;  ///< machine coordinates near the move (start of the inverse TCP kinematics in vector mode)
 };
 
 class Corrector {
 public:
     Corrector(const MachineModel& machine, const DeviationSet& deviations, const CorrectorOptions& options = {});
 
-    /// True when every deviation is zero: corrected commands are the commands, nothing is solved.
+    /// True when every deviation is zero: corrected positions are the positions, nothing is solved.
     bool identity() const { return identity_; }
     const CorrectorOptions& options() const { return options_; }
-    const Kinematics& nominal() const { return nominal_; }
-    const Kinematics& actual() const { return actual_; }
+    const CompiledKinematics& nominal() const { return nominal_; }
+    const CompiledKinematics& actual() const { return actual_; }
+    const TcpModel& tcp() const { return tcp_; }
 
-    /// Commands `q` near `start` at which the erroneous machine puts the point at `toolLength` along the tool,
-    /// and the tool axis, where the nominal machine puts them at `qNom`. Regularised Gauss–Newton on the exact
-    /// model: the tip is matched exactly (linear axes are free), the tool axis in the least-squares sense with
-    /// rotary corrections damped by options().rotaryDamping (exact away from singular poses).
-    SolveResult solve(const AxisVector& qNom, double toolLength, const AxisVector& start, AxisVector& q) const;
+    /// Machine coordinates of a program position (nominal controller). false when the TCP inverse fails.
+    bool toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c) const;
+    /// Program position of machine coordinates c.
+    void toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) const;
 
-    /// Distance (mm) between the nominal tool tip at `qNom` and the actual tool tip at `q`.
-    double tipDeviation(const AxisVector& qNom, const AxisVector& q, double toolLength) const;
+    /// Machine coordinates `c` near `start` at which the erroneous machine puts the point at `toolLength` along the
+    /// tool, and the tool axis, where the nominal machine puts them at `cNom`. Regularised Gauss–Newton on the exact
+    /// model: the tip is matched exactly (linear axes are free), the tool axis in the least-squares sense with the rotary
+    /// corrections (c − cNom) pulled towards 0 by options().rotaryDamping and, given `neighbour` (the corrected
+    /// rotary positions next to this point: the previous end point, or the interpolation of a move's corrected ends),
+    /// towards neighbour − its nominal by options().continuity. Exact away from singular poses; near them the rotary
+    /// axes stay on the branch of their neighbours and of the programmed value instead of swinging.
+    /// `tipShift` moves the target tip (a point of a path whose start offset is blended out).
+    SolveResult solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
+                      const AxisVector* neighbourDelta = nullptr, const Vec3& tipShift = Vec3::Zero()) const;
 
-    /// Appends pieces (ending at t = 1 with `qEnd`) so that straight interpolation between consecutive corrected
-    /// commands, starting from `outStart`, stays within the tolerance of `path` at every checked midpoint.
-    /// `subdivide` false: one piece, deviation still measured at the midpoint.
-    void split(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
-               bool subdivide, std::vector<Piece>& pieces, SplitStats& stats) const;
+    /// Tip (at `toolLength`) of the nominal machine at cNom minus that of the erroneous machine at c.
+    Vec3 tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const;
+    double tipDeviation(const AxisVector& cNom, const AxisVector& c, double toolLength) const {
+        return tipError(cNom, c, toolLength).norm();
+    }
+    /// Tip of the erroneous machine at c.
+    Vec3 actualTip(const AxisVector& c, double toolLength) const;
+    Vec3 nominalTip(const AxisVector& c, double toolLength) const;
 
-    /// Corrected arc from `outStart` to `qEnd` that stays a circle in the same plane: its centre is the nominal
-    /// centre corrected, moved onto the bisector of the corrected end points; ok when every sampled point is
-    /// within the tolerance of the nominal arc.
-    ArcFit fitArc(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
-                  bool closed) const;
+    /// Corrected program position for the nominal one: joints `cNom` (out), solved joints `c` (start `start`,
+    /// reference rotary positions `reference`), the program position `out`.
+    SolveResult correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess, const AxisVector& start,
+                        const AxisVector* neighbourDelta, AxisVector& cNom, AxisVector& c, ProgramPoint& out,
+                        const Vec3& tipShift = Vec3::Zero()) const;
+
+    /// Appends pieces (ending at t = 1 with `end`) so that the controller's interpolation between consecutive
+    /// corrected positions, starting from ctx.outStart, stays within ctx.tolerance of `path` at every checked
+    /// midpoint. `subdivide` false: one piece, deviation still measured at the midpoint.
+    void split(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool subdivide,
+               std::vector<Piece>& pieces, SplitStats& stats) const;
+
+    /// Corrected arc from ctx.outStart to `end` that stays a circle in the same plane: its centre is the nominal
+    /// centre corrected, moved onto the bisector of the corrected end points; ok when every sampled point is within
+    /// the tolerance of the nominal arc.
+    ArcFit fitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool closed) const;
 
     /// Arc → straight pieces: chords short enough for the tolerance, each checked and split like a line.
-    void splitArc(const MovePath& path, const AxisVector& outStart, const AxisVector& qEnd, double toolLength,
-                  std::vector<Piece>& pieces, SplitStats& stats) const;
+    void splitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, std::vector<Piece>& pieces,
+                  SplitStats& stats) const;
+
+    /// Tip deviation of the corrected interpolation at program point `corrected` from the nominal path point `nominal`
+    /// at parameter t (with the context's start offset blended out).
+    double deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected, double t) const;
 
 private:
-    /// Jacobian of the erroneous machine and its factorised normal matrix, kept from one solve to the next
-    /// while the commands stay close (chord Newton): consecutive program points differ little.
+    /// Jacobian of the erroneous machine and its factorised normal matrix, kept from one solve to the next while the
+    /// commands stay close (chord Newton): consecutive program points differ little.
     struct JacobianCache {
         bool valid = false;
-        double toolLength = 0;
+        double toolLength = 0, lambda2 = 0;
         AxisVector q;
         PoseJacobian J;
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes> A, Ainv;  ///< normal matrix, inverse
         Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxAxes, 6> gain;  ///< Ainv · Jᵀ (n × 6)
     };
-    void refreshJacobian(const AxisVector& q, double toolLength, const Vec3& tip) const;
-    bool cacheUsable(const AxisVector& q, double toolLength) const;
-    void splitRecursive(const MovePath& path, double t0, const AxisVector& q0, double t1, const AxisVector& q1,
-                        double toolLength, int depth, std::vector<Piece>& pieces, SplitStats& stats) const;
+    SolveResult solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
+                        double toolLength, const AxisVector& start, const AxisVector& reference, double lambda2,
+                        AxisMask free, AxisVector& c) const;
+    void refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength,
+                         double lambda2, AxisMask free) const;
+    bool cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength, double lambda2) const;
+    void splitRecursive(const MovePath& path, const PathContext& ctx, double t0, const ProgramPoint& q0, double t1,
+                        const ProgramPoint& q1, int depth, std::vector<Piece>& pieces, SplitStats& stats) const;
+    /// Corrected program position of the nominal path at t, started near `near` (program space).
+    void correctedAt(const MovePath& path, const PathContext& ctx, double t, const ProgramPoint& near,
+                     ProgramPoint& out, SplitStats& stats) const;
+
     const MachineModel& machine_;
-    Kinematics nominal_, actual_;
+    CompiledKinematics nominal_, actual_;
+    TcpModel tcp_;
     CorrectorOptions options_;
+    AxisVector zero_;      ///< model commands of the controller's machine zero (machine-zero per axis)
     bool identity_ = false;
     bool affine_ = false;  ///< no component errors: with rotary axes fixed, the error is affine in the linear axes
     AxisMask rotary_ = 0;
-    mutable JacobianCache cache_;  ///< not thread-safe: one Corrector per program being corrected
+    mutable JacobianCache cache_, nominalCache_;  ///< not thread-safe: one Corrector per program being corrected
 };
 
 }  // namespace cnccomp::pp

@@ -17,6 +17,7 @@ const char* lexFlagReason(uint32_t flags) {
     if (flags & kCall) return "subprogram or cycle call";
     if (flags & kIdentifier) return "keyword";
     if (flags & kMissingValue) return "address letter without a number";
+    if (flags & kExponent) return "number in exponent notation (e.g. 1e-3), which G-code does not have";
     if (flags & kBadNumber) return "malformed or out-of-range number";
     if (flags & kUnknownChar) return "unexpected character";
     return "";
@@ -113,6 +114,37 @@ void problem(LexedBlock& b, uint32_t flag, size_t at) {
 bool printerTextCode(int m) { return m == 23 || m == 28 || m == 30 || m == 32 || m == 117 || m == 118 || m == 928; }
 
 }  // namespace
+
+void OverlongLine::feed(std::string_view piece) {
+    for (const char ch : piece) {
+        const unsigned char c = static_cast<unsigned char>(ch);
+        if (inComment) return;
+        if (inParen) {
+            if (c == ')') inParen = false;
+            continue;
+        }
+        if (c == '(') {
+            inParen = true;
+            lastWasLetter = false;
+            continue;
+        }
+        if (c == ';') {
+            inComment = true;
+            return;
+        }
+        if (isSpace(c)) continue;
+        code = true;
+        if (isAlpha(c)) {
+            // A letter right after a letter is a keyword (GOTO, TRAORI …): not a plain word.
+            if (lastWasLetter) other = true;
+            letters |= 1u << (upper(c) - 'A');
+            lastWasLetter = true;
+            continue;
+        }
+        lastWasLetter = false;
+        if (!(isDigit(c) || c == '.' || c == '-' || c == '+' || c == '/')) other = true;
+    }
+}
 
 bool parseGcodeNumber(std::string_view text, double& value) {
     Word w;
@@ -250,9 +282,47 @@ void lexBlock(std::string_view s, Dialect dialect, LexedBlock& b, bool firstLine
                 } else {
                     if (bad) problem(b, kBadNumber, j);
                     j = e;
-                    // A number directly followed by '=' is an assignment target (R1=…, #1=…).
+                    // "X1e-3": RS274NGC (LinuxCNC reads an E word and stops: "E word with no G70, G76, M66, M67 or
+                    // M68 to use it", interp_check.cc), Fanuc and Sinumerik (1EX-3) have no such notation: never read
+                    // it as X1 silently. Printers (Marlin) end the number at 'E' and read an extruder word [G].
+                    if (dialect != Dialect::Printer && j < n && (s[j] == 'e' || s[j] == 'E')) {
+                        size_t k = j + 1;
+                        if (k < n && (s[k] == '+' || s[k] == '-')) ++k;
+                        if (k < n && isDigit(static_cast<unsigned char>(s[k]))) {
+                            problem(b, kExponent, j);
+                            w.kind = ValueKind::Exponent;  // its value is not the number's: never used
+                        }
+                    }
+                    // A number directly followed by '=' is an assignment target (R1=…, #1=…), or on Sinumerik an
+                    // address with an extension and a plain number: A3=0.5 (orientation vector component).
                     size_t k = j;
                     while (k < n && isSpace(s[k])) ++k;
+                    if (k < n && s[k] == '=' && dialect == Dialect::Sinumerik && !w.point && !w.plus &&
+                        (w.letter == 'A' || w.letter == 'B' || w.letter == 'C') &&
+                        s[w.valueBegin] != '-' && w.value >= 1 && w.value <= 9 && w.valueBegin == i + 1) {
+                        size_t m = k + 1;
+                        while (m < n && (s[m] == ' ' || s[m] == '\t')) ++m;
+                        Word v;
+                        bool badValue = false;
+                        const size_t e2 = scanNumber(s, m, v, badValue);
+                        const bool ends = e2 >= n || isSpace(s[e2]) || s[e2] == ';' || s[e2] == '(';
+                        if (e2 > m && !badValue && ends) {
+                            const auto ext = static_cast<uint8_t>(w.value);
+                            const uint32_t wordBegin = w.begin;
+                            const bool wasLower = w.lower;
+                            w = v;
+                            w.begin = wordBegin;
+                            w.letter = upper(c);
+                            w.lower = wasLower;
+                            w.ext = ext;
+                            w.valueBegin = static_cast<uint32_t>(m);
+                            w.end = static_cast<uint32_t>(e2);
+                            ++b.count;
+                            i = e2;
+                            endToken(i);
+                            continue;
+                        }
+                    }
                     if (k < n && s[k] == '=') {
                         w.end = static_cast<uint32_t>(n);
                         ++b.count;

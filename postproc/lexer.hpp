@@ -26,17 +26,18 @@ enum LexFlag : uint32_t {
     kCall = 1u << 10,                ///< NAME(arguments) call (Sinumerik)
     kTextArgument = 1u << 11,        ///< M117-style text argument (printer; harmless)
     kOverlong = 1u << 12,            ///< set by the reader: the line was longer than its buffer
+    kExponent = 1u << 13,            ///< a number in exponent notation (X1e-3): no G-code dialect reads it so
 };
 
 /// Flags that make a block's words impossible to evaluate.
 inline constexpr uint32_t kNotEvaluable = kUnterminatedComment | kExpression | kVariable | kAssignment | kIdentifier |
                                           kMissingValue | kBadNumber | kBinary | kUnknownChar | kTooManyWords |
-                                          kCall | kOverlong;
+                                          kCall | kOverlong | kExponent;
 
 /// Human-readable reason of the lowest set flag in `flags` (a static string).
 const char* lexFlagReason(uint32_t flags);
 
-enum class ValueKind : uint8_t { Number, Missing, Expression, Variable, Assignment };
+enum class ValueKind : uint8_t { Number, Missing, Expression, Variable, Assignment, Exponent };
 
 /// One address word: a letter and its value. Offsets are into the block's line.
 struct Word {
@@ -53,6 +54,7 @@ struct Word {
     bool trailingZero = false;  ///< the fraction ends in '0' (fixed-width style)
     uint8_t decimals = 0;       ///< digits after the point
     uint8_t digitsBefore = 0;   ///< digits before the point (leading zeros included)
+    uint8_t ext = 0;            ///< Sinumerik address extension: A3=0.5 is letter A, ext 3 (0: a plain word)
 };
 
 struct Span {
@@ -89,6 +91,21 @@ struct LexedBlock {
 /// Lexes one block. `firstLine`: the block is the first of the file (a UTF-8 byte-order mark is skipped).
 /// Never throws; problems are flags.
 void lexBlock(std::string_view line, Dialect dialect, LexedBlock& out, bool firstLine = false);
+
+/// What a line longer than the reader's buffer (it comes in pieces and is never lexed whole) may change, gathered
+/// piece by piece in constant memory: comments are skipped as the lexer skips them, the word letters outside them
+/// are collected.
+struct OverlongLine {
+    bool inParen = false;    ///< inside a ( … ) comment at the end of the last piece
+    bool inComment = false;  ///< after a ';' comment start: the rest of the line is comment
+    bool code = false;       ///< something other than white space and comments
+    bool other = false;      ///< characters that are not plain words: '#', '[', '=', '$', '<', control bytes …
+    uint32_t letters = 0;    ///< word letters outside comments (bit letter − 'A', upper case)
+    bool lastWasLetter = false;
+    void reset() { *this = OverlongLine{}; }
+    void feed(std::string_view piece);
+    bool has(char upperLetter) const { return (letters >> (upperLetter - 'A')) & 1u; }
+};
 
 /// Parses a plain G-code number ("-12.500", "+.5", "3.") as the lexer does. Returns false on anything else.
 bool parseGcodeNumber(std::string_view text, double& value);

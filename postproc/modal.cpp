@@ -274,6 +274,32 @@ void Interpreter::forgetAll(BlockResult& r, const char* reason) {
     motion_ = Motion::Unknown;
 }
 
+bool Interpreter::forgetOverlong(const OverlongLine& l, BlockResult& r) {
+    static constexpr char kModal[] = "GMOLPQHDTEUVWIJKR";
+    bool modal = l.other;
+    for (const char* c = kModal; *c && !modal; ++c)
+        if (layout_.axis(*c) < 0 && l.has(*c)) modal = true;
+    const char* why = "line longer than the read buffer";
+    if (modal) {
+        forgetAll(r, why);
+        return true;
+    }
+    AxisMask named = 0;
+    for (int a = 0; a < layout_.count; ++a)
+        if (l.has(layout_.letter[a])) named |= 1u << a;
+    r = BlockResult{};
+    r.start = pos_;
+    r.end = pos_;
+    r.startKnown = known_;
+    r.axisWord.fill(-1);
+    passThrough(r, why, 0);
+    known_ &= ~named;
+    assumed_ &= ~named;
+    r.endKnown = known_;
+    r.words = named;
+    return false;
+}
+
 bool Interpreter::isDimensionLetter(char c) const {
     return layout_.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || c == 'U' || c == 'V' || c == 'W';
 }
@@ -310,7 +336,8 @@ void Interpreter::fillConversions(BlockResult& r) const {
             if (diameter_ && layout_.letter[i] == 'X') r.scale[i] = 0.5 * lin;
         }
         r.offset[i] = (work ? (*work)[i] : 0.0) + local_[i];
-        if (i == layout_.zAxis) r.offset[i] += tloSign_ * tloLength_;
+        // In TCP mode the words are the tool point itself: no tool length shift of Z.
+        if (i == layout_.zAxis && mode_ == ProgramMode::Joints) r.offset[i] += tloSign_ * tloLength_;
         if (options_.rotaryShortest && layout_.rotary[i] && layout_.modulo[i]) r.wrap |= 1u << i;
     }
     r.absolute = absolute_;
@@ -321,6 +348,13 @@ void Interpreter::fillConversions(BlockResult& r) const {
     r.feedMode = feedMode_;
     r.feed = feed_;
     r.tipLength = tloSign_ != 0 ? tloLength_ : options_.setup.defaultToolLength;
+    r.mode = mode_;
+    r.tcpSource = tcpSource_;
+    // The controller's tool length in TCP mode: the active G43 / G43.4 / G43.5 offset; Sinumerik always works with
+    // the active tool's length (--tool-length); LinuxCNC's trt kinematics take motion.tooloffset.z (0 without G43).
+    r.controlLength = tloSign_ != 0 ? tloSign_ * tloLength_
+                      : options_.dialect == Dialect::Sinumerik ? options_.setup.defaultToolLength
+                                                               : 0.0;
     r.rapidIsFeed = options_.dialect == Dialect::Printer;
 }
 
@@ -514,8 +548,12 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
     r.machineCoordinates = false;
     r.report = true;
     r.warningCount = 0;
+    r.modeSwitch = false;
+    r.vectorWord = {{-1, -1, -1}};
+    r.vectorGiven = false;
     fillConversions(r);
     if (b.percent) return;
+    const ProgramMode modeBefore = mode_;
     if (b.count == 0 && b.identifierCount == 0 && (b.flags & kNotEvaluable) == 0) return;
     const Dialect dialect = options_.dialect;
     const AxisMask all = layout_.all();
@@ -560,10 +598,17 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
     bool gProblem = false, mCall = false, mSubEnd = false, duplicateAxis = false;
     char foreignAxis = 0;
     const Word *F = nullptr, *H = nullptr, *T = nullptr, *P = nullptr, *L = nullptr, *O = nullptr;
-    bool arcWords = false;
+    bool arcWords = false, extProblem = false, userTcpOn = false, userTcpOff = false;
+    std::array<int, 3> ijk{{-1, -1, -1}};
     for (int i = 0; i < b.count; ++i) {
         const Word& w = b.words[i];
         const char c = w.letter;
+        if (w.ext != 0) {
+            // Sinumerik A3= B3= C3=: components of the tool vector (TRAORI); other extended addresses unsupported.
+            if (w.ext == 3 && (c == 'A' || c == 'B' || c == 'C')) r.vectorWord[c - 'A'] = static_cast<int8_t>(i);
+            else extProblem = true;
+            continue;
+        }
         if (c == 'G') {
             if (w.kind != ValueKind::Number || w.value < 0 || w.value >= 10000) {
                 gProblem = true;
@@ -593,6 +638,8 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
                 if (w.kind == ValueKind::Number && w.value == std::floor(w.value)) {
                     const int m = static_cast<int>(w.value);
                     if (m == 0 || m == 1 || m == 2 || m == 30 || m == 60) r.stop = true;
+                    if (m == options_.tcpOnM && std::fabs(w.value - m) == 0) userTcpOn = true;
+                    if (m == options_.tcpOffM && std::fabs(w.value - m) == 0) userTcpOff = true;
                     if (dialect != Dialect::Printer) {
                         if (m == 98 || m == 97 || m == 198) mCall = true;
                         if (m == 99 || (dialect == Dialect::Sinumerik && m == 17)) mSubEnd = true;
@@ -605,7 +652,11 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
             case 'P': P = &w; break;
             case 'L': L = &w; break;
             case 'O': O = &w; break;
-            case 'I': case 'J': case 'K': case 'R': arcWords = true; break;
+            case 'I': case 'J': case 'K':
+                ijk[c - 'I'] = i;
+                arcWords = true;
+                break;
+            case 'R': arcWords = true; break;
             default: break;
         }
     }
@@ -627,7 +678,7 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         unknownAll(r);
         return;
     }
-    constexpr uint32_t kValueFlags = kExpression | kVariable | kAssignment | kMissingValue | kBadNumber;
+    constexpr uint32_t kValueFlags = kExpression | kVariable | kAssignment | kMissingValue | kBadNumber | kExponent;
     if (flags & kNotEvaluable & ~kValueFlags) {
         passThrough(r, lexFlagReason(flags & kNotEvaluable & ~kValueFlags), 0);
         unknownAll(r);
@@ -743,7 +794,11 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         tloSign_ = has(GKind::ToolLengthNeg) ? -1 : 1;
         tloKnown_ = true;
         if (layout_.zAxis < 0) warn(r, Warning::NoToolLengthAxis, 0);
-        if (has(GKind::Tcp)) tcp_ = true;
+        if (const int k = gIndex(GKind::Tcp); k >= 0) {
+            // Fanuc tool centre point control: G43.4 type 1 (rotary angles), G43.5 type 2 (I J K vector).
+            mode_ = gCode[k] == 435 ? ProgramMode::TcpVector : ProgramMode::TcpAngles;
+            tcpSource_ = gCode[k] == 435 ? TcpSource::FanucVector : TcpSource::FanucAngles;
+        }
     }
     if (nonModal == GKind::ToolLengthDynamic) {
         const int z = layout_.zAxis;
@@ -760,7 +815,10 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         tloSign_ = 0;
         tloLength_ = 0;
         tloKnown_ = true;
-        tcp_ = false;
+        if (tcpSource_ == TcpSource::FanucAngles || tcpSource_ == TcpSource::FanucVector) {
+            mode_ = ProgramMode::Joints;
+            tcpSource_ = TcpSource::None;
+        }
     }
     // Work offset.
     if (const int k = gIndex(GKind::WorkOffset); k >= 0) {
@@ -792,11 +850,26 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
     }
     if (nonModal == GKind::ModalMacro) modalMacro_ = true;
     if (has(GKind::ModalMacroCancel)) modalMacro_ = false;
-    if (tcpOn) tcp_ = true;
+    if (tcpOn) {
+        mode_ = ProgramMode::TcpAngles;
+        tcpSource_ = TcpSource::Sinumerik;
+    }
     if (tcpOff) {
-        tcp_ = false;
+        mode_ = ProgramMode::Joints;
+        tcpSource_ = TcpSource::None;
         transform_ = false;
     }
+    // A user-declared switch (--tcp-on M428 --tcp-off M429: LinuxCNC's switchable trt kinematics, whose remapped M
+    // codes run before the block's motion, modal group 10).
+    if (userTcpOn) {
+        mode_ = ProgramMode::TcpAngles;
+        tcpSource_ = TcpSource::UserSwitch;
+    }
+    if (userTcpOff && tcpSource_ == TcpSource::UserSwitch) {
+        mode_ = ProgramMode::Joints;
+        tcpSource_ = TcpSource::None;
+    }
+    if (mode_ != modeBefore) r.modeSwitch = true;
     if (has(GKind::PositionOffsetCancel)) g92Unknown_ = 0;
     if (has(GKind::PositionOffsetRestore)) g92Unknown_ = all;
     // Motion mode.
@@ -917,9 +990,52 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
     }
     const bool machineCoordinates = nonModal == GKind::MachineCoords || machineKeyword;
 
+    if (extProblem) {
+        passThrough(r, "address with an extension other than A3= B3= C3= (e.g. Euler angles A2=): not supported", 0);
+        unknownAll(r);
+        return;
+    }
+    if (mode_ != ProgramMode::Joints) {
+        // The block's tool vector: Fanuc G43.5 I J K, Sinumerik A3= B3= C3= (omitted components are 0; with none
+        // given the vector stays). Fanuc A-79348E "Tool center point control for 5-axis machining" p. 9; Sinumerik
+        // Job Planning 6FC5398-2BP10 sec. 7.2 p. 7-20: "the vector points towards the tool adapter".
+        const bool arcMotion = motion_ == Motion::ArcCw || motion_ == Motion::ArcCcw;
+        if (tcpSource_ == TcpSource::FanucVector && !arcMotion) r.vectorWord = {{static_cast<int8_t>(ijk[0]),
+                                                                                 static_cast<int8_t>(ijk[1]),
+                                                                                 static_cast<int8_t>(ijk[2])}};
+        const bool anyVector = r.vectorWord[0] >= 0 || r.vectorWord[1] >= 0 || r.vectorWord[2] >= 0;
+        if (tcpSource_ == TcpSource::FanucVector || anyVector) {
+            r.mode = ProgramMode::TcpVector;
+            for (int a = 0; a < layout_.count; ++a)
+                if (layout_.rotary[a] && (r.words & (1u << a))) {
+                    passThrough(r, "tool vector and rotary axis words in one block", 0);
+                    unknownAll(r);
+                    return;
+                }
+            if (anyVector) {
+                r.vectorGiven = true;
+                for (int k = 0; k < 3; ++k) {
+                    r.vector[k] = 0.0;
+                    if (r.vectorWord[k] < 0) continue;
+                    const Word& w = b.words[r.vectorWord[k]];
+                    if (w.kind != ValueKind::Number) {
+                        passThrough(r, "tool vector component is not a plain number", 0);
+                        unknownAll(r);
+                        return;
+                    }
+                    r.vector[k] = wordValue(w);
+                }
+                if (!(std::hypot(r.vector[0], r.vector[1], r.vector[2]) > 0)) {
+                    passThrough(r, "tool vector of length zero", 0);
+                    unknownAll(r);
+                    return;
+                }
+            }
+        }
+    }
     // --- Motion --------------------------------------------------------------------------------------------
     const bool isArc = motion_ == Motion::ArcCw || motion_ == Motion::ArcCcw;
-    if (r.words == 0 && !(isArc && arcWords && !onlyModal && !cycleActive_ && !machineCoordinates)) {
+    if (r.words == 0 && !r.vectorGiven && !(isArc && arcWords && !onlyModal && !cycleActive_ && !machineCoordinates)) {
         if (foreignAxis) {
             passThrough(r, "axis letter that this machine does not have", 0);
             r.reasonLetter = foreignAxis;
@@ -943,8 +1059,10 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         commit(r);
         return;
     }
-    if (tcp_) {
-        passThrough(r, "tool-tip programming (G43.4/G43.5/TRAORI) active: not corrected", 0);
+    if (r.modeSwitch) {
+        // Moves of the block that switches tool-tip programming (Fanuc: tool length compensation only) are not
+        // corrected; where they end in the new mode is not known here.
+        passThrough(r, "move in the block that switches tool-tip programming on or off: not corrected", 0);
         unknownAll(r);
         return;
     }

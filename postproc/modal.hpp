@@ -38,6 +38,12 @@ struct AxisLayout {
 };
 
 enum class Motion : uint8_t { Unknown, Rapid, Linear, ArcCw, ArcCcw, Cycle, Other };
+
+/// How the controller reads a block's positions: machine coordinates (joints), or in tool-centre-point (TCP) mode the
+/// tool point in its world frame with the orientation as rotary angles or as a tool vector (postproc/tcp_model.hpp).
+enum class ProgramMode : uint8_t { Joints, TcpAngles, TcpVector };
+/// Which tool-centre-point function a TCP mode came from (how the vector is written, how it was switched on).
+enum class TcpSource : uint8_t { None, FanucAngles, FanucVector, Sinumerik, UserSwitch };
 enum class FeedMode : uint8_t { PerMinute, InverseTime, PerRevolution };
 
 struct ArcGeometry {
@@ -80,6 +86,13 @@ struct BlockResult {
     double feed = 0.0;                ///< F in effect (program units)
     int feedWord = -1;                ///< index of the block's F word
     double tipLength = 0.0;           ///< mm: active tool length (tool point along the tool direction)
+    ProgramMode mode = ProgramMode::Joints;  ///< how this block's positions are read (start and end)
+    TcpSource tcpSource = TcpSource::None;
+    double controlLength = 0.0;       ///< mm, TCP: the controller's tool length (the programmed point is there)
+    bool modeSwitch = false;          ///< the TCP mode changes with this block (after its motion); `mode` is the new one
+    std::array<int8_t, 3> vectorWord{{-1, -1, -1}};  ///< TcpVector: word of each vector component (I J K / A3 B3 C3)
+    bool vectorGiven = false;         ///< TcpVector: the block programs the tool vector (else it is kept)
+    std::array<double, 3> vector{};   ///< TcpVector: programmed vector (world, tip → spindle as written; not unit)
     bool stop = false;                ///< M0 M1 M2 M30 M60: the block's motion is not split
     bool rapidIsFeed = false;         ///< printers: G0 is a straight feed move
     bool absolute = true;
@@ -105,6 +118,8 @@ struct InterpreterOptions {
     Dialect dialect = Dialect::Rs274ngc;
     Setup setup;
     bool rotaryShortest = false;  ///< modulo rotary axes: absolute positions in [0, 360) reached the shortest way
+    int tcpOnM = -1;              ///< M code that switches tool-tip programming (angles) on, e.g. 428; -1 none
+    int tcpOffM = -1;             ///< M code that switches it off, e.g. 429
 };
 
 class Interpreter {
@@ -116,7 +131,18 @@ public:
     void interpret(std::string_view line, const LexedBlock& block, BlockResult& result);
     /// A line the caller could not lex (overlong): everything becomes unknown.
     void forgetAll(BlockResult& result, const char* reason);
+    /// A line the caller could not lex because it is longer than its buffer (gathered in `line`): the axes it names
+    /// become unknown; when it holds G/M/O … codes or anything but plain words, every position and the motion mode
+    /// do. Returns true in that second case. Comment-only lines change nothing (call only when line.code).
+    bool forgetOverlong(const OverlongLine& line, BlockResult& result);
 
+    /// Position after a change of TCP mode, converted by the caller (the interpreter knows no kinematics).
+    void setPosition(const AxisVector& p, AxisMask known) {
+        pos_ = p;
+        known_ = known;
+        assumed_ &= known;
+    }
+    ProgramMode mode() const { return mode_; }
     const AxisLayout& layout() const { return layout_; }
     const AxisVector& position() const { return pos_; }
     AxisMask known() const { return known_; }
@@ -156,7 +182,9 @@ private:
     int tloSign_ = 0;                ///< 0 none, +1 G43, -1 G44
     double tloLength_ = 0.0;         ///< mm
     bool tloKnown_ = true;
-    bool tcp_ = false, transform_ = false, modalMacro_ = false, cutterComp_ = false;
+    ProgramMode mode_ = ProgramMode::Joints;  ///< TCP mode (TcpVector: Fanuc G43.5; Sinumerik vectors are per block)
+    TcpSource tcpSource_ = TcpSource::None;
+    bool transform_ = false, modalMacro_ = false, cutterComp_ = false;
     AxisVector local_;               ///< G52 local offset (machine units)
     AxisMask g92Unknown_ = 0;        ///< axes under a position-dependent G92 / G50 offset
     std::vector<std::pair<int, AxisVector>> offsets_;  ///< work offsets from the setup and G10 L2

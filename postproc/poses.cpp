@@ -19,27 +19,39 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
     checkTextHead(head, options.inputName);
     s.dialect = options.dialect ? *options.dialect : detectDialect(head).dialect;
     if (s.dialect == Dialect::Heidenhain) return writeKlartextPoses(layout, reader, csv, options);
-    Interpreter interp(layout, InterpreterOptions{s.dialect, options.setup, options.rotaryShortest});
+    Interpreter interp(layout, InterpreterOptions{s.dialect, options.setup, options.rotaryShortest, options.tcpOnM,
+                                                  options.tcpOffM});
     OutputBuffer out(csv);
     out.write("line,motion,X,Y,Z,A,B,C\n");
     LexedBlock b;
     BlockResult r;
     Line line;
-    uint64_t no = 0;
-    bool inLong = false;
+    OverlongLine overlong;
     static constexpr char kColumns[] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
     fmt::memory_buffer row;
     while (reader.next(line)) {
-        ++no;
-        ++s.lines;
+        const uint64_t no = line.number;
+        if (line.firstPiece) ++s.lines;
         if (line.partial) {
-            if (!inLong) interp.forgetAll(r, "line longer than the read buffer");
-            inLong = line.eol.empty();
+            // The same rule as `correct`: an overlong line forgets what it may change, nothing more.
+            if (line.firstPiece) overlong.reset();
+            overlong.feed(line.text);
+            if (line.lastPiece && overlong.code) {
+                ++s.passedThrough;
+                interp.forgetOverlong(overlong, r);
+            }
             continue;
         }
-        inLong = false;
         lexBlock(line.text, s.dialect, b, no == 1);
         interp.interpret(line.text, b, r);
+        if (r.modeSwitch) {
+            // Without the machine's kinematics the position cannot be carried into the other mode: rotary angles are
+            // the same numbers in both, the linear positions are unknown until the program names them.
+            AxisMask rotary = 0;
+            for (int a = 0; a < layout.count; ++a)
+                if (layout.rotary[a]) rotary |= 1u << a;
+            interp.setPosition(interp.position(), interp.known() & rotary);
+        }
         const bool moveRow = r.kind == BlockKind::Move;
         if (r.kind == BlockKind::PassThrough) ++s.passedThrough;
         if (!moveRow && !(r.kind == BlockKind::PassThrough && r.words)) continue;
@@ -49,7 +61,7 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
         const char* motion = "-";
         if (moveRow) motion = r.motion == Motion::Rapid ? "G0" : r.motion == Motion::Linear ? "G1" : r.motion == Motion::ArcCw ? "G2" : "G3";
         if (r.machineCoordinates) motion = "G53";
-        fmt::format_to(std::back_inserter(row), "{},{}", no, motion);
+        fmt::format_to(std::back_inserter(row), "{},{}{}", no, motion, moveRow && r.mode != ProgramMode::Joints ? " TCP" : "");
         for (char c : kColumns) {
             const int a = layout.axis(c);
             if (a < 0 || !(r.endKnown & (1u << a))) {

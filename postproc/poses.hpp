@@ -17,6 +17,7 @@ struct PosesOptions {
     bool rotaryShortest = false;
     std::string inputName = "<input>";
     size_t bufferSize = size_t{1} << 20;
+    int tcpOnM = -1, tcpOffM = -1;   ///< user-declared tool-tip programming switches (e.g. M428 / M429)
 };
 
 struct PosesSummary {
@@ -25,7 +26,9 @@ struct PosesSummary {
 };
 
 /// Writes the CSV (header first). One row per evaluated G0–G3 move (motion "G0" … "G3") and per block that moves
-/// axes without being evaluable (motion "-": a G53 move, a canned cycle, a move with an expression …).
+/// axes without being evaluable (motion "-": a G53 move, a canned cycle, a move with an expression …). Moves in
+/// tool-tip (TCP) mode are labelled "G1 TCP" …: their X Y Z are the programmed tool point (world frame, work offset
+/// applied), not machine coordinates.
 PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream& csv, const PosesOptions& options);
 
 }  // namespace cnccomp::pp

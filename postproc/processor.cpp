@@ -55,6 +55,16 @@ const char* warningText(Warning w) {
 
 double circular(double d) { return d - 360.0 * std::round(d / 360.0); }
 
+/// How the words of one block are spaced and aligned, so that words added to it (or lines added after it) look like
+/// its own: the white space between words, between a letter and its number, and whether positive numbers take the
+/// place of a minus sign ("X  16.339  Y -25.409").
+struct BlockStyle {
+    std::array<char, 8> sep{};
+    size_t sepLen = 0;
+    int valueGap = 0;      ///< spaces between the letter and the number of the block's last axis word
+    bool anchorNeg = false;
+};
+
 class ProgramCorrector {
 public:
     ProgramCorrector(const MachineModel& m, const DeviationSet& d, const CorrectOptions& o, Dialect dialect,
@@ -63,37 +73,52 @@ public:
           options_(o),
           dialect_(dialect),
           layout_(AxisLayout::fromMachine(m)),
-          interp_(layout_, InterpreterOptions{dialect, o.setup, o.rotaryShortest}),
+          interp_(layout_, InterpreterOptions{dialect, o.setup, o.rotaryShortest, o.tcpOnM, o.tcpOffM}),
           corrector_(m, d, o.corrector),
           summary_(s),
           out_(out) {
-        outPos_ = AxisVector::Zero(layout_.count);
-        lastDelta_ = AxisVector::Zero(layout_.count);
-        qEnd_ = AxisVector::Zero(layout_.count);
+        const int n = layout_.count;
+        outPos_ = AxisVector::Zero(n);
+        lastDelta_ = AxisVector::Zero(n);
         pieces_.reserve(static_cast<size_t>(o.corrector.maxPieces) + 4);
         all_ = layout_.all();
+        for (int a = 0; a < n; ++a) {
+            if (layout_.rotary[a]) ++rotaryCount_;
+            else ++linearCount_;
+        }
     }
 
-    void line(const Line& ln, uint64_t no);
+    void line(const Line& ln);
 
 private:
     void notice(bool warning, uint64_t line, std::string message);
-    void updateStyles(const LexedBlock& b);
+    void overlong(uint64_t no);
+    void updateStyles(const LexedBlock& b, std::string_view text);
+    void blockStyle(std::string_view text);
     void warnings(uint64_t no);
     void passThrough(const Line& ln, uint64_t no);
     void move(const Line& ln, uint64_t no);
+    void switchMode();
     void updateOutputAfterPassThrough();
+    double toleranceFor(const MoveSpace& space, uint64_t no);
+    void checkTravel(const AxisVector& cNom, const AxisVector& c, uint64_t no);
     // Text helpers.
     int decimalsFor(char letter, bool rotary) const;
     NumberStyle styleFor(char letter, bool rotary, const Word* original, bool& increments) const;
     size_t number(char letter, bool rotary, double programValue, const Word* original, char* out, double& readBack,
                   double& resolution) const;
     size_t motionText(Motion m, char* out) const;
-    char sep() const { return b_.spaced ? ' ' : '\0'; }
     char letterCase(char c) const { return b_.lowerCase ? static_cast<char>(c | 0x20) : c; }
-    /// Word needed for axis a to reach q (machine)? Writes "A1.234" into text (len) and updates the output
-    /// position. `existing` is the word index in the block (piece 1) or -1.
+    /// A new word "X  -1.25" in the block's style (separator first when `separated`).
+    size_t composeWord(char letter, const char* num, size_t n, int ext, bool separated, char* out) const;
+    /// Replaces a word's number, keeping a sign-aligned column aligned.
+    void replaceNumber(const Word& w, const char* num, size_t n);
+    /// Word needed for axis a to reach q (program space)? Writes the number (replace) or a new word into text (len)
+    /// and updates the output position. `existing` is the word index in the block (piece 1) or -1.
     bool axisWord(int a, double q, int existing, char* text, size_t& len, bool& replace);
+    /// Vector words (I J K / A3= B3= C3=) for the tool vector v (world, spindle → tip): replaced in place on the
+    /// block (onBlock) or appended to `buf`.
+    void vectorWords(const Vec3& v, bool onBlock, char* buf, size_t& used);
     bool insertMotionWord(Motion m);
     size_t arcWords(const ArcFit& fit, const AxisVector& outStart, uint32_t insertPos);
 
@@ -108,15 +133,43 @@ private:
     LexedBlock b_;
     BlockResult r_;
     BlockEdits edits_;
+    BlockStyle style_;
     std::array<LetterStyle, 26> styles_{};
+    LetterStyle vectorStyle_;
     bool gPadded_ = false;
     bool fixedProgram_ = false;  ///< some dimension word keeps trailing zeros: write fixed decimals everywhere
-    AxisVector outPos_, lastDelta_, qEnd_;
+    bool alignSign_ = false;     ///< positive numbers take one more space than negative ones ("X  1.0  Y -2.0")
+    std::array<char, 8> programSep_{{' '}};  ///< separator of the last block with two words or more
+    size_t programSepLen_ = 1;
+    std::string_view lineText_;  ///< the current block's text
+    bool sawNegative_ = false;
+    // Output program: position in program space as written (read back from the written digits), tool vector, joints.
+    AxisVector outPos_;
     AxisMask outKnown_ = 0, all_ = 0;
+    Vec3 outVector_ = Vec3(0, 0, -1);  ///< tool vector as written (vector mode), world, spindle → tip
+    bool outVectorKnown_ = false;
+    /// Where the nominal program and the output program are (unrounded), in the space they were read in; machine
+    /// coordinates and the tool vector there are computed when needed.
+    struct Where {
+        bool known = false;
+        MoveSpace space;
+        ProgramPoint point;
+        AxisVector joints;
+        bool jointsValid = false;
+        Vec3 vector = Vec3(0, 0, -1);
+        bool vectorValid = false;
+    };
+    Where nomAt_, outAt_;
+    bool jointsOf(Where& w, const AxisVector& guess);
+    bool vectorOf(Where& w, const AxisVector& guess);
+    AxisVector lastDelta_;
+    bool haveDelta_ = false;     ///< lastDelta_ is the correction at the previous end point (continuity)
+    bool offCourse_ = true;      ///< the output's position is not the corrected nominal one (start, after pass-through)
     Motion outMotion_ = Motion::Unknown;
     std::vector<Piece> pieces_;
-    bool inLong_ = false;
-    bool warnedDecimals_ = false;
+    OverlongLine long_;
+    int linearCount_ = 0, rotaryCount_ = 0;
+    bool warnedCr_ = false, warnedTolerance_ = false;
     std::string lastEol_ = "\n";
 };
 
@@ -132,11 +185,11 @@ void ProgramCorrector::notice(bool warning, uint64_t line, std::string message) 
     if (list.size() < CorrectSummary::kMaxNotices) list.push_back({line, std::move(message)});
 }
 
-void ProgramCorrector::updateStyles(const LexedBlock& b) {
+void ProgramCorrector::updateStyles(const LexedBlock& b, std::string_view text) {
     for (int i = 0; i < b.count; ++i) {
         const Word& w = b.words[i];
         if (w.kind != ValueKind::Number) continue;
-        LetterStyle& s = styles_[w.letter - 'A'];
+        LetterStyle& s = w.ext ? vectorStyle_ : styles_[w.letter - 'A'];
         if (w.point) {
             s.sawPoint = true;
             if (w.decimals > s.maxDecimals) s.maxDecimals = w.decimals;
@@ -151,6 +204,90 @@ void ProgramCorrector::updateStyles(const LexedBlock& b) {
         }
         if (w.letter == 'G' && w.digitsBefore == 2 && w.value < 10) gPadded_ = true;
     }
+    // A sign column ("X  1.0  Y -2.0"): in a block, a positive number has one space more than a negative one; before
+    // any negative number is seen, two spaces or more before a positive one. Words without spaces say nothing.
+    int pos = -1, neg = -1;
+    for (int i = 0; i < b.count; ++i) {
+        const Word& w = b.words[i];
+        if (w.kind != ValueKind::Number || w.ext || layout_.axis(w.letter) < 0) continue;
+        const int gap = static_cast<int>(w.valueBegin - w.begin) - 1;
+        if (gap <= 0 && text[w.valueBegin] != '-') continue;
+        (text[w.valueBegin] == '-' ? neg : pos) = gap;
+    }
+    if (pos >= 0 && neg >= 0) {
+        alignSign_ = pos == neg + 1;
+        sawNegative_ = true;
+    } else if (neg >= 0) {
+        sawNegative_ = true;
+    } else if (pos >= 0 && !sawNegative_) {
+        alignSign_ = pos >= 2;
+    }
+}
+
+void ProgramCorrector::blockStyle(std::string_view text) {
+    // Anchor: the last axis word of the block, else its last word.
+    int anchor = -1;
+    for (int i = 0; i < b_.count; ++i)
+        if (layout_.axis(b_.words[i].letter) >= 0 && !b_.words[i].ext) anchor = i;
+    if (anchor < 0) anchor = b_.count - 1;
+    style_ = BlockStyle{};
+    auto setSep = [&](std::string_view ws) {
+        style_.sepLen = std::min(ws.size(), style_.sep.size());
+        std::copy_n(ws.begin(), style_.sepLen, style_.sep.begin());
+    };
+    setSep(std::string_view(programSep_.data(), programSepLen_));
+    if (anchor < 0) return;
+    const Word& w = b_.words[anchor];
+    style_.valueGap = static_cast<int>(w.valueBegin - w.begin) - 1;
+    style_.anchorNeg = w.valueBegin < text.size() && text[w.valueBegin] == '-';
+    if (anchor == 0) return;  // no word before it: the program's usual separator
+    // The white space between the anchor and the token before it is this block's separator (and the program's).
+    size_t a = w.begin;
+    while (a > 0 && (text[a - 1] == ' ' || text[a - 1] == '\t')) --a;
+    setSep(text.substr(a, w.begin - a));
+    programSepLen_ = style_.sepLen;
+    programSep_ = style_.sep;
+}
+
+size_t ProgramCorrector::composeWord(char letter, const char* num, size_t n, int ext, bool separated, char* out) const {
+    size_t len = 0;
+    if (separated)
+        for (size_t k = 0; k < style_.sepLen; ++k) out[len++] = style_.sep[k];
+    out[len++] = letterCase(letter);
+    if (ext) {
+        out[len++] = static_cast<char>('0' + ext);
+        out[len++] = '=';
+    } else {
+        int gap = style_.valueGap;
+        if (alignSign_) {
+            // The sign takes a space of the column; a block that separates letter and number keeps one at least.
+            const int width = gap + (style_.anchorNeg ? 1 : 0);
+            gap = std::max(style_.valueGap > 0 || style_.anchorNeg ? 1 : 0, width - ((n > 0 && num[0] == '-') ? 1 : 0));
+        }
+        for (int k = 0; k < gap && k < 8; ++k) out[len++] = ' ';
+    }
+    std::memcpy(out + len, num, n);
+    return len + n;
+}
+
+void ProgramCorrector::replaceNumber(const Word& w, const char* num, size_t n) {
+    const std::string_view text = lineText_;
+    const bool wasNeg = w.valueBegin < text.size() && text[w.valueBegin] == '-';
+    const bool isNeg = n > 0 && num[0] == '-';
+    if (alignSign_ && !w.ext && wasNeg != isNeg) {
+        if (isNeg && w.valueBegin > w.begin + 1 && text[w.valueBegin - 1] == ' ') {
+            edits_.add(w.valueBegin - 1, w.end, std::string_view(num, n));  // "X  1.0" → "X -1.0"
+            return;
+        }
+        if (!isNeg) {
+            char t[kMaxNumberChars + 2];
+            t[0] = ' ';
+            std::memcpy(t + 1, num, n);
+            edits_.add(w.valueBegin, w.end, std::string_view(t, n + 1));  // "X -1.0" → "X  1.0"
+            return;
+        }
+    }
+    edits_.add(w.valueBegin, w.end, std::string_view(num, n));
 }
 
 void ProgramCorrector::warnings(uint64_t no) {
@@ -256,12 +393,52 @@ bool ProgramCorrector::axisWord(int a, double q, int existing, char* text, size_
         std::memcpy(text, num, n);
         len = n;
     } else {
-        if (sep() && len == 0) text[len++] = ' ';
-        text[len++] = letterCase(layout_.letter[a]);
-        std::memcpy(text + len, num, n);
-        len += n;
+        len = composeWord(layout_.letter[a], num, n, 0, true, text);
     }
     return true;
+}
+
+void ProgramCorrector::vectorWords(const Vec3& v, bool onBlock, char* buf, size_t& used) {
+    // Written vector: tip → spindle (Fanuc I J K, Sinumerik A3 B3 C3), all three components (omitted ones read as 0).
+    const Vec3 w = -v.normalized();
+    const bool sinumerik = r_.tcpSource == TcpSource::Sinumerik;
+    const char letters[3] = {sinumerik ? 'A' : 'I', sinumerik ? 'B' : 'J', sinumerik ? 'C' : 'K'};
+    const int ext = sinumerik ? 3 : 0;
+    NumberStyle st;
+    st.decimals = options_.decimals >= 0 ? options_.decimals : std::max(vectorStyle_.maxDecimals, 7);
+    st.fixed = vectorStyle_.trailingZero;
+    st.bareFraction = vectorStyle_.bare;
+    const double res = std::pow(10.0, -st.decimals);
+    // Unchanged at the written resolution: keep the program's words (or its kept vector).
+    Vec3 given = outVector_;
+    bool anyWord = false;
+    if (onBlock && r_.vectorGiven) {
+        Vec3 g(r_.vector[0], r_.vector[1], r_.vector[2]);
+        given = -g.normalized();
+        anyWord = true;
+    }
+    if (outVectorKnown_ || anyWord) {
+        const Vec3 old = -given;
+        if ((w - old).cwiseAbs().maxCoeff() < 0.5 * res) {
+            outVector_ = given;
+            outVectorKnown_ = true;
+            return;
+        }
+    }
+    Vec3 back;
+    for (int k = 0; k < 3; ++k) {
+        char num[kMaxNumberChars];
+        const size_t n = formatNumber(w[k], st, num);
+        back[k] = roundToStyle(w[k], st);
+        const int wi = onBlock ? r_.vectorWord[k] : -1;
+        if (wi >= 0) {
+            replaceNumber(b_.words[wi], num, n);
+        } else {
+            used += composeWord(letters[k], num, n, ext, true, buf + used);
+        }
+    }
+    outVector_ = -back.normalized();
+    outVectorKnown_ = true;
 }
 
 bool ProgramCorrector::insertMotionWord(Motion m) {
@@ -269,13 +446,17 @@ bool ProgramCorrector::insertMotionWord(Motion m) {
     size_t n = 0;
     const bool lead = b_.count > 0 && b_.words[0].letter == 'N';
     uint32_t pos = lead ? b_.words[0].end : (b_.count > 0 ? b_.words[0].begin : b_.codeEnd);
-    if (lead && sep()) t[n++] = ' ';
+    const bool spaced = style_.sepLen > 0;
+    if (lead && spaced)
+        for (size_t k = 0; k < style_.sepLen; ++k) t[n++] = style_.sep[k];
     n += motionText(m, t + n);
-    if (!lead && sep()) t[n++] = ' ';
+    if (!lead && spaced)
+        for (size_t k = 0; k < style_.sepLen; ++k) t[n++] = style_.sep[k];
     return edits_.add(pos, pos, std::string_view(t, n));
 }
 
 void ProgramCorrector::updateOutputAfterPassThrough() {
+    const bool tcp = r_.mode != ProgramMode::Joints;
     for (int a = 0; a < layout_.count; ++a) {
         const AxisMask bit = 1u << a;
         if (!(r_.endKnown & bit)) {
@@ -290,6 +471,18 @@ void ProgramCorrector::updateOutputAfterPassThrough() {
             outPos_[a] += r_.end[a] - r_.start[a];
         } else {
             outKnown_ &= ~bit;
+        }
+    }
+    // The machine is where the nominal program puts it (joint mode); in TCP mode its joints are not followed.
+    if (r_.words || r_.vectorGiven) {
+        offCourse_ = true;
+        outVectorKnown_ = false;
+        if (tcp) {
+            nomAt_.known = outAt_.known = false;
+        } else {
+            const MoveSpace joints{ProgramMode::Joints, 0.0, r_.tipLength};
+            nomAt_ = Where{(r_.endKnown & all_) == all_, joints, ProgramPoint{r_.end, Vec3(0, 0, -1)}, r_.end, true};
+            outAt_ = Where{(outKnown_ & all_) == all_, joints, ProgramPoint{outPos_, Vec3(0, 0, -1)}, outPos_, true};
         }
     }
 }
@@ -323,6 +516,11 @@ void ProgramCorrector::passThrough(const Line& ln, uint64_t no) {
     if (r_.motionCode) outMotion_ = r_.motion;
     if (restored) outMotion_ = r_.motion;
     updateOutputAfterPassThrough();
+    if (r_.modeSwitch) {
+        // A move in the block that switches TCP mode: positions unknown in the new mode.
+        outKnown_ = 0;
+        nomAt_.known = outAt_.known = outVectorKnown_ = false;
+    }
 }
 
 size_t ProgramCorrector::arcWords(const ArcFit& fit, const AxisVector& outStart, uint32_t insertPos) {
@@ -357,57 +555,216 @@ size_t ProgramCorrector::arcWords(const ArcFit& fit, const AxisVector& outStart,
         if (std::fabs(pv - origPv) < 0.5 * res) continue;
         ++changes;
         if (w) {
-            edits_.add(w->valueBegin, w->end, std::string_view(num, n));
+            replaceNumber(*w, num, n);
         } else {
-            char t[kMaxNumberChars + 4];
-            size_t len = 0;
-            if (sep()) t[len++] = ' ';
-            t[len++] = letterCase(let[k]);
-            std::memcpy(t + len, num, n);
-            len += n;
+            char t[kMaxNumberChars + 16];
+            const size_t len = composeWord(let[k], num, n, 0, true, t);
             edits_.add(insertPos, insertPos, std::string_view(t, len));
         }
     }
     return changes;
 }
 
+double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
+    // The written digits bound what any subdivision can achieve: each end point is off by up to half a digit per
+    // axis (in joint mode a rotary digit moves the tip by its lever arm). A tolerance below that only multiplies
+    // the program; it is raised to the bound, and the summary says so.
+    const double tol = options_.corrector.toleranceMm;
+    int linDecimals = 15, rotDecimals = 15;
+    for (int a = 0; a < layout_.count; ++a) {
+        const int d = decimalsFor(layout_.letter[a], layout_.rotary[a]);
+        const bool fanucInt = r_.integerIncrements && !styles_[layout_.letter[a] - 'A'].sawPoint &&
+                              styles_[layout_.letter[a] - 'A'].sawInteger;
+        const int dd = fanucInt ? static_cast<int>(std::lround(-std::log10(r_.increment))) : d;
+        if (layout_.rotary[a]) rotDecimals = std::min(rotDecimals, dd);
+        else linDecimals = std::min(linDecimals, dd);
+    }
+    const double linStep = std::pow(10.0, -linDecimals) * (r_.inch ? 25.4 : 1.0);
+    double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearCount_, 1)));
+    if (space.mode == ProgramMode::Joints && rotaryCount_ > 0) {
+        // Lever arm of the rotary axes at this pose: the tip's distance from the workpiece origin plus the tool.
+        const double lever = corrector_.nominalTip(r_.end, space.toolLength).norm() + std::fabs(space.toolLength);
+        floor += 0.5 * std::pow(10.0, -rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
+    }
+    if (tol >= floor) return tol;
+    ++summary_.clampedTolerance;
+    summary_.toleranceFloor = std::max(summary_.toleranceFloor, floor);
+    if (!warnedTolerance_) {
+        warnedTolerance_ = true;
+        notice(true, no,
+               fmt::format("--tol-um {:.3g} is below what the written digits can hold here ({:.3g} um with {} decimals): "
+                           "moves are checked against {:.3g} um (--decimals writes more digits)",
+                           tol / kUm, floor / kUm, linDecimals, floor / kUm));
+    }
+    return floor;
+}
+
+void ProgramCorrector::checkTravel(const AxisVector& cNom, const AxisVector& c, uint64_t no) {
+    bool outside = false;
+    for (int a = 0; a < layout_.count; ++a) {
+        const Link& link = machine_.axisLink(a);
+        const double mz = link.machineZero;
+        const double lo = link.min - mz, hi = link.max - mz;  // in the controller's machine coordinates
+        const bool nomOut = cNom[a] < lo - 1e-9 || cNom[a] > hi + 1e-9;
+        const bool corOut = c[a] < lo - 1e-9 || c[a] > hi + 1e-9;
+        if (!nomOut && !corOut) continue;
+        outside = true;
+        const double k = layout_.rotary[a] ? 1.0 / kDeg : 1.0;
+        const char* unit = layout_.rotary[a] ? "deg" : "mm";
+        notice(true, no,
+               fmt::format("axis {} at {:.4f} {} ({}) is outside its travel [{:g}, {:g}] {}: corrected all the same",
+                           layout_.letter[a], (nomOut ? cNom[a] : c[a]) * k, unit,
+                           nomOut ? "as programmed" : "after correction", lo * k, hi * k, unit));
+    }
+    if (outside) ++summary_.outsideTravel;
+}
+
+bool ProgramCorrector::jointsOf(Where& w, const AxisVector& guess) {
+    if (!w.known) return false;
+    if (!w.jointsValid) w.jointsValid = corrector_.toJoints(w.space, w.point, guess, w.joints);
+    return w.jointsValid;
+}
+
+bool ProgramCorrector::vectorOf(Where& w, const AxisVector& guess) {
+    if (!w.known) return false;
+    if (w.vectorValid) return true;
+    if (w.space.mode == ProgramMode::TcpVector) {
+        w.vector = w.point.v;
+    } else {
+        if (!jointsOf(w, guess)) return false;
+        ProgramPoint p;
+        corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, w.space.controlLength, w.space.toolLength}, w.joints, p);
+        w.vector = p.v;
+    }
+    w.vectorValid = true;
+    return true;
+}
+
+void ProgramCorrector::switchMode() {
+    // The controller's position is the same machine; what the program's numbers mean changes (LinuxCNC re-reads the
+    // world position of the new kinematics at the switch: M66 E0 L0 in the M428/M429 remaps).
+    const MoveSpace space{r_.mode, r_.controlLength, r_.tipLength};
+    AxisMask rotary = 0;
+    for (int a = 0; a < layout_.count; ++a)
+        if (layout_.rotary[a]) rotary |= 1u << a;
+    const AxisVector guess = r_.end;
+    auto convert = [&](Where& w) {
+        if (!jointsOf(w, guess)) {
+            w.known = false;
+            return false;
+        }
+        const AxisVector joints = w.joints;
+        w.space = space;
+        corrector_.toProgram(space, joints, w.point);
+        w.joints = joints;
+        w.jointsValid = true;
+        w.vectorValid = false;
+        return true;
+    };
+    if (convert(nomAt_)) {
+        interp_.setPosition(nomAt_.point.p, all_);
+    } else {
+        // Rotary angles are the same numbers in both modes; the linear positions are not known in the new one.
+        interp_.setPosition(interp_.position(), interp_.known() & rotary);
+    }
+    if (convert(outAt_)) {
+        outPos_ = outAt_.point.p;
+        outKnown_ = all_;
+    } else {
+        outKnown_ &= rotary;
+    }
+    outVectorKnown_ = false;
+    offCourse_ = true;
+}
+
 void ProgramCorrector::move(const Line& ln, uint64_t no) {
-    ++summary_.moves;
     const int n = layout_.count;
-    const double L = r_.tipLength;
+    const MoveSpace space{r_.mode, r_.controlLength, r_.tipLength};
+    const bool tcp = space.mode != ProgramMode::Joints;
+    if (tcp && !corrector_.tcp().supported()) {
+        r_.kind = BlockKind::PassThrough;
+        r_.reason = corrector_.tcp().why();
+        r_.report = true;
+        passThrough(ln, no);
+        outKnown_ = 0;
+        return;
+    }
     const bool identity = corrector_.identity();
     const bool isArc = r_.motion == Motion::ArcCw || r_.motion == Motion::ArcCcw;
     const bool isRapid = r_.motion == Motion::Rapid && !r_.rapidIsFeed;
-    const bool outStartKnown = (outKnown_ & all_) == all_;
-    const bool nomStartKnown = (r_.startKnown & all_) == all_;
+    const bool vector = space.mode == ProgramMode::TcpVector;
+    bool outStartKnown = (outKnown_ & all_) == all_;
+    bool nomStartKnown = (r_.startKnown & all_) == all_;
+    const AxisVector guess = nomAt_.known && nomAt_.jointsValid ? nomAt_.joints : r_.end;
 
-    // Corrected end point.
+    // Nominal end point in program space (vector mode: the programmed vector, tip → spindle, or the kept one).
+    ProgramPoint nomEnd, nomStart;
+    nomEnd.p = r_.end;
+    nomStart.p = r_.start;
+    if (vector) {
+        const bool nomVector = nomStartKnown && vectorOf(nomAt_, guess);
+        outStartKnown = outStartKnown && (outVectorKnown_ || vectorOf(outAt_, guess));
+        if (outStartKnown && !outVectorKnown_) {
+            outVector_ = outAt_.vector;
+            outVectorKnown_ = true;
+        }
+        nomStartKnown = nomStartKnown && nomVector;
+        nomStart.v = nomAt_.vector;
+        nomEnd.v = r_.vectorGiven ? Vec3(-r_.vector[0], -r_.vector[1], -r_.vector[2]).normalized() : nomAt_.vector;
+        if (!r_.vectorGiven && !nomVector) {
+            r_.kind = BlockKind::PassThrough;
+            r_.reason = "tool vector not known yet (no I J K / A3 B3 C3 given since TCP was switched on)";
+            r_.report = true;
+            passThrough(ln, no);
+            return;
+        }
+    }
+    ++summary_.moves;
+    if (tcp) ++summary_.tcpMoves;
+
+    // Corrected end point: nominal machine coordinates, the erroneous machine's solution, its program position.
+    AxisVector cNom, cEnd;
+    ProgramPoint qEnd;
+    if (identity && !vector) {
+        cNom = r_.end;  // not the machine coordinates in TCP mode: not used for anything but guesses
+    } else if (!corrector_.toJoints(space, nomEnd, guess, cNom)) {
+        r_.kind = BlockKind::PassThrough;
+        r_.reason = "the controller's TCP kinematics cannot reach this tool vector (no rotary solution)";
+        r_.report = true;
+        --summary_.moves;
+        passThrough(ln, no);
+        return;
+    }
     if (identity) {
-        qEnd_ = r_.end;
+        cEnd = cNom;
+        qEnd = nomEnd;
     } else {
-        const SolveResult s = corrector_.solve(r_.end, L, r_.end + lastDelta_, qEnd_);
+        // Near the previous end point's correction (continuity) and the programmed value.
+        const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd,
+                                               haveDelta_ ? &lastDelta_ : nullptr);
         summary_.maxTipResidual = std::max(summary_.maxTipResidual, s.tipError);
         summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, s.axisError);
         if (!s.converged || !(s.tipError < 1e-5)) {
             ++summary_.unconverged;
             notice(true, no, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
                                          s.tipError / kUm));
-            qEnd_ = r_.end;
+            cEnd = cNom;
+            qEnd = nomEnd;
         } else {
-            lastDelta_ = qEnd_ - r_.end;
+            lastDelta_ = cEnd - cNom;
+            haveDelta_ = true;
+            corrector_.toProgram(space, cEnd, qEnd);
         }
         for (int a = 0; a < n; ++a) {
-            const double d = std::fabs(qEnd_[a] - r_.end[a]);
+            const double d = std::fabs(cEnd[a] - cNom[a]);
             if (layout_.rotary[a]) {
                 if (d > summary_.maxRotaryCorrection) summary_.maxRotaryCorrection = d, summary_.maxRotaryLine = no;
             } else if (d > summary_.maxLinearCorrection) {
                 summary_.maxLinearCorrection = d, summary_.maxLinearLine = no;
             }
-            const Link& link = machine_.axisLink(a);
-            if ((qEnd_[a] < link.min - 1e-9 || qEnd_[a] > link.max + 1e-9) && r_.end[a] >= link.min && r_.end[a] <= link.max)
-                notice(true, no, fmt::format("corrected axis {} command is outside its travel", layout_.letter[a]));
         }
     }
+    if (!(identity && tcp && !vector)) checkTravel(cNom, cEnd, no);
 
     // Pieces.
     pieces_.clear();
@@ -415,43 +772,68 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     bool arcKept = false, arcToLines = false;
     ArcFit fit;
     const AxisVector outStart = outPos_;
+    PathContext ctx;
+    ctx.space = space;
+    ctx.outStart.p = outPos_;
+    ctx.outStart.v = outVector_;
+    ctx.guess = cNom;
+    if (!identity && outStartKnown && nomStartKnown && offCourse_) {
+        // The output starts off the corrected nominal start (a block before it was passed through, or TCP was just
+        // switched on): splitting cannot remove that offset, so it is blended out along the move, not measured.
+        AxisVector c0, cOut;
+        if (corrector_.toJoints(space, nomStart, cNom, c0) && corrector_.toJoints(space, ctx.outStart, cNom, cOut)) {
+            ctx.startOffset = corrector_.actualTip(cOut, space.toolLength) - corrector_.nominalTip(c0, space.toolLength);
+            if (ctx.startOffset.norm() > options_.corrector.toleranceMm) ++summary_.offPathStarts;
+        }
+    }
+    ctx.tolerance = identity ? options_.corrector.toleranceMm : toleranceFor(space, no);
     if (isArc) {
         if (!outStartKnown) {
             r_.reason = "arc from an output position that is not known";
             r_.report = true;
+            --summary_.moves;
             passThrough(ln, no);
             return;
         }
-        const MovePath path = MovePath::arc(r_.start, r_.end, r_.arc);
+        MovePath path = MovePath::arc(r_.start, r_.end, r_.arc);
+        path.vector = vector;
+        path.v0 = nomStart.v;
+        path.v1 = nomEnd.v;
         const bool closed = std::hypot(r_.end[r_.arc.axis0] - r_.start[r_.arc.axis0],
                                        r_.end[r_.arc.axis1] - r_.start[r_.arc.axis1]) < 1e-12;
         if (closed && !identity) {
             // A full circle must end exactly where the controller starts it, digit for digit.
-            qEnd_[r_.arc.axis0] = outStart[r_.arc.axis0];
-            qEnd_[r_.arc.axis1] = outStart[r_.arc.axis1];
+            qEnd.p[r_.arc.axis0] = outStart[r_.arc.axis0];
+            qEnd.p[r_.arc.axis1] = outStart[r_.arc.axis1];
         }
-        fit = corrector_.fitArc(path, outStart, qEnd_, L, closed);
+        fit = corrector_.fitArc(path, ctx, qEnd, closed);
         if (fit.ok || r_.stop) {
             if (!fit.ok)
                 notice(true, no, fmt::format("arc kept although {:.3f} um off the nominal path: the block holds a program stop",
                                              fit.maxDeviation / kUm));
             arcKept = true;
             summary_.maxPathDeviation = std::max(summary_.maxPathDeviation, fit.maxDeviation);
-            pieces_.push_back({1.0, qEnd_});
+            pieces_.push_back({1.0, qEnd});
         } else {
-            corrector_.splitArc(path, outStart, qEnd_, L, pieces_, stats);
+            corrector_.splitArc(path, ctx, qEnd, pieces_, stats);
             arcToLines = true;
             ++summary_.arcsToLines;
         }
     } else {
-        const MovePath path = MovePath::line(r_.start, r_.end);
+        MovePath path = MovePath::line(r_.start, r_.end);
+        path.vector = vector;
+        path.v0 = nomStart.v;
+        path.v1 = nomEnd.v;
         const bool measurable = nomStartKnown && outStartKnown && !identity;
         const bool subdivide = measurable && !isRapid && !r_.stop;
-        if (measurable && !isRapid) corrector_.split(path, outStart, qEnd_, L, subdivide, pieces_, stats);
-        else pieces_.push_back({1.0, qEnd_});
+        if (measurable && !isRapid) corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
+        else pieces_.push_back({1.0, qEnd});
     }
     summary_.maxPathDeviation = std::max(summary_.maxPathDeviation, stats.maxDeviation);
-    if (stats.limited) notice(true, no, fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
+    if (stats.limited) {
+        ++summary_.limited;
+        notice(true, no, fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
+    }
     const bool inverseTime = r_.feedMode == FeedMode::InverseTime;
     if (pieces_.size() > 1 && inverseTime && r_.feedWord < 0)
         notice(true, no, "inverse-time move without F split: the pieces carry no feed");
@@ -471,13 +853,15 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     } else if (outMotion_ != pieceMotion) {
         insertMotionWord(pieceMotion);
     }
-    // Where new words go: after the last axis / centre word, else after the motion word, else at the end of the code.
+    // Where new words go: after the last axis / centre / vector word, else after the motion word, else at the end
+    // of the code.
     uint32_t insertPos = 0;
     bool anchor = false;
     for (int i = 0; i < b_.count; ++i) {
-        const char c = b_.words[i].letter;
-        if (layout_.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R') {
-            insertPos = std::max(insertPos, b_.words[i].end);
+        const Word& w = b_.words[i];
+        const char c = w.letter;
+        if (layout_.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || w.ext) {
+            insertPos = std::max(insertPos, w.end);
             anchor = true;
         }
     }
@@ -485,40 +869,27 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     char text[BlockEdits::kArena / 4];
     size_t textLen = 0;
     static constexpr char kOrder[] = "XYZUVWABC";
-    auto axesOf = [&](const AxisVector& q, bool onBlock, char* buf, size_t& used) {
-        // Existing words in place; missing ones appended in X Y Z U V W A B C order.
-        for (const char* p = kOrder; *p; ++p) {
-            const int a = layout_.axis(*p);
-            if (a < 0) continue;
+    auto axesOf = [&](const ProgramPoint& q, bool onBlock, char* buf, size_t& used) {
+        // Existing words in place; missing ones appended in X Y Z U V W A B C order (vector mode: no rotary words).
+        auto one = [&](int a) {
+            if (vector && layout_.rotary[a]) return;
             const int existing = onBlock ? r_.axisWord[a] : -1;
-            char w[kMaxNumberChars + 4];
+            char w[kMaxNumberChars + 16];
             size_t len = 0;
             bool replace = false;
-            if (!axisWord(a, q[a], existing, w, len, replace)) continue;
+            if (!axisWord(a, q.p[a], existing, w, len, replace)) return;
             if (replace && existing >= 0 && existing < b_.count) {
-                const Word& word = b_.words[static_cast<size_t>(existing)];
-                edits_.add(word.valueBegin, word.end, std::string_view(w, len));
+                replaceNumber(b_.words[static_cast<size_t>(existing)], w, len);
             } else {
                 std::memcpy(buf + used, w, len);
                 used += len;
             }
-        }
-        for (int a = 0; a < n; ++a) {
-            // Axes with letters outside the usual set.
-            if (std::strchr(kOrder, layout_.letter[a])) continue;
-            const int existing = onBlock ? r_.axisWord[a] : -1;
-            char w[kMaxNumberChars + 4];
-            size_t len = 0;
-            bool replace = false;
-            if (!axisWord(a, q[a], existing, w, len, replace)) continue;
-            if (replace && existing >= 0 && existing < b_.count) {
-                const Word& word = b_.words[static_cast<size_t>(existing)];
-                edits_.add(word.valueBegin, word.end, std::string_view(w, len));
-            } else {
-                std::memcpy(buf + used, w, len);
-                used += len;
-            }
-        }
+        };
+        for (const char* p = kOrder; *p; ++p)
+            if (const int a = layout_.axis(*p); a >= 0) one(a);
+        for (int a = 0; a < n; ++a)
+            if (!std::strchr(kOrder, layout_.letter[a])) one(a);  // axes with letters outside the usual set
+        if (vector) vectorWords(q.v, onBlock, buf, used);
     };
     axesOf(pieces_[0].q, true, text, textLen);
     if (arcKept && !identity) arcWords(fit, outStart, insertPos);
@@ -527,7 +898,7 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
             const Word& w = b_.words[i];
             const bool centre = w.letter == 'I' || w.letter == 'J' || w.letter == 'K' || w.letter == 'R' ||
                                 (w.letter == 'P' && dialect_ == Dialect::Rs274ngc);
-            if (!centre) continue;
+            if (!centre || w.ext) continue;
             uint32_t begin = w.begin;
             if (begin > 0 && (ln.text[begin - 1] == ' ' || ln.text[begin - 1] == '\t')) --begin;
             edits_.add(begin, w.end, {});
@@ -548,6 +919,7 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     if (edits_.overflow()) {
         r_.reason = "block too long to rewrite";
         r_.report = true;
+        --summary_.moves;
         passThrough(ln, no);
         return;
     }
@@ -560,7 +932,7 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     }
     if (!ln.eol.empty()) lastEol_.assign(ln.eol);
 
-    // Further pieces: new lines after the block.
+    // Further pieces: new lines after the block, in its style.
     if (pieces_.size() > 1) {
         ++summary_.split;
         summary_.addedLines += pieces_.size() - 1;
@@ -582,9 +954,8 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
             used += motionText(lineMotion, buf);
             axesOf(pieces_[k].q, false, buf, used);
             if (inverseTime && r_.feedWord >= 0) {
-                if (sep()) buf[used++] = ' ';
-                buf[used++] = letterCase('F');
-                used += number('F', false, feedOf(k), &b_.words[r_.feedWord], buf + used, readBack, res);
+                const size_t fn = number('F', false, feedOf(k), &b_.words[r_.feedWord], num, readBack, res);
+                used += composeWord('F', num, fn, 0, true, buf + used);
             }
             out_.write(prefix);
             out_.write(skip);
@@ -593,27 +964,59 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     }
     out_.write(ln.eol);
     outMotion_ = arcToLines ? Motion::Linear : r_.motion;
+    // Where the nominal and the output programs now are.
+    const bool jointsComputed = !identity || vector || !tcp;
+    nomAt_ = Where{true, space, nomEnd, cNom, jointsComputed, nomEnd.v, vector};
+    outAt_ = Where{outStartKnown || (r_.absolute && !isArc), space, pieces_.back().q, cEnd, jointsComputed && !isArc,
+                 pieces_.back().q.v, vector};
+    if (!vector) outVectorKnown_ = false;
+    offCourse_ = false;
 }
 
-void ProgramCorrector::line(const Line& ln, uint64_t no) {
-    if (!ln.partial || !inLong_) ++summary_.lines;  // the pieces of an overlong line count as one line
+void ProgramCorrector::overlong(uint64_t no) {
+    if (!long_.code) return;  // white space and comments only: nothing it could change
+    ++summary_.blocks;
+    ++summary_.passedThrough;
+    const bool modal = interp_.forgetOverlong(long_, r_);
+    std::string axes;
+    for (int a = 0; a < layout_.count; ++a)
+        if (r_.words & (1u << a)) axes.push_back(layout_.letter[a]);
+    if (modal) {
+        outKnown_ = 0;
+        outMotion_ = Motion::Unknown;
+    } else {
+        outKnown_ &= ~r_.words;
+    }
+    if (modal || r_.words) {
+        nomAt_.known = outAt_.known = outVectorKnown_ = false;
+        offCourse_ = true;
+    }
+    notice(false, no,
+           fmt::format("line longer than {} bytes: passed through unparsed; {}", options_.bufferSize,
+                       modal ? "it holds codes that may change any mode: every position is unknown afterwards"
+                             : axes.empty() ? "it names no axis: positions kept"
+                                            : fmt::format("positions of {} unknown afterwards", axes)));
+}
+
+void ProgramCorrector::line(const Line& ln) {
+    const uint64_t no = ln.number;
+    if (ln.firstPiece) ++summary_.lines;  // the pieces of an overlong line count as one line
+    if (ln.eol.size() == 1 && ln.eol[0] == '\r' && !warnedCr_) {
+        warnedCr_ = true;
+        notice(true, no, "lines end with a lone CR (classic Mac OS line ends): read as line ends and kept");
+    }
     if (ln.partial) {
         out_.write(ln.text);
         out_.write(ln.eol);
-        if (!inLong_) {
-            ++summary_.blocks;
-            ++summary_.passedThrough;
-            interp_.forgetAll(r_, "line longer than the read buffer");
-            outKnown_ = 0;
-            outMotion_ = Motion::Unknown;
-            notice(false, no, fmt::format("line longer than {} bytes: passed through unparsed", options_.bufferSize));
-        }
-        inLong_ = ln.eol.empty();
+        if (ln.firstPiece) long_.reset();
+        long_.feed(ln.text);
+        if (ln.lastPiece) overlong(no);
         return;
     }
-    inLong_ = false;
+    lineText_ = ln.text;
     lexBlock(ln.text, dialect_, b_, no == 1);
-    updateStyles(b_);
+    updateStyles(b_, ln.text);
+    if (b_.count > 0) blockStyle(ln.text);
     interp_.interpret(ln.text, b_, r_);
     warnings(no);
     // Axes taken at 0 until commanded are at 0 for the output controller too.
@@ -632,6 +1035,7 @@ void ProgramCorrector::line(const Line& ln, uint64_t no) {
             out_.write(ln.text);
             out_.write(ln.eol);
             if (r_.motionCode) outMotion_ = r_.motion;
+            if (r_.modeSwitch) switchMode();
             return;
         case BlockKind::PassThrough:
             ++summary_.blocks;
@@ -664,10 +1068,9 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     OutputBuffer buffer(out);
     ProgramCorrector pc(machine, deviations, options, s.dialect, s, buffer);
     Line line;
-    uint64_t no = 0;
     while (reader.next(line)) {
-        pc.line(line, ++no);
-        if (options.progress && (no & 0x1fff) == 0) options.progress(reader.bytesConsumed());
+        pc.line(line);
+        if (options.progress && (line.number & 0x1fff) == 0 && line.lastPiece) options.progress(reader.bytesConsumed());
     }
     buffer.flush();
     if (options.progress) options.progress(reader.bytesConsumed());
@@ -691,7 +1094,17 @@ std::string formatSummary(const CorrectSummary& s, size_t maxListed) {
                      s.maxLinearCorrection / kUm, s.maxLinearLine, s.maxRotaryCorrection / kArcsec, s.maxRotaryLine);
     t += fmt::format("largest residual: {:.2g} um at endpoints, {:.3f} um on the path (checked midpoints), tool axis {:.3f} arcsec\n",
                      s.maxTipResidual / kUm, s.maxPathDeviation / kUm, s.maxAxisResidual / kArcsec);
+    if (s.tcpMoves) t += fmt::format("moves in tool-tip (TCP) mode: {}\n", s.tcpMoves);
     if (s.unconverged) t += fmt::format("endpoints not converged (left unchanged): {}\n", s.unconverged);
+    if (s.limited) t += fmt::format("moves over the tolerance after the subdivision limit: {}\n", s.limited);
+    if (s.outsideTravel) t += fmt::format("moves outside the travel of an axis: {} (see the warnings)\n", s.outsideTravel);
+    if (s.clampedTolerance)
+        t += fmt::format("tolerance raised to {:.3g} um on {} moves: the written digits cannot hold less\n",
+                         s.toleranceFloor / kUm, s.clampedTolerance);
+    if (s.offPathStarts)
+        t += fmt::format("moves starting off the nominal path after a block passed through: {} (offset blended out, "
+                         "not split for)\n",
+                         s.offPathStarts);
     if (!s.passThrough.empty()) {
         t += "not evaluated (passed through):\n";
         for (size_t i = 0; i < s.passThrough.size() && i < maxListed; ++i)

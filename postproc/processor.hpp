@@ -26,6 +26,7 @@ struct CorrectOptions {
     std::function<void(uint64_t bytesRead)> progress;  ///< called every few thousand lines
     std::ostream* report = nullptr;  ///< optional CSV "line,kind,message" of every notice (unbounded, streamed)
     size_t bufferSize = size_t{1} << 20;  ///< read buffer: longest line parsed; longer lines pass through
+    int tcpOnM = -1, tcpOffM = -1;   ///< user-declared TCP switches (--tcp-on M428 --tcp-off M429), -1 none
 };
 
 struct Notice {
@@ -55,6 +56,14 @@ struct CorrectSummary {
     double maxAxisResidual = 0;     ///< rad: tool-axis residual at endpoints (non-zero only near singular poses)
     double maxPathDeviation = 0;    ///< mm: at the checked midpoints / arc samples
     uint64_t unconverged = 0;
+    uint64_t limited = 0;           ///< moves where the subdivision limit left the tolerance unmet
+    uint64_t tcpMoves = 0;          ///< moves corrected in tool-tip (TCP) mode
+    uint64_t outsideTravel = 0;     ///< moves with a nominal or corrected position outside an axis' travel
+    uint64_t clampedTolerance = 0;  ///< moves checked at the output resolution instead of --tol-um (too fine)
+    double toleranceFloor = 0;      ///< mm: largest such resolution bound
+    uint64_t offPathStarts = 0;     ///< moves starting off the nominal path (after a block passed through)
+    /// Blocks left uncorrected that --strict counts: reported pass-through, unconverged or unmet tolerance.
+    uint64_t uncorrected() const { return (passedThrough - notCorrected) + unconverged + limited; }
     std::vector<Notice> passThrough;  ///< first kMaxNotices
     std::vector<Notice> warnings;     ///< first kMaxNotices
     uint64_t warningCount = 0;

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -48,6 +49,14 @@ std::string offsetCodeName(int code) {
     if (code >= 100000) return fmt::format("G54.1 P{}", code - 100000);
     if (code % 10 == 0) return fmt::format("G{}", code / 10);
     return fmt::format("G{}.{}", code / 10, code % 10);
+}
+
+std::optional<int> parseMCode(std::string_view text) {
+    text = trim(text);
+    if (!text.empty() && (text[0] == 'M' || text[0] == 'm')) text.remove_prefix(1);
+    const auto v = parseNumber(text);
+    if (!v || *v < 0 || *v > 99999 || *v != std::floor(*v)) return std::nullopt;
+    return static_cast<int>(*v);
 }
 
 const WorkOffset* Setup::offset(int code) const {
@@ -165,6 +174,45 @@ void Setup::readFile(const std::string& path) {
             throw InputError(path, lineNo,
                              fmt::format("expected 'work-offset G54=x,y,z', 'tool-length [Hn=]L', 'assume Y=0' or 'units mm|inch', got '{}'", key));
     }
+}
+
+void Setup::readToolTable(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "cannot open the tool table");
+    std::string text;
+    int lineNo = 0, tools = 0;
+    while (std::getline(in, text)) {
+        ++lineNo;
+        std::string_view l = text;
+        const size_t semi = l.find(';');
+        if (semi != std::string_view::npos) l = l.substr(0, semi);
+        l = trim(l);
+        if (l.empty()) continue;
+        int tool = -1;
+        std::optional<double> z;
+        while (!l.empty()) {
+            const size_t sp = l.find_first_of(" \t");
+            const std::string_view word = l.substr(0, sp);
+            l = sp == std::string_view::npos ? std::string_view{} : trim(l.substr(sp));
+            const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
+            const auto v = parseNumber(word.substr(1));
+            if (std::string_view("TPXYZABCUVWDIJQ").find(letter) == std::string_view::npos || !v || !std::isfinite(*v))
+                throw InputError(path, lineNo,
+                                 fmt::format("expected tool table words T P X Y Z A B C U V W D I J Q with numbers "
+                                             "(LinuxCNC format, e.g. 'T1 P1 Z12.5 D6 ;comment'), got '{}'",
+                                             word));
+            if (letter == 'T') {
+                if (*v < 0 || *v > 99999 || *v != std::floor(*v))
+                    throw InputError(path, lineNo, fmt::format("tool number '{}' is not a whole number", word));
+                tool = static_cast<int>(*v);
+            }
+            if (letter == 'Z') z = *v;
+        }
+        if (tool < 0) throw InputError(path, lineNo, "a tool table line without a T word");
+        addToolLength(fmt::format("T{}={}", tool, z ? *z : 0.0), path, lineNo);
+        ++tools;
+    }
+    if (tools == 0) throw InputError(path, 0, "the tool table lists no tools");
 }
 
 }  // namespace cnccomp::pp

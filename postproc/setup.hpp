@@ -15,6 +15,8 @@ int offsetCodeOfG(double gValue, int pValue = 0);
 /// "G54", "G59.1", "G54.1P3" / "G54.1 P3", "G505"; nullopt when not a work offset name.
 std::optional<int> parseOffsetCode(std::string_view name);
 std::string offsetCodeName(int code);
+/// "M428" / "m428" / "428" → 428; nullopt when not a whole M number 0..99999.
+std::optional<int> parseMCode(std::string_view text);
 
 struct WorkOffset {
     int code = 540;
@@ -42,6 +44,10 @@ struct Setup {
     /// Setup file: lines "work-offset G54=…", "tool-length H3=…", "assume Y=0", "units inch|mm"; '#' comments.
     /// Throws InputError.
     void readFile(const std::string& path);
+    /// LinuxCNC tool table (docs: "Tool Table Format"): one tool a line, "T1 P1 Z12.5 D6 ;comment", words T (tool
+    /// number) P (pocket) X Y Z A B C U V W (offsets) D (diameter) I J Q (lathe); the Z offset becomes the length of
+    /// tool n for G43 / G43 Hn (LinuxCNC's H is the tool number). Throws InputError naming file and line.
+    void readToolTable(const std::string& path);
 };
 
 }  // namespace cnccomp::pp

@@ -55,6 +55,34 @@ TEST(PostprocCli, PosesPrintsMachineCoordinates) {
     EXPECT_NE(csv.find("2,G0,25.400000,50.800000,12.700000,,0.000000,0.000000\n"), std::string::npos) << csv;
 }
 
+TEST(PostprocCli, PosesLabelToolTipMovesAndForgetSlidesAtAModeSwitch) {
+    test::ScratchDir dir("pp-poses-tcp");
+    test::writeText(dir.file("p.ngc"), "G21 G90\nG0 X1 Y2 Z3 A0 C0\nM428\nG1 X2 Y2 Z3 A-10 C5 F100\nM429\nG1 X3\n");
+    const auto r = test::runCli("poses --in " + dir.file("p.ngc") + " --tcp-on M428 --tcp-off M429");
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_EQ(r.out,
+              "line,motion,X,Y,Z,A,B,C\n"
+              "2,G0,1.000000,2.000000,3.000000,0.000000,0.000000,0.000000\n"
+              "4,G1 TCP,2.000000,2.000000,3.000000,-10.000000,0.000000,5.000000\n"
+              "6,-,3.000000,,,-10.000000,0.000000,5.000000\n");
+    const auto bad = test::runCli("poses --in " + dir.file("p.ngc") + " --tcp-on Q428");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.out.find("--tcp-on"), std::string::npos) << bad.out;
+}
+
+TEST(PostprocCli, ToolTableGivesToolLengths) {
+    test::ScratchDir dir("pp-tooltable");
+    test::writeText(dir.file("t.tbl"), "T1 P1 Z0 D1 ;end mill\nT2 P2 Z15 D8 ;end mill\nT10 P10 D0.5\n");
+    test::writeText(dir.file("p.ngc"), "G21 G90 G43 H2\nG0 X1 Y0 Z5\n");
+    const auto r = test::runCli("poses --in " + dir.file("p.ngc") + " --tool-table " + dir.file("t.tbl"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("2,G0,1.000000,0.000000,20.000000"), std::string::npos) << r.out;
+    test::writeText(dir.file("bad.tbl"), "T1 P1 Z0\nT2 P2 Zfifteen\n");
+    const auto bad = test::runCli("poses --in " + dir.file("p.ngc") + " --tool-table " + dir.file("bad.tbl"));
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.out.find("bad.tbl:2"), std::string::npos) << bad.out;
+}
+
 TEST(PostprocCli, SetupFileGivesOffsetsToolLengthsAndAssumedAxes) {
     test::ScratchDir dir("pp-setup");
     test::writeText(dir.file("setup.txt"),

@@ -6,6 +6,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "postproc/dialect.hpp"
 #include "postproc/lexer.hpp"
@@ -194,6 +196,52 @@ TEST(PostprocLineReader, KeepsLineEndingsAndSplitsOverlongLines) {
     }
     EXPECT_EQ(rebuilt, longLine);
     EXPECT_GE(partial, 7);
+}
+
+TEST(PostprocLineReader, LoneCarriageReturnsEndLinesAndPiecesShareTheirLineNumber) {
+    // Every split of "\r\n" across the buffer edge (buffer 16) is tried by shifting the data one byte at a time.
+    for (size_t pad = 0; pad < 20; ++pad) {
+        const std::string data = std::string(pad, ' ') + "G0 X1\rG1 Y2\r\nG1 Z3\n" + std::string(40, 'x') + "\rend";
+        std::istringstream in(data);
+        LineReader r(in, 16);
+        Line l;
+        std::string rebuilt;
+        std::vector<std::pair<uint64_t, std::string>> eols;
+        while (r.next(l)) {
+            rebuilt.append(l.text).append(l.eol);
+            if (l.lastPiece) eols.emplace_back(l.number, std::string(l.eol));
+            if (l.partial) {
+                EXPECT_TRUE(l.number == 4 || (l.number == 1 && pad + 5 >= 15)) << l.number;  // 15 + "\r" fill the buffer
+            }
+        }
+        EXPECT_EQ(rebuilt, data) << pad;
+        ASSERT_EQ(eols.size(), 5u) << pad;
+        EXPECT_EQ(eols[0], std::make_pair(uint64_t{1}, std::string("\r")));
+        EXPECT_EQ(eols[1], std::make_pair(uint64_t{2}, std::string("\r\n")));
+        EXPECT_EQ(eols[2], std::make_pair(uint64_t{3}, std::string("\n")));
+        EXPECT_EQ(eols[3], std::make_pair(uint64_t{4}, std::string("\r")));
+        EXPECT_EQ(eols[4], std::make_pair(uint64_t{5}, std::string()));
+        EXPECT_EQ(r.crOnlyEndings(), 2u);
+    }
+}
+
+TEST(PostprocLineReader, OverlongLineScannerSkipsCommentsAndCollectsWordLetters) {
+    OverlongLine o;
+    o.feed("(comment X1 G0");
+    o.feed(" still comment) ");
+    EXPECT_FALSE(o.code);
+    o.feed("X5 Y-2.5 ; G0 Z1");
+    o.feed(" B7");  // after ';': comment
+    EXPECT_TRUE(o.code);
+    EXPECT_TRUE(o.has('X') && o.has('Y'));
+    EXPECT_FALSE(o.has('G') || o.has('Z') || o.has('B'));
+    EXPECT_FALSE(o.other);
+    o.reset();
+    o.feed("GOTO1");
+    EXPECT_TRUE(o.other);  // a keyword
+    o.reset();
+    o.feed("X#1");
+    EXPECT_TRUE(o.other);
 }
 
 TEST(PostprocDialect, DetectsUnambiguousProgramsOnly) {

@@ -227,8 +227,13 @@ TEST(PostprocModal, SinumerikKeywordsAndTcp) {
         Dialect::Sinumerik);
     EXPECT_EQ(r.blocks[1].kind, BlockKind::NoMotion);
     EXPECT_EQ(r.blocks[2].kind, BlockKind::NoMotion);
-    EXPECT_EQ(r.blocks[4].kind, BlockKind::PassThrough);
+    EXPECT_TRUE(r.blocks[3].modeSwitch);
+    EXPECT_EQ(r.blocks[3].mode, ProgramMode::TcpAngles);
+    EXPECT_EQ(r.blocks[4].kind, BlockKind::Move);  // tool-tip programming: read in TCP mode
+    EXPECT_EQ(r.blocks[4].mode, ProgramMode::TcpAngles);
+    EXPECT_TRUE(r.blocks[5].modeSwitch);
     EXPECT_EQ(r.blocks[6].kind, BlockKind::Move);
+    EXPECT_EQ(r.blocks[6].mode, ProgramMode::Joints);
     EXPECT_EQ(r.blocks[7].kind, BlockKind::PassThrough);
     EXPECT_EQ(r.blocks[8].kind, BlockKind::PassThrough);
 }

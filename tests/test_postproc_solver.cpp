@@ -56,12 +56,16 @@ TEST_P(PostprocSolver, AgreesWithSolveToolPoseAwayFromSingularities) {
         EXPECT_LT((reached.tip - target.tip).norm(), 1e-6) << "tip, trial " << trial;  // mm
         const IkResult ref = solveToolPose(actual, target, tip, q);
         ASSERT_TRUE(ref.converged);
-        // The tool axis as well as the reference solver meets it, within 3e-7 rad (0.06 arcsec, 36 nm at the 120 mm
-        // tool): the fast corrector settles at up to 1.3e-7 rad, the reference (regularised, then polished) below 1e-11;
-        // on the four-axis head neither can meet it and both give the same least-squares compromise.
-        EXPECT_LT((reached.axis - target.axis).norm(), ref.axisError + 3e-7) << "axis, trial " << trial;  // rad
+        // The tool axis nearly as well as the reference solver (undamped at regular poses, polished) meets it: the
+        // corrector damps rotary corrections (CorrectorOptions::rotaryDamping 5 mm/rad against axisWeight 100 mm/rad, so
+        // that they stay bounded and continuous near singular poses), which leaves about (5 / (100 s))^2 of a rotary
+        // correction undone, s = sine of the angle between the tool axis and that rotary axis: with these 20 arcsec
+        // errors and rotary axes at 20 deg or more, up to 4e-6 rad (0.8 arcsec) of tool axis; the commands differ
+        // accordingly (the tip is exact for both, so the slides follow the rotary difference: < 2 um). On the
+        // four-axis head neither can meet the axis and both give the same least-squares compromise.
+        EXPECT_LT((reached.axis - target.axis).norm(), ref.axisError + 4e-6) << "axis, trial " << trial;  // rad
         for (int i = 0; i < m.axisCount(); ++i)
-            EXPECT_NEAR(qStar[i], ref.q[i], m.axisLink(i).kind == AxisKind::Rotary ? 1e-6 : 1e-4)
+            EXPECT_NEAR(qStar[i], ref.q[i], m.axisLink(i).kind == AxisKind::Rotary ? 1e-5 : 2e-3)
                 << GetParam() << " axis " << m.axisNames[i];
     }
 }
@@ -136,26 +140,34 @@ TEST(PostprocSplit, RotaryMovesAreSplitUntilMidpointsMeetTheTolerance) {
     std::vector<Piece> pieces;
     SplitStats stats;
     const MovePath path = MovePath::line(a, b);
-    corrector.split(path, qa, qb, 100, true, pieces, stats);
+    PathContext ctx;
+    ctx.space.toolLength = 100;
+    ctx.outStart.p = qa;
+    ctx.tolerance = o.toleranceMm;
+    ctx.guess = a;
+    ProgramPoint end;
+    end.p = qb;
+    corrector.split(path, ctx, end, true, pieces, stats);
     ASSERT_GT(pieces.size(), 2u);
     EXPECT_FALSE(stats.limited);
     EXPECT_DOUBLE_EQ(pieces.back().t, 1.0);
     // Independent re-check of every piece's midpoint (and a quarter point, which the splitter never looked at).
-    AxisVector prev = qa, qn;
+    AxisVector prev = qa;
+    ProgramPoint qn;
     double prevT = 0, worst = 0;
     for (const Piece& p : pieces) {
         for (double f : {0.25, 0.5, 0.75}) {
             path.at(prevT + f * (p.t - prevT), qn);
-            worst = std::max(worst, corrector.tipDeviation(qn, prev + f * (p.q - prev), 100));
+            worst = std::max(worst, corrector.tipDeviation(qn.p, prev + f * (p.q.p - prev), 100));
         }
-        prev = p.q;
+        prev = p.q.p;
         prevT = p.t;
     }
     EXPECT_LT(worst, 0.5e-3 * 1.2);
     // Without subdivision the same move is far off.
     std::vector<Piece> one;
     SplitStats single;
-    corrector.split(path, qa, qb, 100, false, one, single);
+    corrector.split(path, ctx, end, false, one, single);
     EXPECT_EQ(one.size(), 1u);
     EXPECT_GT(single.maxDeviation, 2 * 0.5e-3);
 }

@@ -3,8 +3,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -19,20 +21,28 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, deviations, in, out, dialect = "auto", setup, report;
+    std::string machine, deviations, in, out, dialect = "auto", setup, report, toolTable, tcpOn, tcpOff;
     double tolUm = 1.0;
     int decimals = -1;
     std::vector<std::string> workOffsets, toolLengths, assume;
-    bool tipOnly = false, rotaryShortest = false;
+    bool tipOnly = false, rotaryShortest = false, strict = false;
     std::string units;
 };
 
-/// Builds the setup from --setup, --work-offset, --tool-length, --units (shared with `poses`).
-pp::Setup setupOf(const std::string& file, const std::vector<std::string>& offsets,
+int mCodeOption(const std::string& text, const char* option) {
+    if (text.empty()) return -1;
+    const auto m = pp::parseMCode(text);
+    if (!m) throw InputError(option, 0, fmt::format("expected an M code such as M428, got '{}'", text));
+    return *m;
+}
+
+/// Builds the setup from --setup, --tool-table, --work-offset, --tool-length, --units.
+pp::Setup setupOf(const std::string& file, const std::string& toolTable, const std::vector<std::string>& offsets,
                   const std::vector<std::string>& lengths, const std::vector<std::string>& assume,
                   const std::string& units) {
     pp::Setup s;
     if (!file.empty()) s.readFile(file);
+    if (!toolTable.empty()) s.readToolTable(toolTable);
     for (const auto& a : assume) s.addAssumed(a);
     for (const auto& w : offsets) s.addWorkOffset(w);
     for (const auto& l : lengths) s.addToolLength(l);
@@ -50,10 +60,13 @@ std::optional<pp::Dialect> dialectOf(const std::string& name) {
 }
 
 void run(const Options& o) {
+    // Outputs first: a folder, a device or a missing folder as --out / --report fails before any work.
+    checkOutputPath(o.out);
+    if (!o.report.empty()) checkOutputPath(o.report);
     const MachineModel m = readMachineXml(o.machine);
     const DeviationSet d = readDeviationCsv(o.deviations, m);
-    refuseToOverwrite(o.out, {o.in, o.machine, o.deviations, o.setup});
-    if (!o.report.empty()) refuseToOverwrite(o.report, {o.in, o.machine, o.deviations, o.setup, o.out});
+    refuseToOverwrite(o.out, {o.in, o.machine, o.deviations, o.setup, o.toolTable});
+    if (!o.report.empty()) refuseToOverwrite(o.report, {o.in, o.machine, o.deviations, o.setup, o.toolTable, o.out});
     if (std::filesystem::absolute(o.out).lexically_normal() == std::filesystem::absolute(o.in).lexically_normal())
         throw InputError(o.out, 0, "refusing to overwrite the input program");
     if (!(o.tolUm > 0) || !std::isfinite(o.tolUm) || o.tolUm > 1e4)
@@ -61,7 +74,10 @@ void run(const Options& o) {
     if (o.decimals < -1 || o.decimals > 12) throw InputError("--decimals", 0, "decimals must be 0..12");
     pp::CorrectOptions co;
     co.dialect = dialectOf(o.dialect);
-    co.setup = setupOf(o.setup, o.workOffsets, o.toolLengths, o.assume, o.units);
+    co.setup = setupOf(o.setup, o.toolTable, o.workOffsets, o.toolLengths, o.assume, o.units);
+    co.tcpOnM = mCodeOption(o.tcpOn, "--tcp-on");
+    co.tcpOffM = mCodeOption(o.tcpOff, "--tcp-off");
+    if (co.tcpOnM >= 0 && co.tcpOnM == co.tcpOffM) throw InputError("--tcp-off", 0, "the same M code as --tcp-on");
     co.rotaryShortest = o.rotaryShortest;
     co.corrector.toleranceMm = o.tolUm * kUm;
     co.corrector.tipOnly = o.tipOnly;
@@ -80,26 +96,21 @@ void run(const Options& o) {
                          static_cast<int>(100.0 * std::min<double>(1.0, double(done) / double(total))));
             std::fflush(stderr);
         };
-    // The report streams to a temporary file, renamed only when the correction succeeded.
-    std::ofstream report;
-    std::string reportTmp;
+    // Both files are written atomically: temporary files beside the targets, renamed only when the correction succeeded.
+    std::optional<AtomicFile> report;
     if (!o.report.empty()) {
-        reportTmp = o.report + ".tmp" + std::to_string(::getpid());
-        report.open(reportTmp, std::ios::binary | std::ios::trunc);
-        if (!report) throw InputError(o.report, 0, "cannot create the report file");
-        report << "line,kind,message\n";
-        co.report = &report;
+        report.emplace(o.report);
+        report->stream() << "line,kind,message\n";
+        co.report = &report->stream();
     }
     pp::CorrectSummary summary;
     try {
-        writeFileAtomically(o.out, [&](std::ostream& out) { summary = pp::correctProgram(m, d, in, out, co); });
-        if (!o.report.empty()) {
-            report.close();
-            std::filesystem::rename(reportTmp, o.report);
-        }
+        AtomicFile out(o.out);
+        summary = pp::correctProgram(m, d, in, out.stream(), co);
+        out.commit();
+        if (report) report->commit();
     } catch (...) {
         if (bar) std::fprintf(stderr, "\n");
-        if (!reportTmp.empty()) std::filesystem::remove(reportTmp, ec);
         throw;
     }
     if (bar) std::fprintf(stderr, "\r%60s\r", "");
@@ -107,6 +118,15 @@ void run(const Options& o) {
                std::count(d.present.begin(), d.present.end(), 1), d.values.cwiseAbs().maxCoeff() == 0 ? ", all zero" : "",
                o.out);
     fmt::print("{}", pp::formatSummary(summary));
+    if (o.strict && summary.uncorrected() > 0) {
+        // Scripted use: the files are written (and listed above), the exit status says not everything was corrected.
+        fmt::print(stderr, "cnccomp: --strict: {} block(s) left uncorrected (passed through, not converged or over the "
+                           "tolerance); exit status 3\n",
+                   summary.uncorrected());
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::exit(3);
+    }
 }
 
 const RegisterCommand reg([](CLI::App& app) {
@@ -122,6 +142,12 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--decimals", o->decimals, "decimals of changed numbers (default: the program's own, at least 4 in mm and deg, 5 in inch)");
     c->add_option("--work-offset", o->workOffsets, "work offset CODE=x,y,z[,a,b,c] in mm and deg, e.g. G54=100,0,-300 (repeatable)");
     c->add_option("--tool-length", o->toolLengths, "tool length in mm: L (default tool point) or Hn=L for G43 Hn (repeatable)");
+    c->add_option("--tool-table", o->toolTable, "LinuxCNC tool table (T1 P1 Z12.5 ...): tool lengths for G43 / G43 Hn")
+        ->check(CLI::ExistingFile);
+    c->add_option("--tcp-on", o->tcpOn, "M code that switches tool-tip (TCP) programming on, e.g. M428 (LinuxCNC trt remap)");
+    c->add_option("--tcp-off", o->tcpOff, "M code that switches tool-tip programming off, e.g. M429");
+    c->add_flag("--strict", o->strict, "exit status 3 when any block is left uncorrected (passed through, not converged, "
+                                       "tolerance not met)");
     c->add_option("--setup", o->setup, "setup file: lines 'work-offset G54=…', 'tool-length H3=…', 'units mm|inch'")
         ->check(CLI::ExistingFile);
     c->add_option("--assume", o->assume, "positions of axes until the program commands them, e.g. Y=0 (mm, deg; rotary default 0)");

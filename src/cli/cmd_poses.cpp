@@ -1,5 +1,6 @@
 // cnccomp poses: every motion endpoint of a program in absolute machine coordinates (mm, deg), for checking it.
 #include <fstream>
+#include <tuple>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -14,12 +15,13 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, in, out, dialect = "auto", setup, units;
+    std::string machine, in, out, dialect = "auto", setup, units, toolTable, tcpOn, tcpOff;
     std::vector<std::string> workOffsets, toolLengths, assume;
     bool rotaryShortest = false;
 };
 
 void run(const Options& o) {
+    if (!o.out.empty()) checkOutputPath(o.out);  // a folder or a device as --out fails before any work
     pp::PosesOptions po;
     if (o.dialect != "auto") {
         po.dialect = pp::parseDialect(o.dialect);
@@ -27,6 +29,13 @@ void run(const Options& o) {
             throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, rs274ngc, fanuc, sinumerik, printer)", o.dialect));
     }
     if (!o.setup.empty()) po.setup.readFile(o.setup);
+    if (!o.toolTable.empty()) po.setup.readToolTable(o.toolTable);
+    for (const auto& [text, name, target] : {std::tuple{&o.tcpOn, "--tcp-on", &po.tcpOnM}, std::tuple{&o.tcpOff, "--tcp-off", &po.tcpOffM}}) {
+        if (text->empty()) continue;
+        const auto m = pp::parseMCode(*text);
+        if (!m) throw InputError(name, 0, fmt::format("expected an M code such as M428, got '{}'", *text));
+        *target = *m;
+    }
     for (const auto& w : o.workOffsets) po.setup.addWorkOffset(w);
     for (const auto& l : o.toolLengths) po.setup.addToolLength(l);
     for (const auto& a : o.assume) po.setup.addAssumed(a);
@@ -58,6 +67,9 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--dialect", o->dialect, "auto, rs274ngc (linuxcnc), fanuc, sinumerik, printer")->capture_default_str();
     c->add_option("--work-offset", o->workOffsets, "work offset CODE=x,y,z[,a,b,c] in mm and deg (repeatable)");
     c->add_option("--tool-length", o->toolLengths, "tool length in mm: L or Hn=L for G43 Hn (repeatable)");
+    c->add_option("--tool-table", o->toolTable, "LinuxCNC tool table: tool lengths for G43 / G43 Hn")->check(CLI::ExistingFile);
+    c->add_option("--tcp-on", o->tcpOn, "M code that switches tool-tip (TCP) programming on, e.g. M428");
+    c->add_option("--tcp-off", o->tcpOff, "M code that switches it off, e.g. M429");
     c->add_option("--setup", o->setup, "setup file (see correct --help)")->check(CLI::ExistingFile);
     c->add_option("--assume", o->assume, "positions of axes until the program commands them, e.g. Y=0 (mm, deg; rotary default 0)");
     c->add_option("--units", o->units, "units when the program sets neither G20 nor G21: mm (default) or inch");

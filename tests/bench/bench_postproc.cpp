@@ -1,7 +1,9 @@
-// Post-processor throughput on a generated program of >= 1 M lines (written once to a temporary file and
-// streamed from it): identity (all-zero deviation set) and 5-axis correction with simultaneous rotary motion
-// on the multitasking machine. Reports lines/s and bytes/s; memory use does not depend on the program size
-// (fixed read and write buffers; the output goes to a counting sink).
+// Post-processor throughput on programs of >= 1 M lines (written once to a temporary file and streamed from it):
+//  - a generated 5-axis program on the multitasking machine (joint mode): identity and correction;
+//  - the real impeller of LinuxCNC's xyzac-trt sim (../shared/gcode-corpus/impeller-7bl-xyzac.ngc, its body repeated
+//    to >= 1 M lines after M428): identity and correction in TCP mode on the sim's machine (skipped without the
+//    corpus). Reports lines/s and bytes/s (CPU time); memory use does not depend on the program size (fixed read and
+//    write buffers; the output goes to a counting sink).
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -11,10 +13,12 @@
 #include <fstream>
 #include <streambuf>
 #include <string>
+#include <vector>
 
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "postproc/processor.hpp"
+#include "tests/test_postproc_xyzac.hpp"
 
 namespace {
 
@@ -70,29 +74,35 @@ protected:
     }
 };
 
-void run(benchmark::State& state, bool identity) {
-    static const MachineModel m = readMachineXml(std::string(CNCCOMP_SOURCE_DIR) + "/samples/machines/multitasking.xml");
-    static const DeviationSet truth =
-        readDeviationCsv(std::string(CNCCOMP_SOURCE_DIR) + "/samples/deviations/multitasking-truth.csv", m);
-    const DeviationSet zero(m);
-    const std::string& path = programPath();
+/// Corrects the program at `path` once per iteration into a counting sink; lines/s, bytes/s and what was done.
+void measure(benchmark::State& state, const MachineModel& m, const DeviationSet& d, const std::string& path,
+             const pp::CorrectOptions& o) {
     const auto bytes = std::filesystem::file_size(path);
-    pp::CorrectOptions o;
-    o.dialect = pp::Dialect::Rs274ngc;
-    o.setup.addToolLength("100");
     pp::CorrectSummary s;
     for (auto _ : state) {
         std::ifstream in(path, std::ios::binary);
         CountingBuf sink;
         std::ostream out(&sink);
-        s = pp::correctProgram(m, identity ? zero : truth, in, out, o);
+        s = pp::correctProgram(m, d, in, out, o);
         benchmark::DoNotOptimize(sink.bytes);
     }
     state.counters["lines/s"] = benchmark::Counter(double(s.lines) * state.iterations(), benchmark::Counter::kIsRate);
     state.counters["lines"] = double(s.lines);
     state.counters["split"] = double(s.split);
     state.counters["corrected"] = double(s.corrected);
+    state.counters["tcp moves"] = double(s.tcpMoves);
     state.SetBytesProcessed(static_cast<int64_t>(bytes) * state.iterations());
+}
+
+void run(benchmark::State& state, bool identity) {
+    static const MachineModel m = readMachineXml(std::string(CNCCOMP_SOURCE_DIR) + "/samples/machines/multitasking.xml");
+    static const DeviationSet truth =
+        readDeviationCsv(std::string(CNCCOMP_SOURCE_DIR) + "/samples/deviations/multitasking-truth.csv", m);
+    const DeviationSet zero(m);
+    pp::CorrectOptions o;
+    o.dialect = pp::Dialect::Rs274ngc;
+    o.setup.addToolLength("100");
+    measure(state, m, identity ? zero : truth, programPath(), o);
 }
 
 void BM_PostprocIdentity(benchmark::State& state) { run(state, true); }
@@ -100,5 +110,79 @@ void BM_PostprocCorrect5Axis(benchmark::State& state) { run(state, false); }
 
 BENCHMARK(BM_PostprocIdentity)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_PostprocCorrect5Axis)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+// --- The real 5-axis program: LinuxCNC's impeller demo in TCP mode ---------------------------------------------------
+
+struct Impeller {
+    std::string program, machine, deviations;
+    bool ok = false;
+    ~Impeller() {
+        std::error_code ec;
+        for (const auto& p : {program, machine, deviations})
+            if (!p.empty()) std::filesystem::remove(p, ec);
+    }
+};
+
+const Impeller& impeller() {
+    static Impeller im;
+    static const bool once = [] {
+        const std::string src = std::string(CNCCOMP_SOURCE_DIR) + "/../shared/gcode-corpus/impeller-7bl-xyzac.ngc";
+        std::ifstream in(src, std::ios::binary);
+        if (!in) return false;
+        std::vector<std::string> body;
+        bool inside = false;
+        for (std::string l; std::getline(in, l);) {
+            if (l.rfind("M428", 0) == 0) {
+                inside = true;
+                continue;
+            }
+            if (l.rfind("M429", 0) == 0) inside = false;
+            if (inside) body.push_back(l);
+        }
+        const auto tmp = std::filesystem::temp_directory_path();
+        const std::string tag = std::to_string(::getpid());
+        im.program = (tmp / ("cnccomp-bench-impeller-" + tag + ".ngc")).string();
+        im.machine = (tmp / ("cnccomp-bench-xyzac-" + tag + ".xml")).string();
+        im.deviations = (tmp / ("cnccomp-bench-xyzac-" + tag + ".csv")).string();
+        std::ofstream(im.machine) << test::kXyzacTrtMachine;
+        std::ofstream(im.deviations) << "name,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\n"
+                                        "EC0A,,-6,arcsec\nEX0C,,15,um\nEY0C,,-9,um\nEA0C,,7,arcsec\nEB0C,,-5,arcsec\n"
+                                        "EC0Y,,4,arcsec\n";
+        std::ofstream out(im.program, std::ios::binary);
+        out << "(impeller body of LinuxCNC's xyzac-trt demo, repeated)\nM428\n";
+        size_t lines = 2;
+        while (lines < size_t(kLines)) {
+            for (const std::string& l : body) out << l << '\n';
+            lines += body.size();
+        }
+        out << "M429\nM30\n";
+        return true;
+    }();
+    im.ok = once;
+    return im;
+}
+
+void runImpeller(benchmark::State& state, bool identity) {
+    const Impeller& im = impeller();
+    if (!im.ok) {
+        state.SkipWithError("no ../shared/gcode-corpus/impeller-7bl-xyzac.ngc");
+        return;
+    }
+    static const MachineModel m = readMachineXml(im.machine);
+    static const DeviationSet truth = readDeviationCsv(im.deviations, m);
+    const DeviationSet zero(m);
+    pp::CorrectOptions o;
+    o.dialect = pp::Dialect::Rs274ngc;
+    o.setup.addToolLength("30");
+    o.tcpOnM = 428;
+    o.tcpOffM = 429;
+    measure(state, m, identity ? zero : truth, im.program, o);
+}
+
+void BM_PostprocImpellerIdentity(benchmark::State& state) { runImpeller(state, true); }
+void BM_PostprocImpellerCorrectTcp(benchmark::State& state) { runImpeller(state, false); }
+
+BENCHMARK(BM_PostprocImpellerIdentity)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_PostprocImpellerCorrectTcp)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace

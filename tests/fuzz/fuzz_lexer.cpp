@@ -30,9 +30,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Line line;
     std::string rebuilt;
     LexedBlock b;
+    OverlongLine overlong;
     bool first = true;
+    uint64_t lastNumber = 0;
+    bool inPieces = false;
     while (reader.next(line)) {
         rebuilt.append(line.text).append(line.eol);
+        // Line numbers: +1 per line, the same for every piece of an overlong line.
+        check(line.number == (inPieces ? lastNumber : lastNumber + 1));
+        check(line.firstPiece == !inPieces);
+        lastNumber = line.number;
+        inPieces = !line.lastPiece;
+        if (line.partial) {
+            if (line.firstPiece) overlong.reset();
+            overlong.feed(line.text);
+        }
         for (Dialect d : {Dialect::Rs274ngc, Dialect::Fanuc, Dialect::Sinumerik, Dialect::Printer}) {
             lexBlock(line.text, d, b, first);
             check(b.count >= 0 && b.count <= LexedBlock::kMaxWords);
@@ -67,5 +79,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         }
     }
     check(rebuilt == input);
+    check(!inPieces);
     return 0;
 }

@@ -2,6 +2,7 @@
 // Strict number parsing and atomic file writing shared by every reader and writer.
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -13,8 +14,37 @@ std::optional<double> parseNumber(std::string_view s);
 /// Trim ASCII white space.
 std::string_view trim(std::string_view s);
 
-/// Writes through `write` into a temporary file beside `path`, then renames it over `path`.
-/// A failure leaves no half file. Refuses to write onto any of `inputs` (the program never overwrites an input).
+/// Checks, before any work, that `path` can be written atomically: its folder exists and it is absent or a regular
+/// file (a symbolic link is followed to its target). A directory, a device (/dev/null), a FIFO or a socket is refused
+/// with an InputError naming the path: the atomic rename would replace the node itself. Returns the path the file will
+/// really be written at (the target of a link).
+std::string checkOutputPath(const std::string& path);
+
+/// A file written atomically: the data go into a temporary file created exclusively (O_CREAT | O_EXCL, mode 0666
+/// less the umask, an unpredictable name) in the target's folder, which commit() renames over the target. Without
+/// commit() (an exception, an early return) the temporary file is removed: a failed run leaves no half file.
+/// The target is checked with checkOutputPath() first.
+class AtomicFile {
+public:
+    explicit AtomicFile(const std::string& path);
+    ~AtomicFile();
+    AtomicFile(const AtomicFile&) = delete;
+    AtomicFile& operator=(const AtomicFile&) = delete;
+    std::ostream& stream();
+    /// Flushes, checks for write errors, keeps an existing target's permission bits, and renames. Throws InputError.
+    void commit();
+    /// The temporary file's path (for tests).
+    const std::string& temporaryPath() const { return tmp_; }
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    std::string path_, target_, tmp_;
+    bool committed_ = false;
+};
+
+/// Writes through `write` into an AtomicFile at `path` and commits it.
+/// A failure leaves no half file. Refuses non-regular targets before `write` runs.
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 /// Throws InputError if `output` names the same file as one of the inputs.
 void refuseToOverwrite(const std::string& output, std::initializer_list<std::string> inputs);

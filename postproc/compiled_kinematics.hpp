@@ -1,0 +1,79 @@
+#pragma once
+// The forward kinematics of one machine (nominal, or with a deviation set), compiled for the post-processor's hot
+// loop: the same model as cnccomp::Kinematics (link i = placement · E_location · motion(q) · E_component(q), exact
+// rotations), with the constant transforms between two motions folded into one, rotations about a coordinate axis
+// built from one sincos, component errors whose coefficients are all zero left out, no allocation per call.
+// The tests compare it with cnccomp::Kinematics and toolPoseJacobian.
+#include <vector>
+
+#include "cnccomp/deviations.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
+
+namespace cnccomp::pp {
+
+/// A rigid transform as rotation and translation (frame b in frame a).
+struct Frame {
+    Mat3 R = Mat3::Identity();
+    Vec3 t = Vec3::Zero();
+    Vec3 operator*(const Vec3& p) const { return R * p + t; }
+};
+
+class CompiledKinematics {
+public:
+    /// `deviations` nullptr: the nominal machine. The machine must outlive this object.
+    CompiledKinematics(const MachineModel& machine, const DeviationSet* deviations);
+
+    const MachineModel& machine() const { return *machine_; }
+    /// Tool point at `length` along the tool direction, and the tool axis (spindle → tip), in the workpiece frame,
+    /// at model commands q (mm, rad).
+    void toolPose(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
+    Vec3 toolTip(const AxisVector& q, double length) const;
+    /// d(tip, axis)/dq (6 × n, workpiece frame, rows as cnccomp::toolPoseJacobian); also the pose at q.
+    void jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const;
+    /// The tool point at q and its derivatives by the three axes `axes` (linear axes: constant in them).
+    void pointJacobian(const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const;
+    Frame baseToWorkpiece(const AxisVector& q) const;
+    Frame baseToTool(const AxisVector& q) const;
+
+private:
+    enum class OpKind : uint8_t { Constant, Linear, Rotary, Component };
+    struct Op {
+        OpKind kind = OpKind::Constant;
+        int axis = -1;
+        int unit = -1;  ///< rotary direction is +X / +Y / +Z exactly: 0 / 1 / 2; else −1
+        Mat3 R = Mat3::Identity();
+        Vec3 t = Vec3::Zero();
+        Vec3 dir = Vec3::UnitZ();
+        bool modulo = false;
+        std::vector<int> components;  ///< deviation definitions of a Component op
+    };
+    struct JointLine {
+        int axis = -1;
+        bool rotary = false;
+        Vec3 direction, point;
+    };
+    struct Lines {
+        JointLine items[kMaxAxes];
+        int count = 0;
+    };
+    /// The last evaluation of a chain, reused while the positions of its own axes are unchanged (consecutive
+    /// evaluations often share the rotary positions: the nominal target, the TCP world point, the check).
+    struct ChainCache {
+        bool valid = false, hasLines = false;
+        double key[kMaxAxes] = {};
+        Frame frame;
+        Lines lines;
+    };
+    void compile(const Chain& chain, Side side, std::vector<Op>& ops, std::vector<int>& axes);
+    void evaluate(const std::vector<Op>& ops, const AxisVector& q, Frame& f, Lines* lines) const;
+    void cached(const std::vector<Op>& ops, const std::vector<int>& axes, ChainCache& cache, const AxisVector& q,
+                Frame& f, Lines* lines) const;
+
+    const MachineModel* machine_;
+    Eigen::VectorXd values_;
+    std::vector<Op> workpiece_, tool_;
+    std::vector<int> workpieceAxes_, toolAxes_;
+    mutable ChainCache workpieceCache_, toolCache_;  ///< not thread-safe: one object per thread
+};
+
+}  // namespace cnccomp::pp

@@ -1,0 +1,55 @@
+#include "postproc/tcp_model.hpp"
+
+#include <Eigen/LU>  // Matrix3d::inverse
+
+namespace cnccomp::pp {
+
+TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
+    const MachineModel& m = nominal.machine();
+    const int n = m.axisCount();
+    zero_ = m.fromController(AxisVector::Zero(n));
+    const char names[3] = {'X', 'Y', 'Z'};
+    supported_ = true;
+    for (int k = 0; k < 3; ++k) {
+        const int a = m.axisIndex(std::string(1, names[k]));
+        if (a < 0 || m.axisLink(a).kind != AxisKind::Linear) {
+            supported_ = false;
+            why_ = "tool-tip programming needs linear X, Y and Z axes";
+        }
+        lin_[k] = a;
+    }
+    const Frame w = nominal.baseToWorkpiece(zero_);
+    const Frame t = nominal.baseToTool(zero_);
+    R0_ = w.R;
+    t0_ = w.t - t.t;
+}
+
+void TcpModel::forward(const AxisVector& c, double length, Vec3& point, Vec3& axis) const {
+    const AxisVector q = c + zero_;
+    Vec3 pw, aw;
+    nominal_.toolPose(q, length, pw, aw);
+    point = R0_ * pw + t0_;
+    axis = R0_ * aw;
+}
+
+void TcpModel::toProgram(const AxisVector& c, double length, AxisVector& p) const {
+    Vec3 point, axis;
+    forward(c, length, point, axis);
+    p = c;
+    for (int k = 0; k < 3; ++k) p[lin_[k]] = point[k];
+}
+
+void TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c) const {
+    c = p;  // rotary angles as programmed; linear axes start at the world coordinates
+    const AxisVector q = c + zero_;
+    Mat3 J;
+    Vec3 tip;
+    nominal_.pointJacobian(q, length, lin_, J, tip);
+    const Mat3 A = R0_ * J;
+    const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
+    const Vec3 have = R0_ * tip + t0_;
+    const Vec3 d = A.inverse() * (want - have);  // 3 x 3, well conditioned (the slides are orthogonal nominally)
+    for (int k = 0; k < 3; ++k) c[lin_[k]] += d[k];
+}
+
+}  // namespace cnccomp::pp
