@@ -166,8 +166,8 @@ TEST(PostprocReview, AppendedWordsFollowTheBlocksSpacing) {
     // aligned columns with a space for the sign, plain single spaces, and no spaces at all.
     const MachineModel& m = test::multitasking();
     DeviationSet d(m);
-    d.set("EC0Y", 200 * kArcsec);
-    d.set("EA0Z", 150 * kArcsec);
+    d.setLinkValue("EC0Y", 200 * kArcsec);  // the X slide turned about Z (ISO EC0Y = -200")
+    d.setLinkValue("EA0Z", 150 * kArcsec);
     std::string out;
     run(m, d,
         "G21 G90 G0 X 0 Y 0 Z 100 B0 C0\n"

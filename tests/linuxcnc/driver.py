@@ -66,8 +66,10 @@ def mdi(block):
     targets = [("XYZABCUVW".index(w[0]), float(w[1:])) for w in words[1:]] if words[0] == "G0" else []
     command.mdi(block)
     command.wait_complete(30)
+    # Motion runs in servo cycles of 50 us (the comp filter's bound needs them short); on a loaded machine a cycle takes
+    # far longer in wall time, so a long rotary move may need minutes: the timeout only guards against a hang.
     wait(lambda: stat.interp_state == linuxcnc.INTERP_IDLE and stat.inpos and stat.queue == 0 and arrived(targets),
-         60, block)
+         400, block)
     check_errors(block)
 
 

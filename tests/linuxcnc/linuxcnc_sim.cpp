@@ -228,7 +228,7 @@ std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& j
         fs::permissions(fifo, fs::perms::all | fs::perms::sticky_bit);
         env += " RTAPI_UID=65534 RTAPI_FIFO_PATH=" + shellQuote((fifo / "rtapi_fifo").string());
     }
-    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 120 linuxcnc -r " + shellQuote(c.ini.string()) +
+    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 600 linuxcnc -r " + shellQuote(c.ini.string()) +
                             " > " + shellQuote(log.string()) + " 2>&1 < /dev/null";
     const auto t0 = std::chrono::steady_clock::now();
     const int rc = std::system(cmd.c_str());
