@@ -9,31 +9,18 @@
 #include "cnccomp/identification/rtest_axis_tables.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "rtest_fixture.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-const MachineModel& tableTable() {
-    static const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
-    return m;
-}
+const MachineModel& tableTable() { return test::sampleMachine("table-table-ac"); }
 
-struct Fixture {
-    MeasurementPlan plan;
-    DeviationSet truth;
-    std::vector<RtestTrace> traces;
-};
+using Fixture = test::RtestFixture;
 
-const Fixture& seed004() {
-    static const Fixture f = [] {
-        const MachineModel& m = tableTable();
-        Fixture x{readPlanXml(test::sourcePath("samples/plans/table-table-ac-kinematic.xml")),
-                  readDeviationCsv(test::sourcePath("samples/deviations/table-table-ac-kinematic.csv"), m), {}};
-        const Kinematics k(m, x.truth);
-        for (const RtestRun& r : x.plan.rtestRuns) x.traces.push_back(simulateRtest(k, r));
-        return x;
-    }();
+const Fixture& kinematicTables() {
+    static const Fixture f = test::makeRtestFixture("table-table-ac", "table-table-ac-kinematic", "table-table-ac-kinematic");
     return f;
 }
 
@@ -64,7 +51,7 @@ std::pair<double, double> worst(const DeviationSet& est, const DeviationSet& tru
 
 TEST(RtestAxisTables, SmallAngleModelMatchesExactKinematics) {
     const MachineModel& m = tableTable();
-    const DeviationSet& t = seed004().truth;
+    const DeviationSet& t = kinematicTables().truth;
     const Kinematics k(m, t);
     const Vec3 w(80, -40, 60);
     double worstDiff = 0;
@@ -87,7 +74,7 @@ TEST(RtestAxisTables, SmallAngleModelMatchesExactKinematics) {
 
 TEST(RtestAxisTables, PerAngleFormulasRecoverTheTables) {
     const MachineModel& m = tableTable();
-    const Fixture& f = seed004();
+    const Fixture& f = kinematicTables();
     // Each axis on its own: the C sweep at A = 0 also sees A's errors at A = 0 and gives them to C.
     const AxisErrors a = cradleAxisErrors(m, "A", f.plan.rtestRuns, f.traces);
     const AxisErrors c = cradleAxisErrors(m, "C", f.plan.rtestRuns, f.traces);
@@ -110,7 +97,7 @@ TEST(RtestAxisTables, PerAngleFormulasRecoverTheTables) {
 
 TEST(RtestAxisTables, LeastSquaresRecoversTheTablesExactly) {
     const MachineModel& m = tableTable();
-    const Fixture& f = seed004();
+    const Fixture& f = kinematicTables();
     const CradleLsq r = cradleLeastSquares(m, "A", "C", f.plan.rtestRuns, f.traces);
     const auto [um, as] = worst(r.deviations, f.truth);
     std::printf("[ seed 004 ] least squares + gauge: worst %.2e um, %.2e arcsec; %zu unobservable directions\n", um, as,
@@ -122,7 +109,7 @@ TEST(RtestAxisTables, LeastSquaresRecoversTheTablesExactly) {
 
 TEST(RtestAxisTables, CollinearBallsAreRefused) {
     const MachineModel& m = tableTable();
-    const Fixture& f = seed004();
+    const Fixture& f = kinematicTables();
     std::vector<RtestRun> runs(f.plan.rtestRuns.begin(), f.plan.rtestRuns.begin() + 2);
     std::vector<RtestTrace> traces(f.traces.begin(), f.traces.begin() + 2);
     EXPECT_THROW(cradleAxisErrors(m, "C", runs, traces), ModelError);

@@ -11,31 +11,18 @@
 #include "cnccomp/identification/rtest_location_fits.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "rtest_fixture.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-const MachineModel& tableTable() {
-    static const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
-    return m;
-}
+const MachineModel& tableTable() { return test::sampleMachine("table-table-ac"); }
 
-struct Fixture {
-    MeasurementPlan plan;
-    DeviationSet truth;
-    std::vector<RtestTrace> traces;
-};
+using Fixture = test::RtestFixture;
 
-const Fixture& seed001() {
-    static const Fixture f = [] {
-        const MachineModel& m = tableTable();
-        Fixture x{readPlanXml(test::sourcePath("samples/plans/table-table-ac-rtest.xml")),
-                  readDeviationCsv(test::sourcePath("samples/deviations/table-table-ac-truth.csv"), m), {}};
-        const Kinematics k(m, x.truth);
-        for (const RtestRun& r : x.plan.rtestRuns) x.traces.push_back(simulateRtest(k, r));
-        return x;
-    }();
+const Fixture& locationRuns() {
+    static const Fixture f = test::makeRtestFixture("table-table-ac", "table-table-ac-rtest", "table-table-ac-truth");
     return f;
 }
 
@@ -57,18 +44,18 @@ std::pair<double, double> worst(const DeviationSet& est, const DeviationSet& tru
 TEST(RtestLocationFits, NominalMachineShowsNoDisplacement) {
     const MachineModel& m = tableTable();
     const Kinematics k(m);
-    for (const RtestRun& r : seed001().plan.rtestRuns) {
+    for (const RtestRun& r : locationRuns().plan.rtestRuns) {
         const RtestTrace t = simulateRtest(k, r);
         EXPECT_EQ(static_cast<int>(t.d.size()), r.sampleCount());
         for (const Vec3& d : t.d) EXPECT_LT(d.norm(), 1e-10) << r.name;
     }
-    EXPECT_EQ(seed001().plan.rtestRuns[0].sampleCount(), 72);  // a whole turn does not repeat its first pose
-    EXPECT_EQ(seed001().plan.rtestRuns[1].sampleCount(), 37);
+    EXPECT_EQ(locationRuns().plan.rtestRuns[0].sampleCount(), 72);  // a whole turn does not repeat its first pose
+    EXPECT_EQ(locationRuns().plan.rtestRuns[1].sampleCount(), 37);
 }
 
 TEST(RtestLocationFits, PaperFitsRecoverTheElevenErrors) {
     const MachineModel& m = tableTable();
-    const Fixture& f = seed001();
+    const Fixture& f = locationRuns();
     // The plain formulas: each reading taken as its error (first order, the readings mix the errors), then the
     // readings matched on the exact model (default refinement steps).
     const RtestLocationResult r = rtestLocationFits(m, f.plan.rtestRuns, f.traces);
@@ -91,7 +78,7 @@ TEST(RtestLocationFits, PaperFitsRecoverTheElevenErrors) {
 
 TEST(RtestLocationFits, LeastSquaresRecoversTheElevenErrorsExactly) {
     const MachineModel& m = tableTable();
-    const Fixture& f = seed001();
+    const Fixture& f = locationRuns();
     const Observations obs = rtestObservations(m, f.plan.rtestRuns, f.traces);
     IdentifyOptions o;
     for (const char* n : kEleven) o.deviations.push_back(m.deviationIndex(n));
@@ -106,7 +93,7 @@ TEST(RtestLocationFits, LeastSquaresRecoversTheElevenErrorsExactly) {
 TEST(RtestLocationFits, ZeroPositionOfAIsNotIdentifiedByName) {
     // EA0A (zero position of A) turns the ball about A and tilts C like EA0C: the engine must say so.
     const MachineModel& m = tableTable();
-    const Fixture& f = seed001();
+    const Fixture& f = locationRuns();
     const Observations obs = rtestObservations(m, f.plan.rtestRuns, f.traces);
     IdentifyOptions o;
     for (const char* n : kEleven) o.deviations.push_back(m.deviationIndex(n));
@@ -120,7 +107,7 @@ TEST(RtestLocationFits, ZeroPositionOfAIsNotIdentifiedByName) {
 
 TEST(RtestLocationFits, VolumetricErrorAlongXyzacFromTheElevenErrors) {
     const MachineModel& m = tableTable();
-    const Fixture& f = seed001();
+    const Fixture& f = locationRuns();
     const RtestLocationResult r = rtestLocationFits(m, f.plan.rtestRuns, f.traces);
     const VolumetricAlongRun v = volumetricErrorAlongRun(m, r.deviations, f.plan.rtestRuns[4], f.traces[4]);
     std::printf("[ seed 001 ] XYZAC: measured RMS %.3f um, residual RMS %.2e um, max %.2e um\n", v.rmsMeasured / kUm,

@@ -9,28 +9,15 @@
 #include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "jacobian_check.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-const MachineModel& tableTable() {
-    static const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
-    return m;
-}
+const MachineModel& tableTable() { return test::sampleMachine("table-table-ac"); }
 
-/// Every deviation of the machine, evaluated at `at`; analytic vs numeric Jacobian of the whole problem.
-double jacobianMismatch(const MachineModel& m, const Observations& obs, const DeviationSet& at) {
-    std::vector<int> devs;
-    for (int i = 0; i < static_cast<int>(m.deviations.size()); ++i) devs.push_back(i);
-    const UnknownLayout layout(m, devs, obs);
-    const LsqProblem p(m, obs, layout, at);
-    Eigen::MatrixXd Ja, Jn;
-    p.jacobian(p.start(), Ja);
-    p.numericJacobian(p.start(), Jn, 1e-2);
-    EXPECT_GT(Ja.norm(), 0);
-    return (Ja - Jn).cwiseAbs().maxCoeff() / Jn.cwiseAbs().maxCoeff();
-}
+using test::jacobianMismatch;
 
 DeviationSet mixedErrors(const MachineModel& m) {
     // The sample truths of seeds 001 and 004 together: location, squareness and component tables.

@@ -10,10 +10,9 @@ namespace cnccomp::test {
 /// A file of the source tree / of ../shared (paths fixed at configure time, defined in test_support_impl.cpp only).
 std::string sourcePath(const std::string& rel);
 std::string sharedPath(const std::string& rel);
-inline const MachineModel& multitasking() {
-    static const MachineModel m = readMachineXml(sourcePath("samples/machines/multitasking.xml"));
-    return m;
-}
+/// A sample machine, samples/machines/<stem>.xml, read once (the reference stays valid for the whole run).
+const MachineModel& sampleMachine(const std::string& stem);
+inline const MachineModel& multitasking() { return sampleMachine("multitasking"); }
 
 /// A fresh empty folder under the system temp dir, removed at destruction.
 struct ScratchDir {

@@ -3,6 +3,9 @@
 #include <array>
 #include <cstdio>
 #include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <sys/wait.h>
@@ -11,6 +14,15 @@ namespace cnccomp::test {
 
 std::string sourcePath(const std::string& rel) { return std::string(CNCCOMP_SOURCE_DIR) + "/" + rel; }
 std::string sharedPath(const std::string& rel) { return std::string(CNCCOMP_SHARED_DIR) + "/" + rel; }
+
+const MachineModel& sampleMachine(const std::string& stem) {
+    static std::mutex lock;
+    static std::map<std::string, std::unique_ptr<MachineModel>> cache;  // node-based: references stay valid
+    const std::lock_guard<std::mutex> guard(lock);
+    auto& m = cache[stem];
+    if (!m) m = std::make_unique<MachineModel>(readMachineXml(sourcePath("samples/machines/" + stem + ".xml")));
+    return *m;
+}
 
 ScratchDir::ScratchDir(const std::string& tag) {
     std::random_device rd;

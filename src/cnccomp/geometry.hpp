@@ -31,6 +31,13 @@ inline Pose errorTransform(const Vec6& e) {
     return p;
 }
 
+/// Cross-product matrix: skew(a) · b = a × b.
+inline Mat3 skew(const Vec3& a) {
+    Mat3 m;
+    m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+    return m;
+}
+
 /// Rotation by `angle` (rad) about unit `axis`.
 inline Mat3 axisRotation(const Vec3& axis, double angle) {
     return Eigen::AngleAxisd(angle, axis).toRotationMatrix();

@@ -16,13 +16,6 @@ namespace {
 using Rows = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 constexpr const char* kLetters = "XYZABC";
 
-/// [a]× with [a]× b = a × b.
-Mat3 skew(const Vec3& a) {
-    Mat3 s;
-    s << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
-    return s;
-}
-
 struct LinkRef {
     Side side = Side::Tool;
     int link = -1;

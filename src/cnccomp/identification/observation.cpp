@@ -12,11 +12,6 @@ namespace cnccomp {
 
 namespace {
 
-Mat3 hat(const Vec3& w) {
-    Mat3 m;
-    m << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-    return m;
-}
 
 /// Left Jacobian of SO(3): exp(w + δ) = exp(Jl(w) δ) · exp(w) to first order. Exact, with series near 0.
 Mat3 leftJacobian(const Vec3& w) {
@@ -30,7 +25,7 @@ Mat3 leftJacobian(const Vec3& w) {
         a = (1.0 - std::cos(t)) / (t * t);
         b = (t - std::sin(t)) / (t * t * t);
     }
-    const Mat3 W = hat(w);
+    const Mat3 W = skew(w);
     return Mat3::Identity() + a * W + b * W * W;
 }
 

@@ -18,11 +18,6 @@ namespace cnccomp {
 
 namespace {
 
-Mat3 hat(const Vec3& w) {
-    Mat3 m;
-    m << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
-    return m;
-}
 
 /// Nominal pose (bed frame) of a workpiece-side axis' frame after its motion.
 Pose nominalAxisFrame(const MachineModel& m, int axis, const AxisVector& q) {
@@ -127,7 +122,7 @@ AxisErrors cradleAxisErrors(const MachineModel& m, const std::string& axis, cons
         Eigen::VectorXd b(3 * n);
         for (Eigen::Index k = 0; k < n; ++k) {
             A.block(3 * k, 0, 3, 3) = Mat3::Identity();
-            A.block(3 * k, 3, 3, 3) = -hat(list[static_cast<size_t>(k)].p);  // ξ × p = −[p]× ξ
+            A.block(3 * k, 3, 3, 3) = -skew(list[static_cast<size_t>(k)].p);  // ξ × p = −[p]× ξ
             b.segment<3>(3 * k) = list[static_cast<size_t>(k)].d;
         }
         Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
@@ -214,8 +209,8 @@ DeviationSet cradleTablesPerAngle(const MachineModel& m, const std::string& oute
 
 Vec3 cradleSmallAngle(const Vec3& outerAxis, double alpha, const SixErrors& outer, const Vec3& innerAxis, double gamma,
                       const SixErrors& inner, const Vec3& w) {
-    const Vec3 cW = inner.delta + (Mat3::Identity() + hat(inner.xi)) * w;                                // (1), (3)
-    const Vec3 aW = outer.delta + (Mat3::Identity() + hat(outer.xi)) * (axisRotation(innerAxis, gamma) * cW);  // (4), (5), (6)
+    const Vec3 cW = inner.delta + (Mat3::Identity() + skew(inner.xi)) * w;                                // (1), (3)
+    const Vec3 aW = outer.delta + (Mat3::Identity() + skew(outer.xi)) * (axisRotation(innerAxis, gamma) * cW);  // (4), (5), (6)
     return axisRotation(outerAxis, alpha) * aW;                                                          // (7)
 }
 

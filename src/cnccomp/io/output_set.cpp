@@ -7,13 +7,14 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp {
 namespace fs = std::filesystem;
 
 namespace {
 
-/// Hidden name beside `target`, unique within this process.
+/// Hidden name beside `target` for the old content kept during commit(), unique within this process.
 fs::path sideName(const fs::path& target, const char* tag) {
     static unsigned counter = 0;
     return target.parent_path() / fmt::format(".{}.{}{}-{}", target.filename().string(), tag, ::getpid(), ++counter);
@@ -80,18 +81,10 @@ void OutputSet::add(const std::string& path, const std::function<void(std::ostre
     for (const std::string& t : targets_)
         if (fs::absolute(t, ec).lexically_normal() == fs::absolute(target, ec).lexically_normal())
             throw InputError(path, 0, "this command would write the same file twice");
-    const fs::path tmp = sideName(target, "tmp");
-    try {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw InputError(path, 0, "cannot create output file");
-        write(out);
-        out.flush();
-        if (!out) throw InputError(path, 0, "write failed");
-    } catch (...) {  // this file is not part of the set
-        fs::remove(tmp, ec);
-        throw;
-    }
-    staged_.push_back(tmp.string());
+    auto file = std::make_unique<AtomicFile>(path);  // refuses a target that is not a regular file
+    write(file->stream());
+    file->close();  // a failure removes its temporary file: this file is not part of the set
+    staged_.push_back(std::move(file));
     targets_.push_back(path);
 }
 
@@ -115,16 +108,20 @@ void OutputSet::commit() {
         backups[i] = b.string();
     }
     for (size_t i = 0; i < targets_.size(); ++i) {
-        fs::rename(staged_[i], targets_[i], ec);
-        if (!ec) continue;
-        const std::string why = ec.message();
+        std::string why;
+        try {
+            staged_[i]->commit();
+            continue;
+        } catch (const InputError& e) {
+            why = e.what();
+        }
         for (size_t k = 0; k < i; ++k) {  // put back what was replaced
             if (backups[k].empty()) fs::remove(targets_[k], ec);
             else fs::rename(backups[k], targets_[k], ec);
             backups[k].clear();
         }
         cleanBackups();
-        throw InputError(targets_[i], 0, fmt::format("cannot write the file: {}; no output was changed", why));
+        throw InputError(targets_[i], 0, fmt::format("{}; no output was changed", why));
     }
     cleanBackups();
     staged_.clear();
@@ -134,8 +131,7 @@ void OutputSet::commit() {
 
 void OutputSet::rollback() noexcept {
     std::error_code ec;
-    for (const std::string& s : staged_) fs::remove(s, ec);
-    staged_.clear();
+    staged_.clear();  // each AtomicFile not committed removes its temporary file
     targets_.clear();
     for (auto it = createdDirs_.rbegin(); it != createdDirs_.rend(); ++it) fs::remove(*it, ec);  // only if empty
     createdDirs_.clear();

@@ -7,17 +7,20 @@
 //   for (run : runs) out.add(OutputSet::fileIn(dir, run.name + ".csv"), [&](std::ostream& o) { ... });
 //   out.commit();                                    // only now do the targets change
 //
-// add() writes the whole file at once into a hidden temporary file beside its target (same folder, so the final
-// rename is atomic). commit() renames every staged file onto its target; if a rename fails half way, the targets
+// add() writes the whole file at once into a hidden temporary file beside its target (an AtomicFile, io/text_util.hpp:
+// created exclusively under an unpredictable name, in the same folder so the final rename is atomic). commit() renames every staged file onto its target; if a rename fails half way, the targets
 // already replaced get their old content back (kept as hard links until the end). Without commit() (an exception,
 // an early return) the destructor removes the temporary files and the folders this set created.
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace cnccomp {
+
+class AtomicFile;
 
 /// Why `name` is not a plain file name (empty, '/' or '\\', "." or "..", a leading '.', a control character),
 /// or an empty string when it is one.
@@ -54,7 +57,8 @@ private:
     void rollback() noexcept;
 
     std::vector<std::string> inputs_;
-    std::vector<std::string> targets_, staged_;
+    std::vector<std::string> targets_;
+    std::vector<std::unique_ptr<AtomicFile>> staged_;  ///< closed, not yet renamed
     std::vector<std::string> createdDirs_;  ///< outermost first
 };
 

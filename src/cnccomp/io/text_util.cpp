@@ -196,7 +196,8 @@ AtomicFile::~AtomicFile() {
 
 std::ostream& AtomicFile::stream() { return *impl_->out; }
 
-void AtomicFile::commit() {
+void AtomicFile::close() {
+    if (closed_) return;
     impl_->out->flush();
     if (!*impl_->out || impl_->buf->failed())
         throw InputError(path_, 0, fmt::format("write failed: {}", std::strerror(impl_->buf->error() ? impl_->buf->error() : EIO)));
@@ -207,11 +208,14 @@ void AtomicFile::commit() {
             throw InputError(path_, 0, fmt::format("the output became {} while writing; not replaced", kindOf(st.st_mode)));
         ::fchmod(impl_->fd, st.st_mode & 07777);
     }
-    if (::close(impl_->fd) != 0) {
-        impl_->fd = -1;
-        throw InputError(path_, 0, fmt::format("write failed: {}", std::strerror(errno)));
-    }
+    const int rc = ::close(impl_->fd);
     impl_->fd = -1;
+    if (rc != 0) throw InputError(path_, 0, fmt::format("write failed: {}", std::strerror(errno)));
+    closed_ = true;
+}
+
+void AtomicFile::commit() {
+    close();
     if (::rename(tmp_.c_str(), target_.c_str()) != 0)
         throw InputError(path_, 0, fmt::format("cannot rename the temporary file onto the output: {}", std::strerror(errno)));
     committed_ = true;

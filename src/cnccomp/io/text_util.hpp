@@ -31,8 +31,13 @@ public:
     AtomicFile(const AtomicFile&) = delete;
     AtomicFile& operator=(const AtomicFile&) = delete;
     std::ostream& stream();
-    /// Flushes, checks for write errors, keeps an existing target's permission bits, and renames. Throws InputError.
+    /// Flushes, checks for write errors, keeps an existing target's permission bits and closes the temporary file,
+    /// without renaming it yet (io/output_set.hpp renames several files together). Throws InputError.
+    void close();
+    /// close(), then renames the temporary file over the target. Throws InputError.
     void commit();
+    /// The file the temporary file replaces (the target of a symbolic link).
+    const std::string& target() const { return target_; }
     /// The temporary file's path (for tests).
     const std::string& temporaryPath() const { return tmp_; }
 
@@ -40,7 +45,7 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
     std::string path_, target_, tmp_;
-    bool committed_ = false;
+    bool closed_ = false, committed_ = false;
 };
 
 /// Writes through `write` into an AtomicFile at `path` and commits it.
