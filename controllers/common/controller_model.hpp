@@ -71,21 +71,24 @@ private:
 /// The TCP of a controller: programmed commands (meant for the nominal machine, in the description's frame) →
 /// nominal tool pose → the controller's machine coordinates at which its model (ControllerModel, controller
 /// coordinates) reaches that pose (Newton, solveToolPose) → back to the description's frame
-/// (MachineModel::fromController). The machine must outlive the transform.
+/// (MachineModel::fromController). The tool point is the active tool's tip: a TCP control (TRAORI, M128 / FUNCTION
+/// TCPM, G43.4) computes with the length of the active tool's offset, so where the tool axis cannot be matched (four
+/// axes, or a singular orientation) the tip of that tool is still met. The machine must outlive the transform.
 class TcpTransform {
 public:
     TcpTransform(const MachineModel& machine, std::unique_ptr<const ControllerModel> controller,
                  double toolLength = kControllerToolLength);
+    /// With the default tool length (constructor).
     AxisVector solve(const AxisVector& programmed) const;
+    /// With the active tool's length (mm along the machine's tool direction from the tool reference point).
+    AxisVector solve(const AxisVector& programmed, double toolLength) const;
     const ControllerModel& controller() const { return *controller_; }
     double toolLength() const { return toolLength_; }
-    void setToolLength(double length);
 
 private:
     Kinematics nominal_;
     std::unique_ptr<const ControllerModel> controller_;
     double toolLength_;
-    Vec3 tip_;
 };
 
 /// The six location-error components (x y z a b c) a deviation set puts on one link (mm, rad).
