@@ -109,7 +109,8 @@ class GenericBackend final : public Backend {
 public:
     std::string_view name() const override { return "generic"; }
     std::string_view description() const override {
-        return "generic CSV + JSON: the deviation set and a grid map of the tool-tip error over the workspace";
+        return "generic CSV + JSON: the deviation set and a grid map of the tool-tip error over the workspace (machine frame, "
+               "nodes for 0.05 um of multilinear interpolation)";
     }
 
     EmitResult emit(const EmitRequest& r) const override { return emitFiles(r, GridMapOptions{}); }
