@@ -141,7 +141,9 @@ TEST(ControllerFanuc, PivotAndPitchErrorsClaimedAreCompensated) {
     const EmitResult r = fanuc30i().emit({m, d, "controllers-fanuc-pitch.csv", "2024-01-01"});
     std::set<std::string> refused;
     for (const auto& c : r.notCompensated) refused.insert(c.deviation);
-    EXPECT_EQ(refused, (std::set<std::string>{"EA0B", "EC0Y", "EYX"}));
+    EXPECT_EQ(refused, (std::set<std::string>{"EA0B", "EC0Y", "EYX", "EXX (rounded to 0.0001 mm)", "EYY (rounded to 0.0001 mm)",
+                                              "EZZ (rounded to 0.0001 mm)", "EBB (rounded to 0.0001 deg)",
+                                              "ECC (rounded to 0.0001 deg)"}));
     const auto samples = test::nonSingularSamples(m, 4, 300.0);
     const CompensationFigures f = test::evaluateBackend(fanuc30i(), m, claimedOnly(d, r), samples, 100.0);
     test::report("fanuc-30i pivots + pitch (claimed)", f);
@@ -245,10 +247,34 @@ TEST(ControllerFanuc, ConstantPartOfAPositioningErrorIsReported) {
     d.values[ecc.offset] = 5 * kArcsec;  // cos c: 5" at the reference position
     d.present[m.deviationIndex("ECC")] = 1;
     const EmitResult r = fanuc30i().emit({m, d, "x", "2024-01-01"});
-    ASSERT_EQ(r.notCompensated.size(), 1u);
-    EXPECT_EQ(r.notCompensated[0].deviation, "ECC (constant part)");
-    EXPECT_NE(r.notCompensated[0].note.find("5.000 arcsec"), std::string::npos) << r.notCompensated[0].note;
+    ASSERT_EQ(r.notCompensated.size(), 2u);
+    EXPECT_EQ(r.notCompensated[0].deviation, "ECC (rounded to 0.0001 deg)");
+    EXPECT_NE(r.notCompensated[0].note.find("up to 0.18 arcsec"), std::string::npos) << r.notCompensated[0].note;
+    EXPECT_EQ(r.notCompensated[1].deviation, "ECC (constant part)");
+    EXPECT_NE(r.notCompensated[1].note.find("5.000 arcsec"), std::string::npos) << r.notCompensated[1].note;
     EXPECT_NE(r.files[0].content.find("(  ECC [constant part]"), std::string::npos);
+}
+
+TEST(ControllerFanuc, ConstantPartOfALinearPositioningErrorGoesIntoTheTcpOffsets) {
+    // A linear axis off by a constant carries everything behind it by that much: the TCP offsets and 1220 hold it
+    // (the pitch table is zero at the reference position). Oracle: the exact erroneous kinematics at the drive commands
+    // (evaluate.hpp). table-table-bc-offsets: X's reference position (machine 0) is the command 50 mm, where the EXX
+    // table reads -4 + 2.5 * 100 / 150 = -2.333 um.
+    const MachineModel m = readMachineXml(sourcePath("samples/machines/table-table-bc-offsets.xml"));
+    const DeviationSet truth = readDeviationCsv(sourcePath("samples/deviations/table-table-bc-offsets-truth.csv"), m);
+    DeviationSet d(m);
+    const int exx = m.deviationIndex("EXX");
+    const auto& def = m.deviations[static_cast<size_t>(exx)];
+    d.values.segment(def.offset, def.size()) = truth.values.segment(def.offset, def.size());
+    d.present[static_cast<size_t>(exx)] = 1;
+    const EmitResult r = fanuc30i().emit({m, d, "x", "2024-01-01"});
+    ASSERT_EQ(r.notCompensated.size(), 1u);  // only the rounding to the detection unit, no constant part
+    EXPECT_EQ(r.notCompensated[0].deviation, "EXX (rounded to 0.0001 mm)");
+    ASSERT_EQ(r.compensated.size(), 1u);
+    EXPECT_NE(r.compensated[0].note.find("1220"), std::string::npos) << r.compensated[0].note;
+    const CompensationFigures f = emitApplyEvaluate(fanuc30i(), m, d, test::nonSingularSamples(m, 4), 50.0);
+    EXPECT_GT(f.maxBefore, 2.3 * kUm);
+    EXPECT_LT(f.maxAfter, 0.06 * kUm);  // the pitch data's detection unit (0.1 um) rounds each absolute value
 }
 
 TEST(ControllerFanuc, LimitsAreReportedAsModelErrors) {

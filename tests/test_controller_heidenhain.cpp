@@ -12,6 +12,8 @@
 #include "controllers/common/evaluate.hpp"
 #include "controllers/heidenhain/kinematics_table.hpp"
 #include "controllers/heidenhain/tnc_table.hpp"
+#include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/verify.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::controllers {
@@ -344,6 +346,49 @@ TEST(ControllerHeidenhain, RowsAndTablesAreInTheMachineCoordinates) {
     const CompensationFigures g =
         evaluateCompensation(base, test::sameDeviations(d, base), *tnc().apply(base, r.files), test::nonSingularSamples(base, 4), 100.0);
     EXPECT_GT(g.maxAfter, 0.5);
+}
+
+TEST(ControllerHeidenhain, ATransRowThatShiftsTheDatumIsReadAndOnlyTheVolumetricFigureSeesIt) {
+    // Review note: flipping the sign of the Trans X row of C on table-table-ac left the verify residual at 0.001 um.
+    // The row is read: EX0C shifts the C axis line along X, after A, which turns about X, and the workpiece datum
+    // follows the axis line (location errors are not wrapped back), so the whole workpiece moves along A's (measured)
+    // axis line. The TCP then moves the slides by the same amount at every pose (oracle: that rigid shift along the A
+    // direction of the true machine, EB0A/EC0A tilt it off X by 0.2 mrad), which no relative
+    // reading (R-test, ball bar: the instrument is set at each run's start) can see; verify's volumetric figure does.
+    const MachineModel m = readMachineXml(sourcePath("samples/machines/table-table-ac.xml"));
+    const DeviationSet truth = readDeviationCsv(sourcePath("samples/deviations/table-table-ac-truth.csv"), m);
+    const EmitResult r = tnc().emit({m, truth, "truth.csv", "2024-01-01"});
+    std::vector<OutputFile> damaged = r.files;
+    std::string& tab = damaged[0].content;
+    ASSERT_TRUE(damaged[0].name.ends_with(".TAB"));
+    const std::string row = "Trans     X     -0.005000000";  // the one Trans X row: EX0C, beside MachAxis C
+    ASSERT_NE(tab.find(row), std::string::npos) << tab;
+    ASSERT_EQ(tab.find(row, tab.find(row) + 1), std::string::npos) << tab;
+    tab.replace(tab.find(row), row.size(), "Trans     X     0.005000000 ");
+    const auto good = tnc().apply(m, r.files), bad = tnc().apply(m, damaged);
+    Vec3 a = Vec3::Zero();
+    const Kinematics k(m, truth);
+    for (const JointFrame& j : k.jointFrames(AxisVector::Zero(m.axisCount())))
+        if (j.axis == m.requireAxis("A")) a = j.direction;
+    ASSERT_NEAR(a.x(), 1.0, 1e-6);
+    for (const AxisVector& q : test::nonSingularSamples(m, 3, 150.0)) {
+        AxisVector shift = AxisVector::Zero(m.axisCount());
+        for (int i = 0; i < 3; ++i) shift[m.requireAxis(std::string(1, "XYZ"[i]))] = 0.010 * a[i];  // +5 um read for -5 um
+        EXPECT_LT((bad->driveCommandsForTool(q, 100.0) - good->driveCommandsForTool(q, 100.0) - shift).norm(), 1e-7);
+    }
+    MeasurementPlan plan = readPlanXml(sourcePath("samples/plans/table-table-ac-rtest.xml"));
+    VerifyOptions o;
+    o.volumetricPerAxis = 3;
+    VerifyCompensation c;
+    c.kind = VerifyCompensation::Kind::ControllerFiles;
+    c.model = std::shared_ptr<const AppliedCompensation>(tnc().apply(m, r.files));
+    const VerifyResult vg = verify(m, plan, truth, "truth", c, o);
+    c.model = std::shared_ptr<const AppliedCompensation>(tnc().apply(m, damaged));
+    const VerifyResult vb = verify(m, plan, truth, "truth", c, o);
+    EXPECT_LT(vg.residual, 0.01 * kUm);
+    EXPECT_LT(vb.residual, 0.01 * kUm);
+    EXPECT_LT(vg.volumetric.maxAfter, 0.01 * kUm);
+    EXPECT_NEAR(vb.volumetric.maxAfter, 10 * kUm, 0.01 * kUm);
 }
 
 }  // namespace

@@ -186,6 +186,81 @@ TEST(Verify, ADamagedFileFailsTheGateWithExitStatusOne) {
     EXPECT_EQ(r.exitCode, 1) << r.out;
 }
 
+TEST(Verify, EveryBackendsDamagedFilesFailTheGate) {
+    // Oracle: the simulation on the true machine (R-test of the A/C cradle). For every backend the files it writes pass a
+    // 0.1 um gate; one value that matters with its sign flipped fails it with exit status 1; one row missing fails it
+    // too (exit 1), or, where the format makes a missing row a syntax error, is refused with file:line (exit 2).
+    // The damaged values move an axis line relative to the workpiece datum. (A value that moves the datum with the axis
+    // line, e.g. the first table axis' offset or a shift along the A axis, is a pure datum shift: no relative
+    // measurement sees it, the volumetric figure does; ControllerHeidenhain.ATransRowThatShiftsTheDatum... shows one.)
+    // ISG: Verify.ADamagedFileFailsTheGateWithExitStatusOne.
+    struct Case {
+        const char* backend;
+        bool claimedTruth;  ///< truth restricted to what the backend compensates of it (EY0A EZ0A EX0C EY0C)
+        const char* signFile;
+        const char* signFrom;  ///< text replaced by signTo: one value's sign flipped
+        const char* signTo;
+        const char* rowFile;
+        const char* rowKey;    ///< text on the line that goes missing
+        const char* rowError;  ///< empty: the gate fails (1); else the file:line message (2)
+    };
+    const Case cases[] = {
+        {"heidenhain-tnc", false, "TABLE_TABLE_AC.TAB", "Trans     Y     -0.002000000", "Trans     Y     0.002000000 ",
+         "TABLE_TABLE_AC.TAB", "Trans     Y     -0.002000000", "TABLE_TABLE_AC.TAB:19: NR '17': expected 16"},
+        {"siemens-840d", false, "CNCCOMP_KINCHAIN.SPF", "$NK_OFF_DIR[9,1]=-0.002000000", "$NK_OFF_DIR[9,1]=0.002000000",
+         "NC_CEC.INI", "$AN_CEC[0,5]=", "NC_CEC.INI:32: CEC table 0: (MAX-MIN)/STEP+1 = 201 points expected, 200 given"},
+        {"fanuc-30i", true, "CNCCOMP.PRM", "N19702Q1L1P-0.0680", "N19702Q1L1P0.0680", "CNCCOMP.PRM", "N19704Q1L1P",
+         "CNCCOMP.PRM:36: parameter 19704 is missing"},
+        {"linuxcnc", true, "cnccomp.hal", "setp xyzac-trt-kins.z-rot-point -0.068000", "setp xyzac-trt-kins.z-rot-point 0.068000",
+         "cnccomp.hal", "setp xyzac-trt-kins.y-offset", ""},
+        {"generic", false, "map.csv", "\n0.000000,-180.000000,-400.000000,-500.000000,-200.000000,-107.159320,91.304743,",
+         "\n0.000000,-180.000000,-400.000000,-500.000000,-200.000000,-107.159320,-91.304743,", "map.csv",
+         "\n0.000000,-180.000000,-400.000000,-500.000000,-200.000000,", "map.csv:27: 1039 rows do not form a full grid (1040 nodes)"},
+    };
+    test::ScratchDir dir("verify-damaged-all");
+    const std::string m = src("samples/machines/table-table-ac.xml"), p = src("samples/plans/table-table-ac-rtest.xml"),
+                      full = src("samples/deviations/table-table-ac-truth.csv"), claimed = dir.file("claimed.csv");
+    test::writeText(claimed, "name,alias,value,unit\nEY0A,,-5,um\nEZ0A,,-68,um\nEX0C,,-5,um\nEY0C,,-2,um\n");
+    for (const Case& c : cases) {
+        const std::string truth = c.claimedTruth ? claimed : full, good = dir.file(std::string(c.backend) + "-good");
+        auto r = test::runCli("emit --controller " + std::string(c.backend) + " --machine " + m + " --deviations " + truth +
+                              " --out " + good);
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+        const auto gate = [&](const std::string& folder) {
+            return test::runCli("verify --machine " + m + " --plan " + p + " --truth " + truth + " --compensation " + folder +
+                                " --max-residual-um 0.1");
+        };
+        r = gate(good);
+        EXPECT_EQ(r.exitCode, 0) << c.backend << "\n" << r.out;
+        // A copy of the good files with one file's text changed.
+        const auto damaged = [&](const std::string& name, const std::string& file, const std::string& from, const std::string& to) {
+            const std::string folder = dir.file(std::string(c.backend) + "-" + name);
+            std::filesystem::copy(good, folder);
+            std::string text = test::readText(folder + "/" + file);
+            const size_t at = text.find(from);
+            EXPECT_NE(at, std::string::npos) << c.backend << ": " << from;
+            if (at != std::string::npos) text.replace(at, from.size(), to);
+            test::writeText(folder + "/" + file, text);
+            return gate(folder);
+        };
+        r = damaged("sign", c.signFile, c.signFrom, c.signTo);
+        EXPECT_EQ(r.exitCode, 1) << c.backend << ": a flipped sign\n" << r.out;
+        EXPECT_NE(r.out.find("above --max-residual-um"), std::string::npos) << c.backend << "\n" << r.out;
+        // The whole line holding rowKey (from the line break before it to the one after it) goes.
+        const std::string text = test::readText(good + "/" + c.rowFile);
+        const size_t key = text.find(c.rowKey);
+        ASSERT_NE(key, std::string::npos) << c.backend << ": " << c.rowKey;
+        const size_t begin = c.rowKey[0] == '\n' ? key + 1 : text.rfind('\n', key) + 1, end = text.find('\n', begin) + 1;
+        r = damaged("row", c.rowFile, text.substr(begin, end - begin), "");
+        if (*c.rowError) {
+            EXPECT_EQ(r.exitCode, 2) << c.backend << ": a missing row\n" << r.out;
+            EXPECT_NE(r.out.find(c.rowError), std::string::npos) << c.backend << "\n" << r.out;
+        } else {
+            EXPECT_EQ(r.exitCode, 1) << c.backend << ": a missing row\n" << r.out;
+        }
+    }
+}
+
 TEST(Verify, CorrectedTestProgramsFolderThroughTheCli) {
     // testprog → correct (each program with its tool length, as its header says) → verify --compensation FOLDER.
     test::ScratchDir dir("verify-corrected");

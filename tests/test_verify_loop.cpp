@@ -1,13 +1,18 @@
 // The closed loop of issue 9 on every sample machine: simulate the plan with a truth set → identify (least squares) →
 // emit with each of the six backends → verify through the emitted files (read back by Backend::apply), through
 // corrected test programs, and with measurement noise. Oracle: the simulation on the true machine (the truth set is
-// known), with the instrument readings analysed like measured ones.
+// known), with the instrument readings analysed like measured ones. Every backend × machine is held to 0.1 um of ΔL
+// span for what it claims (its compensated list less the parts its NOT-compensated list names: a constant part, the
+// rounding to the controller's unit); the machine with machine-zero (table-table-bc-offsets) is in the files loop.
 #include <gtest/gtest.h>
 
 #include <random>
 #include <set>
 #include <sstream>
 
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/rtest_observation.hpp"
 #include "cnccomp/identification/tilting_head_errors.hpp"
@@ -24,14 +29,56 @@ namespace {
 
 struct Case {
     const char* machine;
-    const char* plan;
+    const char* plan;  ///< samples/plans/<plan>, or empty: kBcOffsetsPlan
     const char* truth;
+    /// Only the loop through controller files. table-table-bc-offsets is not in the corrected-program and noise loops:
+    /// `cnccomp correct` takes a program's positions as the description's commands, not as the controller's machine
+    /// coordinates the test programs are written in (postproc/processor.cpp has no machine-zero: 0.5 um left here),
+    /// and the in-test R-test plan identifies its 39 unknowns too weakly for σ = 0.5 um.
+    bool filesOnly = false;
+    /// Machine-zero put on the sample's axes (mm, deg): the controller counts those axes from elsewhere.
+    std::vector<std::pair<const char*, double>> machineZero = {};
 };
-constexpr Case kCases[] = {
+const Case kCases[] = {
     {"multitasking", "multitasking-six-circles.xml", "multitasking-truth.csv"},  // seed 000, six ball-bar runs
     {"table-table-ac", "table-table-ac-rtest.xml", "table-table-ac-truth.csv"},  // seed 001, R-test, 11 errors
     {"tilting-head-b", "tilting-head-b-patterns.xml", "tilting-head-b-truth.csv"},  // head patterns (absolute bar, two tool lengths), B tables
+    // B/C table with a tool-side offset and machine-zero on X, Y, Z: every backend's frame conversion (description
+    // commands → controller machine coordinates) is in the loop; 15 location errors and component tables/polynomials.
+    {"table-table-bc-offsets", "", "table-table-bc-offsets-truth.csv", true},
+    // Machine-zero on rotary axes too, where the axes stay along X/Y/Z at the controller's zero (a C table or work
+    // spindle homed elsewhere; LinuxCNC refuses it: its trt modules turn about joint 0): positions and tables are
+    // written in machine coordinates.
+    {"multitasking", "multitasking-six-circles.xml", "multitasking-truth.csv", true, {{"C", 45}, {"Z", 200}, {"X", -30}}},
+    {"tilting-head-b", "tilting-head-b-patterns.xml", "tilting-head-b-truth.csv", true, {{"X", -250}, {"Z", 100}}},
+    {"table-table-ac", "table-table-ac-rtest.xml", "table-table-ac-truth.csv", true, {{"C", 90}, {"Y", 40}, {"X", -30}}},
 };
+
+/// R-test on the B/C table (as seed 001 on the A/C cradle): C turns at B = 0 and ±45°, B turns at C = 0, both together.
+constexpr const char* kBcOffsetsPlan = R"(<?xml version="1.0" encoding="UTF-8"?>
+<plan machine="table-table-bc-offsets" description="R-test XYC, XZB, XYC at B = +-45 deg, XYZBC">
+  <rtest name="XYC" ball="100 0 50" nest-length="100" steps="72">
+    <hold axis="B" deg="0"/>
+    <sweep axis="C" start="0" end="360"/>
+  </rtest>
+  <rtest name="XZB" ball="100 0 50" nest-length="100" steps="36">
+    <sweep axis="B" start="-90" end="90"/>
+    <hold axis="C" deg="0"/>
+  </rtest>
+  <rtest name="XYC-B+45" ball="100 0 50" nest-length="100" steps="72">
+    <hold axis="B" deg="45"/>
+    <sweep axis="C" start="0" end="360"/>
+  </rtest>
+  <rtest name="XYC-B-45" ball="100 0 50" nest-length="100" steps="72">
+    <hold axis="B" deg="-45"/>
+    <sweep axis="C" start="0" end="360"/>
+  </rtest>
+  <rtest name="XYZBC" ball="100 0 50" nest-length="100" steps="72">
+    <sweep axis="B" start="-45" end="45"/>
+    <sweep axis="C" start="0" end="360"/>
+  </rtest>
+</plan>
+)";
 
 struct Loop {
     MachineModel machine;
@@ -42,7 +89,17 @@ struct Loop {
 Loop load(const Case& c) {
     Loop l;
     l.machine = readMachineXml(test::sourcePath(std::string("samples/machines/") + c.machine + ".xml"));
-    l.plan = readPlanXml(test::sourcePath(std::string("samples/plans/") + c.plan));
+    for (const auto& [axis, zero] : c.machineZero)
+        for (Chain* chain : {&l.machine.workpiece, &l.machine.tool})
+            for (Link& link : chain->links)
+                if (link.name == axis && link.axisIndex >= 0) link.machineZero = link.kind == AxisKind::Rotary ? zero * kDeg : zero;
+    if (*c.plan) {
+        l.plan = readPlanXml(test::sourcePath(std::string("samples/plans/") + c.plan));
+    } else {
+        test::ScratchDir dir("verify_loop_plan");
+        test::writeText(dir.file("plan.xml"), kBcOffsetsPlan);
+        l.plan = readPlanXml(dir.file("plan.xml"));
+    }
     for (BallbarRun& r : l.plan.runs) r.stepDeg = 5;  // fewer samples: the suite stays fast, the loop is the same
     l.truth = std::make_unique<DeviationSet>(readDeviationCsv(test::sourcePath(std::string("samples/deviations/") + c.truth), l.machine));
     return l;
@@ -94,61 +151,109 @@ DeviationSet restricted(const DeviationSet& d, const std::set<std::string>& keep
     return out;
 }
 
+/// What a backend claims of a set: the deviations it lists as compensated, less the parts it lists as not compensated
+/// ("EBB (constant part)": a pitch table is zero at the reference position, the axis' machine zero, so the claim is the
+/// error minus its value there; a table-type error loses that constant at every node).
+DeviationSet claimed(const DeviationSet& d, const controllers::EmitResult& r) {
+    std::set<std::string> names;
+    for (const auto& c : r.compensated) names.insert(c.deviation);
+    DeviationSet out = restricted(d, names);
+    const MachineModel& m = d.machine();
+    for (const auto& c : r.notCompensated) {
+        const size_t at = c.deviation.find(" (constant part)");
+        if (at == std::string::npos) continue;
+        std::stringstream list(c.deviation.substr(0, at));
+        for (std::string name; std::getline(list, name, '+');) {
+            const int i = m.deviationIndex(name);
+            EXPECT_GE(i, 0) << c.deviation;
+            if (i < 0) continue;
+            const DeviationDef& def = m.deviations[static_cast<size_t>(i)];
+            const Link& l = m.chain(def.side).links[def.link];
+            EXPECT_EQ(def.basis.type, ComponentBasis::Type::Table) << c.deviation << ": only a table loses a constant exactly";
+            const double zero = def.basis.evaluate(l.machineZero, out.values.data() + def.offset, l.modulo);
+            out.values.segment(def.offset, def.size()).array() -= zero;
+        }
+    }
+    return out;
+}
+
+/// The largest distance of the instrument's tool-side point (ball, nest) from an axis line over the plan's samples (mm;
+/// for a linear axis 1: its motion moves that point one to one).
+double lever(const Loop& l, int axis) {
+    if (l.machine.axisLink(axis).kind != AxisKind::Rotary) return 1.0;
+    const Kinematics k(l.machine);
+    double out = 0;
+    for (const testprog::RunMotion& r : testprog::planMotions(l.machine, l.plan))
+        for (size_t i = 0; i < r.sampleCount; ++i) {
+            const AxisVector q = r.at(r.points[i]);
+            const Vec3 tip = k.baseToTool(q) * k.toolPoint(r.toolLength);
+            for (const JointFrame& j : k.jointFrames(q))
+                if (j.axis == axis) out = std::max(out, (tip - j.point).cross(j.direction).norm());
+        }
+    return out;
+}
+
+/// What the backend's files cannot hold finer than a unit ("EBB (rounded to 0.0001 deg)": pitch data are whole detection
+/// units): each such table leaves up to half a unit either way, so the span it adds to a reading is at most one unit
+/// times the lever of its axis. Oracle for the bound: the geometry of the plan (lever), not the backend.
+double roundingAllowance(const Loop& l, const controllers::EmitResult& r) {
+    double out = 0;
+    for (const auto& c : r.notCompensated) {
+        const size_t at = c.deviation.find(" (rounded to ");
+        if (at == std::string::npos) continue;
+        std::istringstream in(c.deviation.substr(at + 13));
+        double unit = 0;
+        std::string what;
+        in >> unit >> what;
+        const int d = l.machine.deviationIndex(c.deviation.substr(0, c.deviation.find_first_of("+ ")));
+        EXPECT_TRUE(d >= 0 && unit > 0 && (what == "mm)" || what == "deg)")) << c.deviation;
+        if (d < 0) continue;
+        const DeviationDef& def = l.machine.deviations[static_cast<size_t>(d)];
+        out += unit * (what == "deg)" ? kDeg : 1.0) * lever(l, l.machine.chain(def.side).links[def.link].axisIndex);
+    }
+    return out;
+}
+
 VerifyOptions fastOptions() {
     VerifyOptions o;
     o.volumetricPerAxis = 3;
     return o;
 }
 
-/// Combinations whose apply model leaves more than 0.1 µm of what the backend claims, as measured on this branch
-/// (largest ΔL span after, µm). verify finds them: that is its job. The loop holds them to these figures (a backend that
-/// gets worse fails) and says when one has come below 0.1 µm (then delete its line). The backends' open work:
-///  - generic: the map is a multilinear grid at tool length 0 and the orientation is not corrected;
-///  - heidenhain-tnc, siemens-840d: tilts about X of the multi-tasking machine's C1, B, Y and C (EA0C1 EA0B EA0Z EA0C)
-///    stay (12–24 µm each alone), and the tilting head's component tables leave 10–14 µm;
-///  - isg on the table-table machine (0.77 µm), fanuc-30i on the tilting head (3.0 µm).
-struct KnownGap {
-    std::string_view backend, machine;
-    double boundUm;
-};
-constexpr KnownGap kKnownGaps[] = {
-    {"generic", "multitasking", 2.5},      {"heidenhain-tnc", "multitasking", 18.5}, {"siemens-840d", "multitasking", 18.5},
-    {"generic", "table-table-ac", 3.8},    {"isg", "table-table-ac", 0.85},          {"fanuc-30i", "tilting-head-b", 3.2},
-    {"generic", "tilting-head-b", 0.95},   {"heidenhain-tnc", "tilting-head-b", 11.0}, {"siemens-840d", "tilting-head-b", 14.6},
-};
-const KnownGap* knownGap(std::string_view backend, std::string_view machine) {
-    for (const KnownGap& g : kKnownGaps)
-        if (g.backend == backend && g.machine == machine) return &g;
-    return nullptr;
-}
-
 TEST(VerifyLoop, EmittedFilesLeaveLessThanATenthOfAMicrometreOfWhatEachBackendClaims) {
     for (const Case& c : kCases) {
         const Loop l = load(c);
         const DeviationSet identified = simulateAndIdentify(l, 0.0);
+        int backendsInTheLoop = 0;
         for (const controllers::Backend* b : controllers::backends()) {
-            const std::string where = std::string(c.machine) + " / " + std::string(b->name());
-            const controllers::EmitResult full = b->emit({l.machine, identified, "identified.csv", "2024-01-01"});
-            std::set<std::string> claimed;
-            for (const auto& cov : full.compensated) claimed.insert(cov.deviation);
+            const std::string where = std::string(c.machine) + (c.machineZero.empty() ? "" : " (machine-zero)") + " / " +
+                                      std::string(b->name());
+            controllers::EmitResult full;
+            try {
+                full = b->emit({l.machine, identified, "identified.csv", "2024-01-01"});
+            } catch (const ModelError& e) {
+                // A backend that does not take the machine says why (LinuxCNC: a rotary machine-zero; ...).
+                std::cout << "[ refused  ] " << where << ": " << e.what() << "\n";
+                continue;
+            }
+            ++backendsInTheLoop;
             // The loop restricted to what the backend claims: truth and identification without the others.
-            const DeviationSet truthClaimed = restricted(*l.truth, claimed), idClaimed = restricted(identified, claimed);
+            const DeviationSet truthClaimed = claimed(*l.truth, full), idClaimed = claimed(identified, full);
             const controllers::EmitResult files = b->emit({l.machine, idClaimed, "identified.csv", "2024-01-01"});
             VerifyCompensation comp;
             comp.kind = VerifyCompensation::Kind::ControllerFiles;
             comp.description = where;
             comp.model = std::shared_ptr<const controllers::AppliedCompensation>(b->apply(l.machine, files.files));
             const VerifyResult r = verify(l.machine, l.plan, truthClaimed, "truth", comp, fastOptions());
-            if (claimed.empty()) continue;
-            std::cout << "[ residual ] " << where << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm << " um)\n";
-            if (const KnownGap* g = knownGap(b->name(), c.machine)) {
-                EXPECT_LT(r.residual, g->boundUm * kUm) << where << ": a known gap got worse";
-                if (r.residual < 0.1 * kUm) std::cout << "[ fixed ] " << where << ": below 0.1 um now, remove it from kKnownGaps\n";
-                continue;
-            }
-            EXPECT_LT(r.residual, 0.1 * kUm) << where << ": before " << r.residualBefore / kUm << " um";
+            if (full.compensated.empty()) continue;
+            const double rounding = roundingAllowance(l, full);
+            std::cout << "[ residual ] " << where << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm
+                      << " um" << (rounding > 0 ? fmt::format(", rounding to the controller's unit up to {:.3f} um", rounding / kUm) : "")
+                      << ")\n";
+            EXPECT_LT(r.residual, 0.1 * kUm + rounding) << where << ": before " << r.residualBefore / kUm << " um";
             EXPECT_GT(r.residualBefore, 1.0 * kUm) << where;
         }
+        EXPECT_GE(backendsInTheLoop, 5) << c.machine;  // at most one refuses (LinuxCNC: rotary machine-zero)
     }
 }
 
@@ -158,7 +263,12 @@ TEST(VerifyLoop, WhatABackendLeavesIsNamedWithItsReason) {
         const DeviationSet identified = simulateAndIdentify(l, 0.0);
         for (const controllers::Backend* b : controllers::backends()) {
             const std::string where = std::string(c.machine) + " / " + std::string(b->name());
-            const controllers::EmitResult files = b->emit({l.machine, identified, "identified.csv", "2024-01-01"});
+            controllers::EmitResult files;
+            try {
+                files = b->emit({l.machine, identified, "identified.csv", "2024-01-01"});
+            } catch (const ModelError&) {
+                continue;  // refused: see the loop above
+            }
             VerifyCompensation comp;
             comp.kind = VerifyCompensation::Kind::ControllerFiles;
             comp.model = std::shared_ptr<const controllers::AppliedCompensation>(b->apply(l.machine, files.files));
@@ -190,6 +300,7 @@ TEST(VerifyLoop, WhatABackendLeavesIsNamedWithItsReason) {
 
 TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
     for (const Case& c : kCases) {
+        if (c.filesOnly) continue;
         const Loop l = load(c);
         const DeviationSet identified = simulateAndIdentify(l, 0.0);
         // testprog → cnccomp correct (with the run's tool length, as each program's header says) → verify.
@@ -220,6 +331,7 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
 TEST(VerifyLoop, WithHalfAMicrometreOfNoiseTheResidualStaysBelowThreeSigma) {
     const double sigma = 0.5;
     for (const Case& c : kCases) {
+        if (c.filesOnly) continue;
         Loop l = load(c);
         // The tilting head's 87 unknowns (5 tables × 17 nodes, 2 tilts) take the absolute runs sampled every degree
         // (the instrument samples continuously); at the plan's 15° the 102 samples leave 1.8 µm.

@@ -147,21 +147,18 @@ ControllerModel::ControllerModel(const MachineModel& machine, const std::vector<
 
 TcpTransform::TcpTransform(const MachineModel& machine, std::unique_ptr<const ControllerModel> controller,
                            double toolLength)
-    : nominal_(machine), controller_(std::move(controller)), toolLength_(0), tip_(Vec3::Zero()) {
+    : nominal_(machine), controller_(std::move(controller)), toolLength_(toolLength) {
     if (!controller_) throw ModelError("TCP transform without a controller model");
-    setToolLength(toolLength);
+    if (!std::isfinite(toolLength)) throw ModelError("TCP tool length must be a finite number");
 }
 
-void TcpTransform::setToolLength(double length) {
-    if (!std::isfinite(length)) throw ModelError("TCP tool length must be a finite number");
-    toolLength_ = length;
-    tip_ = nominal_.toolPoint(length);
-}
+AxisVector TcpTransform::solve(const AxisVector& programmed) const { return solve(programmed, toolLength_); }
 
-AxisVector TcpTransform::solve(const AxisVector& programmed) const {
-    const ToolPose target = toolPose(nominal_, programmed, tip_);
+AxisVector TcpTransform::solve(const AxisVector& programmed, double toolLength) const {
+    const Vec3 tip = nominal_.toolPoint(toolLength);
+    const ToolPose target = toolPose(nominal_, programmed, tip);
     const MachineModel& m = nominal_.machine();
-    const IkResult r = solveToolPose(controller_->kinematics(), target, tip_, m.toController(programmed));
+    const IkResult r = solveToolPose(controller_->kinematics(), target, tip, m.toController(programmed));
     return m.fromController(r.q);
 }
 

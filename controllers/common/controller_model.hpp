@@ -71,21 +71,28 @@ private:
 /// The TCP of a controller: programmed commands (meant for the nominal machine, in the description's frame) →
 /// nominal tool pose → the controller's machine coordinates at which its model (ControllerModel, controller
 /// coordinates) reaches that pose (Newton, solveToolPose) → back to the description's frame
-/// (MachineModel::fromController). The machine must outlive the transform.
+/// (MachineModel::fromController). The tool point is the active tool's tip: a TCP control computes with the length of
+/// the active tool's offset — Sinumerik: "an activated tool length compensation is included in the transformation"
+/// (840D sl Function Manual, transformations, "Selection and deselection"); HEIDENHAIN M128: "the position of the tool
+/// tip to the workpiece remains the same", "the tool length must refer to the spherical center of the tool tip" (TNC 620
+/// User's Manual DIN/ISO 5/2013, 11.4, p.340; iTNC 530 User's Manual, M128, p.524); Fanuc G43.4 with the tool length
+/// offset H (A-79348E) — so where the tool axis cannot be matched (four axes, or a singular orientation) the tip of
+/// that tool is still met. The machine must outlive the transform.
 class TcpTransform {
 public:
     TcpTransform(const MachineModel& machine, std::unique_ptr<const ControllerModel> controller,
                  double toolLength = kControllerToolLength);
+    /// With the default tool length (constructor).
     AxisVector solve(const AxisVector& programmed) const;
+    /// With the active tool's length (mm along the machine's tool direction from the tool reference point).
+    AxisVector solve(const AxisVector& programmed, double toolLength) const;
     const ControllerModel& controller() const { return *controller_; }
     double toolLength() const { return toolLength_; }
-    void setToolLength(double length);
 
 private:
     Kinematics nominal_;
     std::unique_ptr<const ControllerModel> controller_;
     double toolLength_;
-    Vec3 tip_;
 };
 
 /// The six location-error components (x y z a b c) a deviation set puts on one link (mm, rad).

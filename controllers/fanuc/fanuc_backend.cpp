@@ -86,7 +86,11 @@ FanucCompensation::FanucCompensation(const MachineModel& m, std::unique_ptr<cons
     : machine_(&m), tcp_(m, std::move(tcp)), pitch_(std::move(pitch)), unit_(unit) {}
 
 AxisVector FanucCompensation::driveCommands(const AxisVector& programmed) const {
-    const AxisVector q = tcp_.solve(programmed);
+    return driveCommandsForTool(programmed, tcp_.toolLength());
+}
+
+AxisVector FanucCompensation::driveCommandsForTool(const AxisVector& programmed, double toolLength) const {
+    const AxisVector q = tcp_.solve(programmed, toolLength);
     AxisVector out = q;
     // Pitch error compensation acts on the machine position of each axis (the controller's coordinates).
     const AxisVector p = machine_->toController(q);

@@ -17,8 +17,11 @@ class FanucCompensation final : public AppliedCompensation {
 public:
     FanucCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> tcp, std::vector<PitchTable> pitch,
                       double unit);
+    /// With the default tool length of the TCP (kControllerToolLength).
     AxisVector driveCommands(const AxisVector& programmed) const override;
-    TcpTransform& tcp() { return tcp_; }
+    /// The TCP with the active tool's length, then the tables at the resulting machine positions.
+    AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
+    const TcpTransform& tcp() const { return tcp_; }
     const std::vector<PitchTable>& pitch() const { return pitch_; }
 
 private:

@@ -94,6 +94,7 @@ ParameterFile parseParameterFile(const std::string& path, std::string_view text)
         }
         if (l == "%") {
             state = Done;
+            f.closingLine = lineNo;
             continue;
         }
         const auto fail = [&](const std::string& why) {
@@ -157,10 +158,15 @@ double value(const ParameterFile& f, int number, int index, double fallback, int
 
 double required(const ParameterFile& f, int number, int index, int q) {
     const Parameter* p = f.find(number, q);
-    if (!p || !p->values.count(index))
-        throw InputError(f.path, p ? p->line : 0,
-                         index == 0 ? fmt::format("parameter {} is missing", number)
-                                    : fmt::format("parameter {} has no value for {}{}", number, p && p->kind == 'A' ? "axis " : "path ", index));
+    if (!p)
+        throw InputError(f.path, f.closingLine,
+                         index == 0 ? fmt::format("parameter {} is missing: expected N{:05d}Q{}P<value> before the closing %",
+                                                  number, number, q)
+                                    : fmt::format("parameter {} is missing: expected a line N{:05d}Q{}(L|A){}P<value> before "
+                                                  "the closing %",
+                                                  number, number, q, index));
+    if (!p->values.count(index))
+        throw InputError(f.path, p->line, fmt::format("parameter {} has no value for {}{}", number, p->kind == 'A' ? "axis " : "path ", index));
     return value(f, number, index, 0.0, q);
 }
 

@@ -29,6 +29,7 @@ struct Parameter {
 struct ParameterFile {
     std::string path;
     std::vector<Parameter> parameters;
+    int closingLine = 0;  ///< line of the closing %: where a missing parameter was expected
     /// Parameter by (number, q), or nullptr.
     const Parameter* find(int number, int q = 1) const;
 };

@@ -50,6 +50,16 @@ int ownAxis(const DeviationDef& def, const Link& l) {
 
 }  // namespace
 
+double positioningError(const MachineModel& m, const Eigen::VectorXd& values, int axis, double command) {
+    const Link& l = m.axisLink(axis);
+    double e = 0;
+    for (const DeviationDef& def : m.deviations) {
+        if (def.kind != DeviationKind::Component || m.chain(def.side).links[def.link].axisIndex != axis) continue;
+        if (const int sign = ownAxis(def, l)) e += sign * def.basis.evaluate(command, values.data() + def.offset, l.modulo);
+    }
+    return e;
+}
+
 PitchPlan pitchFromDeviations(const MachineModel& m, const DeviationSet& d, const PitchOptions& o) {
     PitchPlan plan;
     std::map<int, std::vector<int>> byAxis;
@@ -84,14 +94,7 @@ PitchPlan pitchFromDeviations(const MachineModel& m, const DeviationSet& d, cons
             continue;
         }
         const double toFile = l.kind == AxisKind::Rotary ? 1.0 / kDeg : 1.0;
-        const auto err = [&](double pos) {
-            double e = 0;
-            for (int di : it->second) {
-                const DeviationDef& def = m.deviations[di];
-                e += ownAxis(def, l) * def.basis.evaluate(commandOf(l, pos), d.values.data() + def.offset, l.modulo);
-            }
-            return e * toFile;
-        };
+        const auto err = [&](double pos) { return positioningError(m, d.values, a, commandOf(l, pos)) * toFile; };
         if (grid.modulo && std::abs(err(0.0) - err(360.0)) > 1e-9) {
             reject("not periodic over one revolution: a rotary-axis pitch table must sum to zero");
             continue;
@@ -141,21 +144,34 @@ PitchPlan pitchFromDeviations(const MachineModel& m, const DeviationSet& d, cons
             throw ModelError(fmt::format("fanuc-30i: the pitch error tables need {} compensation points; the control holds {}",
                                          base, o.maxPoints));
         const std::string axisWord = fmt::format("A{}", controllerAxisNumber(m, a));
+        const bool constant = std::abs(e0) > o.unit / 2;
+        const bool linear = l.kind == AxisKind::Linear;
         for (int di : it->second)
             plan.compensated.push_back({m.deviations[di].name,
                                         fmt::format("pitch error compensation of {} ({}): points {}..{}, reference {}, "
-                                                    "interval {:g} {}, magnification {}",
+                                                    "interval {:g} {}, magnification {}{}",
                                                     axisWord, l.name, t.negative, t.positive, t.reference, t.interval,
-                                                    l.kind == AxisKind::Rotary ? "deg" : "mm", t.magnification)});
-        if (std::abs(e0) > o.unit / 2) {
+                                                    linear ? "mm" : "deg", t.magnification,
+                                                    constant && linear ? "; its value at the reference position in the TCP "
+                                                                         "offsets and 1220"
+                                                                       : "")});
+        {
+            // Whole detection units per point: the table holds the error to half a unit.
+            std::string names;
+            for (int di : it->second) names += (names.empty() ? "" : "+") + m.deviations[di].name;
+            plan.notCompensated.push_back(
+                {fmt::format("{} (rounded to {:g} {})", names, o.unit, linear ? "mm" : "deg"),
+                 fmt::format("pitch data are whole detection units (IS-C [G]): up to {:g} {} is left at each point",
+                             o.unit / 2 * (linear ? 1000.0 : 3600.0), linear ? "um" : "arcsec")});
+        }
+        if (constant && !linear) {
             std::string names;
             for (int di : it->second) names += (names.empty() ? "" : "+") + m.deviations[di].name;
             plan.notCompensated.push_back(
                 {names + " (constant part)",
-                 fmt::format("{} {} at the reference position: a pitch table is zero there (shift the reference "
-                             "position instead)",
-                             fixed(e0 * (l.kind == AxisKind::Rotary ? 3600.0 : 1000.0), 3),
-                             l.kind == AxisKind::Rotary ? "arcsec" : "um")});
+                 fmt::format("{} arcsec at the reference position: a zero-position error, which a pitch table cannot hold "
+                             "(zero there) nor a TCP parameter (shift the reference position, parameter 1850, by hand [G])",
+                             fixed(e0 * 3600.0, 3))});
         }
         plan.tables.push_back(std::move(t));
     }

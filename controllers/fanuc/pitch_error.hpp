@@ -15,7 +15,9 @@
 //   (point 3620's section, the last interval before 0 deg, is the one that ends at 360 deg).
 // Positions are the controller's machine coordinates (Link::machineZero). Values are in detection units
 // (IS-C: 0.0001 mm / 0.0001 deg [G]). The compensation is the correction added to the command (= -positioning error)
-// [G: sign]; it is zero at the reference position, so the error's own value there is reported as not compensated.
+// [G: sign]; it is zero at the reference position. The error's own value there is a constant offset of the axis: on a
+// linear axis the TCP offsets and 1220 hold it (tcp_parameters.hpp); on a rotary axis it is a zero-position error, which
+// no parameter cnccomp writes holds: reported as not compensated.
 // The apply model interpolates linearly inside a section [G: the control may output it as a step at the point].
 #include <string>
 #include <vector>
@@ -51,6 +53,10 @@ struct PitchPlan {
     std::vector<PitchTable> tables;
     std::vector<Coverage> compensated, notCompensated;
 };
+
+/// The positioning error of an axis (the sum of its positioning component errors EXX / ECC ..., along the axis) at a
+/// command (internal units), from a flat deviation vector.
+double positioningError(const MachineModel& m, const Eigen::VectorXd& values, int axis, double command);
 
 /// Positioning component errors (EXX of X, ECC of C, ...) → tables. Other component errors are reported NOT
 /// compensated. Throws ModelError when a limit is exceeded.

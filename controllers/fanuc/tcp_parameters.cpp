@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "controllers/fanuc/pitch_error.hpp"
 
 namespace cnccomp::controllers::fanuc {
 namespace {
@@ -19,7 +20,9 @@ struct Walk {
 };
 
 /// Chain at the controller's zero (every axis at its machine zero: the description's command Link::machineZero), with
-/// the translation part of the location errors only. Points and directions are those of each axis line.
+/// the translation part of the location errors only, and each linear axis' positioning error at its machine zero (the
+/// value the pitch table leaves, zero at the reference position: a constant offset of everything the axis carries).
+/// Points and directions are those of each axis line.
 Walk walk(const MachineModel& m, const Eigen::VectorXd& values, Side side) {
     const Chain& c = m.chain(side);
     Walk w;
@@ -33,7 +36,8 @@ Walk walk(const MachineModel& m, const Eigen::VectorXd& values, Side side) {
         p = p * l.placement * t;
         w.point[i] = p.translation();
         w.dir[i] = p.linear() * l.direction;
-        if (l.kind == AxisKind::Linear) p.translation() += p.linear() * l.direction * l.machineZero;
+        if (l.kind == AxisKind::Linear)
+            p.translation() += p.linear() * l.direction * (l.machineZero + positioningError(m, values, l.axisIndex, l.machineZero));
         if (l.kind == AxisKind::Rotary) p.linear() = p.linear() * axisRotation(l.direction, l.machineZero);
     }
     w.end = p.translation();

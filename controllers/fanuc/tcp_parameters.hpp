@@ -23,7 +23,7 @@
 // in the controller's machine coordinate system at machine coordinates 0 (all axes at their Link::machineZero, rotary
 // axes at 0 deg as A-79348E defines the vectors "when the rotation axes are all at 0 degrees").
 // What the TCP parameters hold: the translation location errors (pivot positions, spindle offsets, axis
-// offsets). Orientation errors of rotary axes, squareness and component errors other than positioning have
+// offsets) and the constant part of the linear axes' positioning errors (a shift of all the axis carries). Orientation errors of rotary axes, squareness and component errors other than positioning have
 // no 30i TCP parameter (3-D error compensation numbers are not public) and are reported NOT compensated.
 #include <vector>
 
@@ -50,7 +50,8 @@ struct TcpParameters {
     Vec3 workZero = Vec3::Zero();           ///< 1220 (X Y Z)
 };
 
-/// Parameters of the machine with the translation location errors of `values` (rotations ignored).
+/// Parameters of the machine with the translation location errors of `values` (rotations ignored) and the linear axes'
+/// positioning errors at the reference position (the constant part the pitch tables leave).
 /// Throws ModelError for a structure the 30i TCP does not take (more than two rotary axes, two on one side
 /// with type 21 impossible, linear axes on the table side, axes not along X/Y/Z, a tool not along an axis).
 TcpParameters tcpFromMachine(const MachineModel& m, const Eigen::VectorXd& values);

@@ -17,7 +17,9 @@
 namespace cnccomp::controllers::generic {
 namespace {
 
-constexpr const char* kValueColumns[] = {"dx_um", "dy_um", "dz_um", "dkx_urad", "dky_urad", "dkz_urad"};
+// Machine-frame errors (version 2; version 1 had workpiece-frame columns dx_um ... dkz_urad, which the reader refuses).
+constexpr const char* kValueColumns[] = {"dx_machine_um",     "dy_machine_um",     "dz_machine_um",
+                                         "dkx_machine_urad", "dky_machine_urad", "dkz_machine_urad"};
 
 std::string axisColumn(const MachineModel& m, int a) {
     return m.axisNames[a] + (m.axisLink(a).kind == AxisKind::Rotary ? "_deg" : "_mm");
@@ -89,59 +91,210 @@ void GridMap::at(const AxisVector& q, Vec3& tipError, Vec3& axisError) const {
     }
 }
 
-GridMap buildGridMap(const MachineModel& m, const DeviationSet& d) {
-    GridMap g;
+namespace {
+
+/// Travel of an axis on the map: rotary axes clamped to ±180°.
+std::pair<double, double> mapTravel(const Link& l) {
+    double lo = l.min, hi = l.max;
+    if (l.kind == AxisKind::Rotary) {
+        lo = std::max(lo, -kPi);
+        hi = std::min(hi, kPi);
+    }
+    if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
+        throw ModelError(fmt::format("axis {} has no finite travel: the grid map needs one", l.name));
+    return {lo, hi};
+}
+
+/// Ends of the travel and the nodes of the axis' table-type component errors inside it: the tip error has a kink
+/// there, which multilinear interpolation only reproduces with a node on it.
+std::vector<double> baseNodes(const MachineModel& m, const DeviationSet& d, int a) {
+    const Link& l = m.axisLink(a);
+    const auto [lo, hi] = mapTravel(l);
+    std::set<double> s = {lo, hi};
+    for (size_t k = 0; k < m.deviations.size(); ++k) {
+        const DeviationDef& def = m.deviations[k];
+        if (!d.present[k] || def.kind != DeviationKind::Component || m.chain(def.side).links[def.link].axisIndex != a) continue;
+        if (def.basis.type != ComponentBasis::Type::Table) continue;
+        for (double n : def.basis.nodes) {
+            double u = n;
+            if (l.modulo) u = std::remainder(u, 2 * kPi);  // into [-π, π]
+            if (u > lo + 1e-12 && u < hi - 1e-12) s.insert(u);
+        }
+    }
+    return {s.begin(), s.end()};
+}
+
+/// Values of the other axes at which an axis' nodes are tested: linear axes at their ends (the tip error of location
+/// errors is affine in a linear axis), the middle too when it carries component errors, rotary axes every 30°.
+std::vector<std::vector<double>> probeValues(const MachineModel& m, const std::vector<std::vector<double>>& base) {
+    std::vector<std::vector<double>> out(static_cast<size_t>(m.axisCount()));
     for (int a = 0; a < m.axisCount(); ++a) {
+        const Link& l = m.axisLink(a);
+        const auto [lo, hi] = mapTravel(l);
+        const int count = l.kind == AxisKind::Rotary ? static_cast<int>(std::ceil((hi - lo) / (30 * kDeg) - 1e-9)) + 1
+                                                     : (base[static_cast<size_t>(a)].size() > 2 ? 5 : 2);
+        for (int i = 0; i < count; ++i) out[static_cast<size_t>(a)].push_back(lo + (hi - lo) * i / (count - 1));
+    }
+    return out;
+}
+
+}  // namespace
+
+void machineFrameError(const Kinematics& nominal, const Kinematics& actual, const AxisVector& q, Vec3& tipError,
+                       Vec3& axisError) {
+    const Vec3 tip0 = nominal.toolPoint(0.0);
+    const ToolPose n = toolPose(nominal, q, tip0), e = toolPose(actual, q, tip0);
+    const Mat3 bRw = nominal.baseToWorkpiece(q).linear();
+    tipError = bRw * (e.tip - n.tip);
+    axisError = bRw * (e.axis - n.axis);
+}
+
+GridMap buildGridMap(const MachineModel& m, const DeviationSet& d, const GridMapOptions& o) {
+    if (!(o.tolerance > 0) || !(o.toolLength >= 0) || o.maxNodes < 2)
+        throw ModelError("grid map: tolerance, tool length and node budget must be positive");
+    const Kinematics nominal(m), actual(m, d);
+    const int n = m.axisCount();
+    // The map's value at commands q: the tip error at tool length 0 and at the reference length (both interpolated).
+    const auto value = [&](const AxisVector& q) {
+        Vec3 tip, axis;
+        machineFrameError(nominal, actual, q, tip, axis);
+        Vec6 v;
+        v.head<3>() = tip;
+        v.tail<3>() = tip + o.toolLength * axis;
+        return v;
+    };
+    std::vector<std::vector<double>> base(static_cast<size_t>(n));
+    for (int a = 0; a < n; ++a) base[static_cast<size_t>(a)] = baseNodes(m, d, a);
+    const auto probes = probeValues(m, base);
+    // Per axis: the other axes at their probe values (all combinations, at most ~250 of them, evenly strided).
+    std::vector<std::vector<AxisVector>> others(static_cast<size_t>(n));
+    for (int a = 0; a < n; ++a) {
+        long combos = 1;
+        for (int o2 = 0; o2 < n; ++o2)
+            if (o2 != a) combos *= static_cast<long>(probes[static_cast<size_t>(o2)].size());
+        const long stride = std::max(1L, combos / 250);
+        for (long c = 0; c < combos; c += stride) {
+            AxisVector q = AxisVector::Zero(n);
+            long r = c;
+            for (int o2 = n - 1; o2 >= 0; --o2) {
+                if (o2 == a) continue;
+                const auto& v = probes[static_cast<size_t>(o2)];
+                q[o2] = v[static_cast<size_t>(r % static_cast<long>(v.size()))];
+                r /= static_cast<long>(v.size());
+            }
+            others[static_cast<size_t>(a)].push_back(q);
+        }
+    }
+    // Each base interval split evenly into as many parts as keep the midpoint deviation of the linear interpolation
+    // (h²/8 · curvature) within the tolerance for every probe: parts and the deviation they leave, from a first guess.
+    struct Split {
+        int k = 1;
+        double worst = 0;
+    };
+    const auto split = [&](int a, double u, double v, double tolerance, int k) {
+        for (;;) {
+            double worst = 0;
+            for (AxisVector q : others[static_cast<size_t>(a)]) {
+                const auto at = [&](double x) {
+                    q[a] = x;
+                    return value(q);
+                };
+                Vec6 left = at(u);
+                for (int j = 1; j <= k; ++j) {
+                    const double x0 = u + (v - u) * (j - 1) / k, x1 = j == k ? v : u + (v - u) * j / k;
+                    const Vec6 right = at(x1), mid = at(0.5 * (x0 + x1));
+                    const Vec6 dev = mid - 0.5 * (left + right);
+                    worst = std::max({worst, dev.head<3>().norm(), dev.tail<3>().norm()});
+                    left = right;
+                }
+            }
+            if (worst <= tolerance) return Split{k, worst};
+            if (k >= 100000)
+                throw ModelError(fmt::format("grid map: axis {} needs more than {} nodes per interval for {} um",
+                                             m.axisNames[a], k, tolerance / kUm));
+            k = std::max(k + 1, static_cast<int>(std::ceil(k * std::sqrt(worst / tolerance) * 1.05)));
+        }
+    };
+    std::vector<std::vector<Split>> splits(static_cast<size_t>(n));
+    for (int a = 0; a < n; ++a) {
+        const auto& b = base[static_cast<size_t>(a)];
+        for (size_t i = 0; i + 1 < b.size(); ++i) splits[static_cast<size_t>(a)].push_back(split(a, b[i], b[i + 1], o.tolerance, 1));
+    }
+    const auto nodeCount = [&] {
+        long total = 1;
+        for (const auto& axis : splits) {
+            long count = 1;
+            for (const Split& p : axis) count += p.k;
+            total *= count;
+        }
+        return total;
+    };
+    GridMap g;
+    g.tolerance = o.tolerance;
+    if (nodeCount() > o.maxNodes) {
+        long least = 1;
+        for (const auto& b : base) least *= static_cast<long>(b.size());
+        if (least > o.maxNodes)
+            throw ModelError(fmt::format("the grid map needs at least {} nodes (the travel ends and the component tables' "
+                                         "nodes); the limit is {}",
+                                         least, o.maxNodes));
+        // The tolerance doubles until the grid fits the node budget (many component errors on many axes): the parts
+        // predicted from the deviation's 1/k² law, then checked (a check that needs more parts doubles again).
+        const auto exact = splits;
+        for (;;) {
+            g.tolerance *= 2;
+            for (size_t a = 0; a < splits.size(); ++a)
+                for (size_t i = 0; i < splits[a].size(); ++i) {
+                    const Split& e = exact[a][i];
+                    splits[a][i].k = std::max(1, static_cast<int>(std::ceil(e.k * std::sqrt(e.worst / g.tolerance) - 1e-9)));
+                }
+            if (nodeCount() > o.maxNodes) continue;
+            for (int a = 0; a < n; ++a) {
+                const auto& b = base[static_cast<size_t>(a)];
+                for (size_t i = 0; i + 1 < b.size(); ++i) {
+                    Split& p = splits[static_cast<size_t>(a)][i];
+                    p = split(a, b[i], b[i + 1], g.tolerance, p.k);
+                }
+            }
+            if (nodeCount() <= o.maxNodes) break;
+        }
+    }
+    for (int a = 0; a < n; ++a) {
         const Link& l = m.axisLink(a);
         GridMapAxis ax;
         ax.axis = a;
         ax.rotary = l.kind == AxisKind::Rotary;
-        bool components = false;
-        for (size_t k = 0; k < m.deviations.size(); ++k) {
-            const DeviationDef& def = m.deviations[k];
-            if (d.present[k] && def.kind == DeviationKind::Component && m.chain(def.side).links[def.link].axisIndex == a) components = true;
+        const auto& b = base[static_cast<size_t>(a)];
+        ax.wraps = l.modulo && std::abs(b.back() - b.front() - 2 * kPi) < 1e-12;
+        ax.nodes.push_back(b.front());
+        for (size_t i = 0; i + 1 < b.size(); ++i) {
+            const int k = splits[static_cast<size_t>(a)][i].k;
+            for (int j = 1; j <= k; ++j) ax.nodes.push_back(j == k ? b[i + 1] : b[i] + (b[i + 1] - b[i]) * j / k);
         }
-        double lo = l.min, hi = l.max;
-        int count;
-        if (ax.rotary) {
-            lo = std::max(lo, -kPi);
-            hi = std::min(hi, kPi);
-            count = static_cast<int>(std::ceil((hi - lo) / (30 * kDeg) - 1e-9)) + 1;
-            ax.wraps = l.modulo && std::abs(hi - lo - 2 * kPi) < 1e-12;
-        } else {
-            count = components ? 5 : 2;
-        }
-        if (!std::isfinite(lo) || !std::isfinite(hi) || !(hi > lo))
-            throw ModelError(fmt::format("axis {} has no finite travel: the grid map needs one", l.name));
-        for (int i = 0; i < count; ++i) ax.nodes.push_back(i + 1 == count ? hi : lo + (hi - lo) * i / (count - 1));
         g.axes.push_back(std::move(ax));
     }
     long total = 1;
     for (const GridMapAxis& ax : g.axes) total *= static_cast<long>(ax.nodes.size());
-    if (total > 2'000'000) throw ModelError(fmt::format("the grid map would have {} nodes (limit 2 000 000)", total));
-    const Kinematics nominal(m), actual(m, d);
-    const Vec3 tip0 = nominal.toolPoint(0.0);
     g.tip.resize(static_cast<size_t>(total));
     g.toolAxis.resize(static_cast<size_t>(total));
-    AxisVector q(m.axisCount());
+    AxisVector q(n);
     for (long i = 0; i < total; ++i) {
         long r = i;
-        for (int a = m.axisCount() - 1; a >= 0; --a) {
+        for (int a = n - 1; a >= 0; --a) {
             const auto& x = g.axes[a].nodes;
             q[a] = x[static_cast<size_t>(r % static_cast<long>(x.size()))];
             r /= static_cast<long>(x.size());
         }
-        const ToolPose n = toolPose(nominal, q, tip0), e = toolPose(actual, q, tip0);
-        g.tip[i] = e.tip - n.tip;
-        g.toolAxis[i] = e.axis - n.axis;
+        machineFrameError(nominal, actual, q, g.tip[i], g.toolAxis[i]);
     }
     return g;
 }
 
 std::string formatGridMapCsv(const GridMap& g, const MachineModel& m, const std::string& header) {
     std::string s = header;
-    s += "# tool-tip error at tool length 0 (dx dy dz, um) and tool-axis unit-vector error (dkx dky dkz, urad), workpiece frame;\n"
-         "# error at tool length L = (dx dy dz) + L * (dkx dky dkz); rows: last axis fastest; interpolate multilinearly\n";
+    s += "# tool-tip error at tool length 0 (dx dy dz, um) and tool-axis unit-vector error (dkx dky dkz, urad) of the tool\n"
+         "# relative to the workpiece, along the machine's X Y Z (bed frame); error at tool length L = (dx dy dz) + L * (dkx dky dkz);\n"
+         "# rows: last axis fastest; interpolate multilinearly\n";
     for (int a = 0; a < m.axisCount(); ++a) s += axisColumn(m, a) + ",";
     for (size_t i = 0; i < std::size(kValueColumns); ++i) s += std::string(kValueColumns[i]) + (i + 1 < std::size(kValueColumns) ? "," : "\n");
     std::vector<size_t> idx(g.axes.size(), 0);
@@ -160,9 +313,10 @@ std::string formatGridMapCsv(const GridMap& g, const MachineModel& m, const std:
 }
 
 std::string formatGridMapJson(const GridMap& g, const MachineModel& m, const std::vector<std::string>& header) {
-    std::string s = "{\n  \"format\": \"cnccomp-grid-map\",\n  \"version\": 1,\n  \"header\": [\n";
+    std::string s = "{\n  \"format\": \"cnccomp-grid-map\",\n  \"version\": 2,\n  \"header\": [\n";
     for (size_t i = 0; i < header.size(); ++i) s += "    " + jsonString(header[i]) + (i + 1 < header.size() ? ",\n" : "\n");
     s += fmt::format("  ],\n  \"machine\": {},\n  \"toolLength_mm\": 0,\n", jsonString(m.name));
+    s += "  \"frame\": \"machine (bed): errors of the tool relative to the workpiece along the machine's X Y Z\",\n";
     s += "  \"order\": \"row-major over grid, last axis fastest; error at tool length L = tip + L * toolAxis\",\n  \"grid\": [\n";
     for (size_t a = 0; a < g.axes.size(); ++a) {
         std::vector<double> nodes;

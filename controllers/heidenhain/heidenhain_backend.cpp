@@ -15,6 +15,10 @@ class HeidenhainCompensation final : public AppliedCompensation {
 public:
     explicit HeidenhainCompensation(TcpTransform tcp) : tcp_(std::move(tcp)) {}
     AxisVector driveCommands(const AxisVector& programmed) const override { return tcp_.solve(programmed); }
+    /// M128 / FUNCTION TCPM computes with the active tool's length from the tool table.
+    AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override {
+        return tcp_.solve(programmed, toolLength);
+    }
 
 private:
     TcpTransform tcp_;

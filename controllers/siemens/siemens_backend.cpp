@@ -47,7 +47,11 @@ SiemensCompensation::SiemensCompensation(const MachineModel& m, std::unique_ptr<
     : machine_(&m), tcp_(m, std::move(chain)), cec_(std::move(cec)), eec_(std::move(eec)) {}
 
 AxisVector SiemensCompensation::driveCommands(const AxisVector& programmed) const {
-    const AxisVector q = tcp_.solve(programmed);
+    return driveCommandsForTool(programmed, tcp_.toolLength());
+}
+
+AxisVector SiemensCompensation::driveCommandsForTool(const AxisVector& programmed, double toolLength) const {
+    const AxisVector q = tcp_.solve(programmed, toolLength);
     // CEC and EEC tables are looked up at the machine positions (the NCK's machine coordinates, K3).
     const AxisVector p = machine_->toController(q);
     AxisVector out = q;

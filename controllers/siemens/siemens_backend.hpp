@@ -19,8 +19,11 @@ class SiemensCompensation final : public AppliedCompensation {
 public:
     SiemensCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> chain, std::vector<CecTable> cec,
                         std::vector<EecTable> eec);
+    /// With the default tool length of the TCP (kControllerToolLength).
     AxisVector driveCommands(const AxisVector& programmed) const override;
-    TcpTransform& tcp() { return tcp_; }
+    /// The TCP with the active tool's length, then the tables at the resulting machine positions.
+    AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
+    const TcpTransform& tcp() const { return tcp_; }
     const std::vector<CecTable>& cec() const { return cec_; }
     const std::vector<EecTable>& eec() const { return eec_; }
 
