@@ -33,5 +33,7 @@ struct CliResult {
 };
 /// Runs the cnccomp executable with `args` (shell-quoted by the caller).
 CliResult runCli(const std::string& args);
+/// Path of the cnccomp executable (for scripts that run it themselves).
+std::string cliPath();
 
 }  // namespace cnccomp::test

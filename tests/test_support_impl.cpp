@@ -33,6 +33,8 @@ std::string readText(const std::string& path) {
     return s.str();
 }
 
+std::string cliPath() { return CNCCOMP_CLI; }
+
 CliResult runCli(const std::string& args) {
     const std::string cmd = std::string(CNCCOMP_CLI) + " " + args + " 2>&1";
     FILE* p = popen(cmd.c_str(), "r");
