@@ -133,6 +133,16 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     }
 }
 
+TEST(Quickstart, AFolderItDidNotMakeIsNeverEmptied) {
+    test::ScratchDir dir("quickstart-foreign");
+    test::writeText(dir.file("mine.txt"), "keep me");
+    const auto r = test::runCommand("bash " + test::sourcePath("tools/quickstart.sh") + " --no-build --cnccomp " + test::cliPath() +
+                                    " --out " + dir.path.string());
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("was not made by this script"), std::string::npos) << r.out;
+    EXPECT_EQ(test::readText(dir.file("mine.txt")), "keep me");
+}
+
 TEST(Quickstart, SimulatedInstrumentFilesAreImportedLikeMeasuredOnes) {
     // Round trip: the truth comes back from files in the instrument's layouts (noise-free).
     test::ScratchDir dir("instrument");

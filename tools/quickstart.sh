@@ -18,16 +18,23 @@
 # usage: bash tools/quickstart.sh [--out DIR] [--no-build] [--cnccomp PATH]
 #   --no-build   skip installing packages and building (the test tests/test_quickstart.cpp runs the chain this way)
 set -euo pipefail
-cd "$(dirname "$0")/.."
-out=out/quickstart build=1 cnccomp=build/cnccomp
+root=$(cd "$(dirname "$0")/.." && pwd)
+out=$root/out/quickstart build=1 cnccomp=$root/build/cnccomp
 while (($#)); do
   case "$1" in
-    --out) out=$2; shift 2 ;;
+    --out) out=$(realpath -m "$2"); shift 2 ;;
     --no-build) build=0; shift ;;
-    --cnccomp) cnccomp=$2; shift 2 ;;
+    --cnccomp) cnccomp=$(realpath -m "$2"); shift 2 ;;
     *) echo "usage: bash tools/quickstart.sh [--out DIR] [--no-build] [--cnccomp PATH]" >&2; exit 2 ;;
   esac
 done
+# The output folder is emptied first: only a folder this script made (it holds .quickstart) or an empty one.
+if [ -e "$out" ] && { [ ! -d "$out" ] || { [ -n "$(ls -A "$out")" ] && [ ! -e "$out/.quickstart" ]; }; }; then
+  echo "quickstart: $out exists and was not made by this script; give another --out" >&2
+  exit 2
+fi
+cd "$root"
+out=${out#"$root"/}  # relative to the repository when inside it (shorter to read)
 if ((build)); then
   bash tools/deps.sh
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -41,6 +48,8 @@ T=samples/deviations/multitasking-truth.csv          # the real machine's deviat
 PART=samples/gcode/multitasking-5axis.ngc            # a 5-axis part program
 controllers=(fanuc-30i generic heidenhain-tnc isg linuxcnc siemens-840d)
 rm -rf "$out"
+mkdir -p "$out"
+echo "outputs of tools/quickstart.sh (this folder is emptied when it runs again)" > "$out/.quickstart"
 mkdir -p "$out"/{1-testprog,2-ballbar,3-identify,4-map,5-emit,6-correct/testprog,7-verify}
 step() { echo; echo "== $*"; }
 
