@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # README command 1, the main job: the whole calibration loop on the bundled multi-tasking sample, step by step as
-# you would run it on a real machine with a ball bar. A simulation stands in for the machine and the ball bar only
-# in step 2; every other step is the command you would type.
+# you would run it on a real machine with a ball bar. A simulation stands in for the machine and the ball bar in step
+# 2 (the measurement) and in step 7 (verify --truth: where you would load the files and measure again; without --truth
+# verify predicts on the identified machine, as emit does in step 5); every command is the one you would type.
 #
 #   1 testprog  the NC programs that make the plan's six ball-bar runs
 #   2 simulate  running them with a ball bar: the instrument's time-sampled files, CW then CCW  (the stand-in)
