@@ -3,9 +3,7 @@
 // least squares on the exact model (default, the most accurate) or the formulas of the paper the measurement comes
 // from. Every output is written after every computation succeeded.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
-#include <filesystem>
 
 #include <fmt/format.h>
 
