@@ -30,7 +30,11 @@ struct CliResult {
     int exitCode;
     std::string out;  ///< stdout and stderr together
 };
+/// Runs a shell command line (quoted by the caller), stdout and stderr together.
+CliResult runCommand(const std::string& command);
 /// Runs the cnccomp executable with `args` (shell-quoted by the caller).
 CliResult runCli(const std::string& args);
+/// Path of the cnccomp executable (for scripts that run it themselves).
+std::string cliPath();
 
 }  // namespace cnccomp::test

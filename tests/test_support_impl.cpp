@@ -45,8 +45,12 @@ std::string readText(const std::string& path) {
     return s.str();
 }
 
-CliResult runCli(const std::string& args) {
-    const std::string cmd = std::string(CNCCOMP_CLI) + " " + args + " 2>&1";
+std::string cliPath() { return CNCCOMP_CLI; }
+
+CliResult runCli(const std::string& args) { return runCommand(std::string(CNCCOMP_CLI) + " " + args); }
+
+CliResult runCommand(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     FILE* p = popen(cmd.c_str(), "r");
     CliResult r{-1, {}};
     if (!p) return r;

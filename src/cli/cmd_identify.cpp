@@ -3,9 +3,7 @@
 // least squares on the exact model (default, the most accurate) or the formulas of the paper the measurement comes
 // from. Every output is written after every computation succeeded.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
-#include <filesystem>
 
 #include <fmt/format.h>
 
@@ -31,13 +29,6 @@ struct Options {
     std::string anglesOut, volumetricOut, isoOut, profileOut;
     std::string reportControllers, reportGrid, reportPlane = "XY";
 };
-
-/// --report R.html / R.htm: the HTML report; anything else: the JSON solver report.
-bool htmlReport(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext == ".html" || ext == ".htm";
-}
 
 std::vector<std::string> splitList(const std::string& text) {
     std::vector<std::string> out;
@@ -83,7 +74,7 @@ void run(Options o) {
     } else if (!o.measure.empty() && o.measure != "ball-bar") {
         throw ModelError("--measure needs the plan (--plan P.xml)");
     }
-    const bool html = !o.report.empty() && htmlReport(o.report);
+    const bool html = !o.report.empty() && report::isHtmlPath(o.report);
     if ((!o.reportControllers.empty() || !o.reportGrid.empty()) && !html)
         throw ModelError("--report-controllers and --report-grid belong to an HTML report: give --report R.html");
     if (!o.profileOut.empty() && !r.components) throw ModelError("--profile-out needs --components");
@@ -132,6 +123,7 @@ void run(Options o) {
                    {"fit", fmt::format("{} samples, rank {}/{}, condition number {:.4g}, sigma {:.4f} µm", rep.observations,
                                        rep.rank, rep.unknowns, rep.conditionNumber, rep.sigma / kUm)}};
         d.warnings = rep.warnings;
+        d.afterNote = "the run with the identified deviations compensated";
         d.runs = runs;
         d.deviations = report::deviationRows(rep);
         for (const Combination& c : rep.identifiable) d.combinations.push_back(c.text);

@@ -2,6 +2,9 @@
 // known deviations; one CSV per run (ball-bar runs with their metadata, which the import checks), and eccentricities.csv
 // for the ball-bar runs. Everything is computed, then every file is staged and committed together (io/output_set.hpp):
 // a failing run leaves no output.
+// --instrument time|angle: the ball-bar runs written as an instrument exports them instead (the plan's capture: passes
+// and directions, overshoot, columns, units; io/trace_export.hpp), a simulated measurement standing in for the ball
+// bar that `identify` imports like a measured one.
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -21,12 +24,13 @@
 #include "cnccomp/io/rtest_csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_csv.hpp"
+#include "cnccomp/io/trace_export.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, plan, deviations, out;
+    std::string machine, plan, deviations, out, instrument;
     double noiseUm = 0.0;
     unsigned long seed = 1;
 };
@@ -44,6 +48,10 @@ void run(const Options& o) {
     const DeviationSet d = o.deviations.empty() ? DeviationSet(m) : readDeviationCsv(o.deviations, m);
     if (!(o.noiseUm >= 0) || !std::isfinite(o.noiseUm)) throw ModelError("--noise-um must be zero or positive");
     if (plan.runCount() == 0) throw ModelError(fmt::format("plan '{}' has no runs", o.plan));
+    if (!o.instrument.empty() && o.instrument != "time" && o.instrument != "angle")
+        throw InputError("--instrument", 0, fmt::format("'{}' is not time or angle", o.instrument));
+    if (!o.instrument.empty() && plan.runs.empty())
+        throw ModelError(fmt::format("--instrument: plan '{}' has no ball-bar runs", o.plan));
     const Kinematics k(m, d);
     std::mt19937_64 rng(o.seed);
     std::normal_distribution<double> noise(0.0, o.noiseUm * kUm);
@@ -58,7 +66,23 @@ void run(const Options& o) {
         std::string text = formatTraceCsv(t, run, run ? m.name : std::string());
         pending.push_back({name + ".csv", name, kind, n, [text = std::move(text)](std::ostream& out) { out << text; }});
     };
-    for (const BallbarRun& r : plan.runs) addTrace(r.name, simulateRun(k, r), "ball bar", &r);
+    if (o.instrument.empty()) {
+        for (const BallbarRun& r : plan.runs) addTrace(r.name, simulateRun(k, r), "ball bar", &r);
+    } else {
+        // As the instrument records and exports them: every pass of the capture, overshoot included, noise on every sample.
+        for (const BallbarRun& r : plan.runs) {
+            std::vector<DirectedTrace> passes = simulateCapturedPasses(k, r);
+            size_t n = 0;
+            for (DirectedTrace& p : passes) {
+                if (o.noiseUm > 0)
+                    for (double& v : p.trace.dL) v += noise(rng);
+                n += p.trace.dL.size();
+            }
+            std::string text = formatCapturedTrace(r, passes, o.instrument == "time", m.name);
+            pending.push_back({r.name + ".csv", r.name, o.instrument + "-sampled", n,
+                               [text = std::move(text)](std::ostream& out) { out << text; }});
+        }
+    }
     for (const BallbarRun& r : plan.absoluteRuns) addTrace(r.name, simulateAbsoluteRun(k, r), "absolute bar", &r);
     for (const Dbb5Run& r : plan.dbb5Runs) addTrace(r.name, simulateDbb5(k, r), "DBB5", nullptr);
     for (const RtestRun& r : plan.rtestRuns) {
@@ -70,7 +94,7 @@ void run(const Options& o) {
                            [&m, t = std::move(t)](std::ostream& out) { writeRtestCsv(out, m, t); }});
     }
     std::vector<EccentricityRow> rows;
-    if (!plan.runs.empty()) {
+    if (!plan.runs.empty() && o.instrument.empty()) {
         rows = eccentricitiesFromTraces(m, plan.runs, ballbar);
         pending.push_back({"eccentricities.csv", "", "", rows.size(),
                            [&rows](std::ostream& out) { writeEccentricityCsv(out, rows); }});
@@ -103,6 +127,10 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--out", o->out, "output folder")->required();
     c->add_option("--noise-um", o->noiseUm, "Gaussian noise on every ΔL sample / displacement component, σ in um");
     c->add_option("--seed", o->seed, "random seed for the noise");
+    c->add_option("--instrument", o->instrument,
+                  "time or angle: write the ball-bar runs as a ball-bar instrument exports them (time- or angle-sampled, "
+                  "the passes, directions, overshoot, columns and units of the plan's capture attributes), a simulated "
+                  "measurement standing in for the ball bar; no eccentricities.csv (identify fits the files)");
     c->callback([o] { run(*o); });
 });
 

@@ -1,5 +1,6 @@
 // cnccomp verify: the plan's test programs through the compensation the user will load (a deviation set, the files of
 // `cnccomp emit`, or programs corrected by `cnccomp correct`) to the true or the identified machine, before and after.
+// --json and --report (HTML page, its SVGs and summary) are staged together and written only when both are complete.
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -11,9 +12,12 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/verify_json.hpp"
+#include "cnccomp/report/html_report.hpp"
+#include "cnccomp/report/verification_report.hpp"
 #include "cnccomp/verify.hpp"
 #include "cnccomp/verify_sources.hpp"
 
@@ -22,6 +26,7 @@ namespace {
 
 struct Options {
     std::string machine, plan, compensation, controller, truth, identified, json, dialect = "linuxcnc";
+    std::string report, reportGrid, reportPlane = "XY";
     std::optional<double> maxResidualUm;
     int grid = 5;
 };
@@ -78,8 +83,15 @@ void run(const Options& o) {
     const auto dialect = testprog::parseProgramDialect(o.dialect);
     if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (linuxcnc, fanuc, sinumerik, heidenhain)", o.dialect));
     if (o.maxResidualUm && !(*o.maxResidualUm >= 0)) throw InputError("--max-residual-um", 0, "expected a number >= 0");
-    LoadedCompensation c = loadCompensation(m, plan, source, o.controller);
     namespace fs = std::filesystem;
+    if (!o.report.empty()) {
+        if (!report::isHtmlPath(o.report)) throw InputError(o.report, 0, "--report writes an HTML page: give R.html");
+        if (!o.json.empty() && fs::path(o.json).lexically_normal() == fs::path(o.report).lexically_normal())
+            throw InputError(o.report, 0, "--json and --report name the same file");
+    } else if (!o.reportGrid.empty()) {
+        throw InputError("--report-grid", 0, "belongs to an HTML report: give --report R.html");
+    }
+    LoadedCompensation c = loadCompensation(m, plan, source, o.controller);
     std::optional<DeviationSet> simulated;
     std::string simulatedName;
     if (!o.truth.empty()) {
@@ -100,11 +112,29 @@ void run(const Options& o) {
     vo.dialect = *dialect;
     vo.volumetricPerAxis = o.grid;
     const VerifyResult r = verify(m, plan, *simulated, simulatedName, c.compensation, vo);
-    print(r);
-    if (!o.json.empty()) {
-        refuseToOverwrite(o.json, {o.machine, o.plan, o.truth, o.identified, o.compensation});
-        writeVerifyJson(o.json, r, o.maxResidualUm);
+    // Every output is computed before any is written; a compensation folder's files are inputs too.
+    std::vector<std::string> inputs{o.machine, o.plan, o.truth, o.identified, o.compensation};
+    inputs.insert(inputs.end(), c.compensation.files.begin(), c.compensation.files.end());
+    OutputSet staged(inputs);
+    for (const std::string& out : {o.json, o.report})  // missing folders are created (and removed again on failure)
+        if (!out.empty() && !fs::path(out).parent_path().empty()) staged.makeFolder(fs::path(out).parent_path().string());
+    if (!o.json.empty()) staged.add(o.json, formatVerifyJson(r, o.maxResidualUm));
+    if (!o.report.empty()) {
+        report::VerificationReportInputs in;
+        in.machineFile = o.machine;
+        in.planFile = o.plan;
+        in.compensationPath = source;
+        in.dialect = o.dialect;
+        in.gateUm = o.maxResidualUm;
+        in.compensationSet = c.identified ? &*c.identified : nullptr;
+        in.map.grid = o.reportGrid;
+        in.map.plane = o.reportPlane;
+        const report::ReportData d = report::verificationReport(m, *simulated, c.compensation, r, in);
+        report::stageHtmlReport(staged, o.report, d);
     }
+    staged.commit();
+    print(r);
+    if (!o.report.empty()) fmt::print("report -> {}\n", o.report);
     if (o.maxResidualUm) {
         if (r.residual / kUm > *o.maxResidualUm)
             throw std::runtime_error(fmt::format("verification failed: residual {:.3f} um is above --max-residual-um {:g}",
@@ -138,6 +168,12 @@ const RegisterCommand reg([](CLI::App& app) {
         ->check(CLI::ExistingFile);
     c->add_option("--max-residual-um", o->maxResidualUm, "gate: exit status 1 when the residual (largest span after) is above");
     c->add_option("--json", o->json, "write the result as JSON (schema cnccomp-verify/1)");
+    c->add_option("--report", o->report,
+                  "write an HTML page R.html: polar plots of every run before and after (CW and CCW), ISO 230-4 G, F, H, "
+                  "spans, the compensation with its coverage and residual, maps before and after; each plot also as "
+                  "R-polar-<run>.svg / R-map-<k>.svg, the numbers as R.summary.json");
+    c->add_option("--report-grid", o->reportGrid, "HTML report: map grid as for cnccomp map (default: X, Y over the travel)");
+    c->add_option("--report-plane", o->reportPlane, "HTML report: map plane as for cnccomp map --plane")->capture_default_str();
     c->add_option("--dialect", o->dialect, "dialect of the test programs generated in memory (linuxcnc, fanuc, sinumerik, heidenhain)")
         ->capture_default_str();
     c->add_option("--volumetric-grid", o->grid, "samples per axis of the volumetric grid")->capture_default_str()->check(CLI::Range(1, 20));

@@ -39,6 +39,10 @@ struct VerifyCompensation {
     pp::Dialect programDialect = pp::Dialect::Rs274ngc;
     /// What the compensation leaves, and why (the backend's NOT-compensated list).
     std::vector<controllers::Coverage> notCompensated;
+    /// What it takes, and how (the backend's compensated list from the files' header; empty when they carry none).
+    std::vector<controllers::Coverage> compensated;
+    /// The files it was read from (paths), for reports.
+    std::vector<std::string> files;
 };
 
 /// The ideal compensation of an identified set: drive commands that put the tool of the identified machine where the

@@ -31,7 +31,10 @@ std::vector<controllers::OutputFile> readFolder(const std::string& dir) {
     return files;
 }
 
-std::vector<controllers::Coverage> readNotCompensated(const std::vector<controllers::OutputFile>& files) {
+namespace {
+
+/// The list under the header line `title` ("NOT compensated:" or "compensated:", the latter not preceded by "NOT ").
+std::vector<controllers::Coverage> readCoverageList(const std::vector<controllers::OutputFile>& files, const std::string& title) {
     for (const controllers::OutputFile& f : files) {
         std::istringstream in(f.content);
         std::string line;
@@ -41,10 +44,10 @@ std::vector<controllers::Coverage> readNotCompensated(const std::vector<controll
         while (std::getline(in, line)) {
             if (!line.empty() && line.back() == '\r') line.pop_back();
             if (!inList) {
-                const size_t at = line.find("NOT compensated:");
-                if (at == std::string::npos) continue;
+                const size_t at = line.find(title);
+                if (at == std::string::npos || (title == "compensated:" && at >= 4 && line.compare(at - 4, 4, "NOT ") == 0)) continue;
                 prefix = line.substr(0, at);
-                suffix = std::string(trim(line.substr(at + 16)));
+                suffix = std::string(trim(line.substr(at + title.size())));
                 inList = true;
                 continue;
             }
@@ -61,6 +64,16 @@ std::vector<controllers::Coverage> readNotCompensated(const std::vector<controll
         if (inList) return out;
     }
     return {};
+}
+
+}  // namespace
+
+std::vector<controllers::Coverage> readNotCompensated(const std::vector<controllers::OutputFile>& files) {
+    return readCoverageList(files, "NOT compensated:");
+}
+
+std::vector<controllers::Coverage> readCompensated(const std::vector<controllers::OutputFile>& files) {
+    return readCoverageList(files, "compensated:");
 }
 
 namespace {
@@ -87,6 +100,7 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
         c.kind = VerifyCompensation::Kind::Deviations;
         c.description = fmt::format("ideal compensation of {} (a perfect TCP controller)", fs::path(path).filename().string());
         c.model = idealCompensation(m, *out.identified);
+        c.files = {path};
         return out;
     }
     if (!fs::is_directory(path, ec)) throw InputError(path, 0, "no such file or folder");
@@ -99,6 +113,8 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
         c.model = std::shared_ptr<const controllers::AppliedCompensation>(b->apply(m, files));
         if (!c.model) throw ModelError(fmt::format("backend '{}' returned no compensation model", b->name()));
         c.notCompensated = readNotCompensated(files);
+        c.compensated = readCompensated(files);
+        for (const auto& f : files) c.files.push_back((fs::path(path) / f.name).string());
         return out;
     }
     // Corrected test programs: TP<nn>_<run>.<ext>, one per run.
@@ -120,6 +136,7 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
         if (dialect && *dialect != *d) throw InputError(path, 0, "the corrected programs are in more than one dialect");
         dialect = d;
         c.programs.push_back({motions[i].name, {found->name, found->content}});
+        c.files.push_back((fs::path(path) / found->name).string());
     }
     if (c.programs.empty())
         throw InputError(path, 0,

@@ -26,6 +26,8 @@ LoadedCompensation loadCompensation(const MachineModel& machine, const Measureme
 /// The NOT-compensated list of a header comment (controllers/common/header.hpp layout: a line "NOT compensated:" then
 /// one indented line per deviation, each in the file's comment syntax); empty when the files carry none.
 std::vector<controllers::Coverage> readNotCompensated(const std::vector<controllers::OutputFile>& files);
+/// The compensated list of the same header (the line "compensated:"); empty when the files carry none.
+std::vector<controllers::Coverage> readCompensated(const std::vector<controllers::OutputFile>& files);
 
 /// The files of a folder (regular files, not recursive), sorted by name.
 std::vector<controllers::OutputFile> readFolder(const std::string& dir);

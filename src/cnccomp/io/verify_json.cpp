@@ -1,11 +1,9 @@
 #include "cnccomp/io/verify_json.hpp"
 
 #include <cmath>
-#include <ostream>
 
 #include <fmt/format.h>
 
-#include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp {
 namespace {
@@ -96,11 +94,6 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
                                             str(x.reason), x.valueKnown ? num(x.value) : "null", x.valueKnown ? str(x.unit) : "null");
                      }));
     return o;
-}
-
-void writeVerifyJson(const std::string& path, const VerifyResult& result, std::optional<double> gateUm) {
-    const std::string text = formatVerifyJson(result, gateUm);
-    writeFileAtomically(path, [&](std::ostream& s) { s << text; });
 }
 
 }  // namespace cnccomp

@@ -1,6 +1,7 @@
 #include "cnccomp/report/html_report.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 
@@ -57,6 +58,12 @@ figcaption { font-size: 12px; color: #555; max-width: 600px; }
 
 }  // namespace
 
+bool isHtmlPath(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".html" || ext == ".htm";
+}
+
 ReportFiles reportFiles(const std::string& htmlPath, const ReportData& data) {
     const fs::path p(htmlPath);
     const std::string dir = p.has_parent_path() ? p.parent_path().string() : std::string(".");
@@ -92,6 +99,7 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
              return fmt::format("[{}, {}]", jsonString(f.first), jsonString(f.second));
          }) + ",\n";
     o += "  \"warnings\": " + jsonArray(d.warnings, [](const std::string& w) { return jsonString(w); }) + ",\n";
+    o += "  \"after_note\": " + jsonString(d.afterNote) + ",\n";
     o += "  \"runs\": [";
     for (size_t i = 0; i < d.runs.size(); ++i) {
         const RunSection& r = d.runs[i];
@@ -105,6 +113,15 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
                          jsonString(i < files.plots.size() ? fileName(files.plots[i]) : ""));
     }
     o += d.runs.empty() ? "],\n" : "\n  ],\n";
+    o += "  \"spans\": [";
+    for (size_t i = 0; i < d.spans.size(); ++i) {
+        const PassSpan& p = d.spans[i];
+        o += fmt::format("{}\n    {{\"run\": {}, \"type\": {}, \"pass\": {}, \"quantity\": {}, \"before_um\": {}, \"after_um\": {}, "
+                         "\"warning\": {}}}",
+                         i ? "," : "", jsonString(p.run), jsonString(p.type), jsonString(p.pass), jsonString(p.quantity),
+                         jsonNumber(p.before / kUm), jsonNumber(p.after / kUm), p.warning.empty() ? "null" : jsonString(p.warning));
+    }
+    o += d.spans.empty() ? "],\n" : "\n  ],\n";
     o += "  \"deviations\": [";
     for (size_t i = 0; i < d.deviations.size(); ++i) {
         const DeviationRow& r = d.deviations[i];
@@ -133,16 +150,20 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
     o += "  \"controllers\": [";
     for (size_t k = 0; k < d.controllers.size(); ++k) {
         const ControllerSection& c = d.controllers[k];
-        const auto names = [](const std::vector<std::pair<std::string, std::string>>& v) {
-            return jsonArray(v, [](const auto& p) { return jsonString(p.first); });
+        const auto names = [](const std::vector<CoverageRow>& v) {
+            return jsonArray(v, [](const CoverageRow& r) { return jsonString(r.deviation); });
         };
+        const std::string remaining = jsonArray(c.notCompensated, [](const CoverageRow& r) {
+            return fmt::format("{{\"deviation\": {}, \"value\": {}, \"unit\": {}, \"reason\": {}}}", jsonString(r.deviation),
+                               jsonNumber(r.value), jsonString(r.unit), jsonString(r.note));
+        });
         o += fmt::format("{}\n    {{\"name\": {}, \"files\": {}, \"compensated\": {}, \"not_compensated\": {}, "
                          "\"before_max_um\": {}, \"before_rms_um\": {}, \"after_max_um\": {}, \"after_rms_um\": {}, \"points\": {}, "
-                         "\"basis\": {}}}",
+                         "\"span_before_um\": {}, \"span_after_um\": {}, \"basis\": {},\n     \"remaining\": {}}}",
                          k ? "," : "", jsonString(c.name), jsonArray(c.files, [](const std::string& s) { return jsonString(s); }),
                          names(c.compensated), names(c.notCompensated), jsonNumber(c.beforeMax / kUm),
                          jsonNumber(c.beforeRms / kUm), jsonNumber(c.afterMax / kUm), jsonNumber(c.afterRms / kUm), c.points,
-                         jsonString(c.basis));
+                         jsonNumber(c.spanBefore / kUm), jsonNumber(c.spanAfter / kUm), jsonString(c.basis), remaining);
     }
     o += d.controllers.empty() ? "],\n" : "\n  ],\n";
     o += "  \"files\": {\"html\": " + jsonString(fileName(files.html)) + ", \"plots\": " +
@@ -162,24 +183,28 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
     for (const std::string& w : d.warnings) h += fmt::format("<div class=\"warn\">warning: {}</div>\n", esc(w));
 
     if (!d.runs.empty()) {
+        const bool rms = std::any_of(d.runs.begin(), d.runs.end(), [](const RunSection& r) {
+            return std::isfinite(r.rmsBefore) || std::isfinite(r.rmsAfter);
+        });
         h += "<h2>Ball-bar runs: ISO 230-4 circular test figures</h2>\n<table>\n<tr><th class=\"l\">run</th><th class=\"l\">test</th>"
              "<th>passes</th><th>G before µm</th><th>G after µm</th><th>F max before µm</th><th>F min before µm</th><th>F max after µm</th>"
-             "<th>F min after µm</th><th>mean radius mm</th>"
-             "<th>H before µm</th><th>H after µm</th><th>fit RMS before µm</th><th>fit RMS after µm</th></tr>\n";
+             "<th>F min after µm</th><th>mean radius mm</th><th>H before µm</th><th>H after µm</th>";
+        h += rms ? "<th>fit RMS before µm</th><th>fit RMS after µm</th></tr>\n" : "</tr>\n";
         for (const RunSection& r : d.runs) {
             std::string passes;
             for (const PolarPass& p : r.passes) passes += std::string(passes.empty() ? "" : " ") + (p.direction > 0 ? "CCW" : "CW");
             h += fmt::format("<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
-                             "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                             "<td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
                              esc(r.name), esc(r.test), passes, fixed(r.before.G / kUm, 2), fixed(r.after.G / kUm, 2),
                              fixed(r.before.Fmax / kUm, 2), fixed(r.before.Fmin / kUm, 2), fixed(r.after.Fmax / kUm, 2),
-                             fixed(r.after.Fmin / kUm, 2), fixed(r.before.meanRadius, 5),
-                             fixed(r.before.H / kUm, 2), fixed(r.after.H / kUm, 2), fixed(r.rmsBefore / kUm, 3),
-                             fixed(r.rmsAfter / kUm, 3));
+                             fixed(r.after.Fmin / kUm, 2), fixed(r.before.meanRadius, 5), fixed(r.before.H / kUm, 2),
+                             fixed(r.after.H / kUm, 2));
+            h += rms ? fmt::format("<td>{}</td><td>{}</td></tr>\n", fixed(r.rmsBefore / kUm, 3), fixed(r.rmsAfter / kUm, 3))
+                     : std::string("</tr>\n");
         }
-        h += "</table>\n<p style=\"font-size:12px\">G circular deviation, F radial deviation about the nominal centre, H circular "
-             "hysteresis (CCW against CW), after ISO 230-4. \"after\": the run with the identified deviations compensated.</p>\n"
-             "<div class=\"plots\">\n";
+        h += fmt::format("</table>\n<p style=\"font-size:12px\">G circular deviation, F radial deviation about the nominal centre, H "
+                         "circular hysteresis (CCW against CW), after ISO 230-4.{}</p>\n<div class=\"plots\">\n",
+                         d.afterNote.empty() ? "" : " \"after\": " + esc(d.afterNote) + ".");
         for (size_t i = 0; i < d.runs.size(); ++i) {
             h += "<figure>\n" + plots[i];
             std::string caption = fmt::format("{}", esc(fileName(files.plots[i])));
@@ -187,6 +212,19 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
             h += fmt::format("<figcaption>{}</figcaption>\n</figure>\n", caption);
         }
         h += "</div>\n";
+    }
+
+    if (!d.spans.empty()) {
+        h += "<h2>Instrument readings per pass: span before and after</h2>\n<table>\n<tr><th class=\"l\">run</th>"
+             "<th class=\"l\">type</th><th class=\"l\">pass</th><th class=\"l\">reading</th><th>span before µm</th>"
+             "<th>span after µm</th><th class=\"l\">warning</th></tr>\n";
+        for (const PassSpan& p : d.spans)
+            h += fmt::format("<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td>"
+                             "<td>{}</td><td>{}</td><td class=\"l\">{}</td></tr>\n",
+                             esc(p.run), esc(p.type), esc(p.pass), p.quantity == "dL" ? "ΔL" : esc(p.quantity),
+                             fixed(p.before / kUm, 3), fixed(p.after / kUm, 3), esc(p.warning));
+        h += "</table>\n<p style=\"font-size:12px\">span = max − min of the reading over the pass (ball bar: ΔL = L − LB; "
+             "R-test: the largest span of a displacement component).</p>\n";
     }
 
     if (!d.deviations.empty()) {
@@ -231,22 +269,40 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
     }
 
     if (!d.controllers.empty()) {
-        h += "<h2>Controller files</h2>\n<table>\n<tr><th class=\"l\">controller</th><th class=\"l\">files</th><th>compensated</th>"
-             "<th>not compensated</th><th>max before µm</th><th>max after µm</th><th>RMS after µm</th><th class=\"l\">basis</th></tr>\n";
+        const bool spans = std::any_of(d.controllers.begin(), d.controllers.end(), [](const ControllerSection& c) {
+            return std::isfinite(c.spanBefore) || std::isfinite(c.spanAfter);
+        });
+        h += "<h2>Compensation</h2>\n<table>\n<tr><th class=\"l\">controller</th><th class=\"l\">files</th><th>compensated</th>"
+             "<th>not compensated</th>";
+        h += spans ? "<th>largest ΔL span before µm</th><th>largest ΔL span after µm</th>" : "";
+        h += "<th>tool-tip max before µm</th><th>tool-tip max after µm</th><th>tool-tip RMS after µm</th><th class=\"l\">basis</th></tr>\n";
         for (const ControllerSection& c : d.controllers) {
             std::string files;
             for (const std::string& f : c.files) files += (files.empty() ? "" : "<br>") + esc(f);
-            h += fmt::format("<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
-                             "<td class=\"l\">{}</td></tr>\n",
-                             esc(c.name), files.empty() ? "(not written)" : files, c.compensated.size(), c.notCompensated.size(),
-                             fixed(c.beforeMax / kUm, 2), fixed(c.afterMax / kUm, 2), fixed(c.afterRms / kUm, 2), esc(c.basis));
+            h += fmt::format("<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td>", esc(c.name),
+                             files.empty() ? "(not written)" : files, c.compensated.size(), c.notCompensated.size());
+            if (spans) h += fmt::format("<td>{}</td><td>{}</td>", fixed(c.spanBefore / kUm, 3), fixed(c.spanAfter / kUm, 3));
+            h += fmt::format("<td>{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td></tr>\n", fixed(c.beforeMax / kUm, 2),
+                             fixed(c.afterMax / kUm, 2), fixed(c.afterRms / kUm, 2), esc(c.basis));
         }
         h += "</table>\n";
         for (const ControllerSection& c : d.controllers) {
             if (c.notCompensated.empty()) continue;
+            const bool values = std::any_of(c.notCompensated.begin(), c.notCompensated.end(),
+                                            [](const CoverageRow& r) { return std::isfinite(r.value); });
+            if (values) {  // the deviations left, with their value in the machine the figures are for
+                h += fmt::format("<p class=\"no\">Deviations {} leaves, and why:</p>\n<table>\n<tr><th class=\"l\">deviation</th>"
+                                 "<th>value</th><th class=\"l\">unit</th><th class=\"l\">why not compensated</th></tr>\n",
+                                 esc(c.name));
+                for (const CoverageRow& r : c.notCompensated)
+                    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td></tr>\n",
+                                     esc(r.deviation), fixed(r.value, 3), r.unit == "um" ? "µm" : esc(r.unit), esc(r.note));
+                h += "</table>\n";
+                continue;
+            }
             h += fmt::format("<p class=\"no\">{} does not compensate: ", esc(c.name));
             for (size_t i = 0; i < c.notCompensated.size(); ++i)
-                h += fmt::format("{}{} ({})", i ? "; " : "", esc(c.notCompensated[i].first), esc(c.notCompensated[i].second));
+                h += fmt::format("{}{} ({})", i ? "; " : "", esc(c.notCompensated[i].deviation), esc(c.notCompensated[i].note));
             h += "</p>\n";
         }
     }

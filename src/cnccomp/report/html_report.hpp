@@ -19,6 +19,9 @@ struct ReportFiles {
     std::vector<std::string> plots;  ///< <stem>-polar-<run>.svg per run, <stem>-map-<k>.svg per map, in page order
 };
 
+/// True for a path ending in .html or .htm (any case): the commands' --report writes the page there.
+bool isHtmlPath(const std::string& path);
+
 /// File names for a page path: "out/report.html" → out/report.summary.json, out/report-polar-<run>.svg,
 /// out/report-map-1.svg, … (run names must be plain file names: InputError otherwise).
 ReportFiles reportFiles(const std::string& htmlPath, const ReportData& data);

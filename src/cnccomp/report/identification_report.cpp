@@ -7,6 +7,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/map_grid.hpp"
+#include "cnccomp/report/compensation_map.hpp"
 #include "cnccomp/volumetric_map.hpp"
 #include "controllers/backend.hpp"
 #include "controllers/common/evaluate.hpp"
@@ -102,90 +103,14 @@ std::vector<DeviationRow> deviationRows(const IdentificationReport& r) {
     return out;
 }
 
-namespace {
-
-/// True where the tool axis is (nearly) parallel to a rotary axis: there a TCP controller has no unique answer (any
-/// angle of that axis gives the same tool axis) and its model is not a prediction of the machine.
-bool singularPose(const Kinematics& k, const AxisVector& q) {
-    const Vec3 axis = k.baseToTool(q).linear() * k.machine().toolDirection;
-    for (const JointFrame& j : k.jointFrames(q))
-        if (j.rotary && j.direction.cross(axis).norm() < 0.1) return true;
-    return false;
-}
-
-/// X and Y over their travel (≤ ±200 mm, 21 points); the other linear axes at 0 (or the nearest end of their travel);
-/// the rotary axes at 0, or, where that pose is singular, at the first of 30°, 45°, −30°, 60° that is not (and lies in
-/// the axis's travel).
-std::string defaultGrid(const MachineModel& m) {
-    const Kinematics k(m);
-    AxisVector q = AxisVector::Zero(m.axisCount());
-    for (int a = 0; a < m.axisCount(); ++a) q[a] = std::clamp(0.0, m.axisLink(a).min, m.axisLink(a).max);
-    for (int a = 0; a < m.axisCount() && singularPose(k, q); ++a) {
-        const Link& l = m.axisLink(a);
-        if (l.kind != AxisKind::Rotary) continue;
-        for (double deg : {30.0, 45.0, -30.0, 60.0}) {
-            AxisVector t = q;
-            t[a] = deg * kDeg;
-            if (t[a] < l.min || t[a] > l.max || singularPose(k, t)) continue;
-            q = t;
-            break;
-        }
-    }
-    std::string g;
-    for (int a = 0; a < m.axisCount(); ++a) {
-        const Link& l = m.axisLink(a);
-        const std::string& n = m.axisNames[a];
-        if ((n == "X" || n == "Y") && l.kind == AxisKind::Linear) {
-            const double lo = std::max(l.min, -200.0), hi = std::min(l.max, 200.0);
-            if (hi - lo > 1e-6) {
-                g += fmt::format("{}{}={:g}:{:g}:{:g}", g.empty() ? "" : " ", n, lo, hi, (hi - lo) / 20);
-                continue;
-            }
-        }
-        g += fmt::format("{}{}={:g}", g.empty() ? "" : " ", n, q[a] / (l.kind == AxisKind::Rotary ? kDeg : 1.0));
-    }
-    return g;
-}
-
-/// The map of `before` recomputed with the controller's drive commands: tip error of the identified machine.
-VolumetricMap compensatedMap(const VolumetricMap& before, const MachineModel& m, const DeviationSet& identified,
-                             const controllers::AppliedCompensation& comp, double toolLength) {
-    VolumetricMap map = before;
-    const Kinematics actual(m, identified), nominal(m);
-    const Vec3 tipActual = actual.toolPoint(toolLength), tipNominal = nominal.toolPoint(toolLength);
-    double sum = 0;
-    map.stats.norm = {};
-    long n = 0;
-    AxisVector q(m.axisCount());
-    for (MapPoint& p : map.points) {
-        if (!p.ok) continue;
-        for (int a = 0; a < m.axisCount(); ++a) q[a] = p.q[static_cast<size_t>(a)];
-        const AxisVector drive = comp.driveCommandsForTool(q, toolLength);
-        p.error = actual.toolPointInWorkpiece(drive, tipActual) - nominal.toolPointInWorkpiece(q, tipNominal);
-        p.rotation.setZero();
-        p.tilt = 0;
-        map.stats.norm.maxAbs = std::max(map.stats.norm.maxAbs, p.error.norm());
-        sum += p.error.squaredNorm();
-        ++n;
-    }
-    map.stats.norm.rms = n > 0 ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
-    return map;
-}
-
-}  // namespace
-
 void addCompensationSections(ReportData& data, const MachineModel& m, const DeviationSet& identified,
                              const std::vector<std::string>& names, const MapOptions& o) {
-    MapRequest req{m, identified, parseGrid(o.grid.empty() ? defaultGrid(m) : o.grid, "report map grid"), o.toolLength, {}, 0};
     const MapPlane plane = parseMapPlane(o.plane);
-    const VolumetricMap before = computeMap(req);
+    const VolumetricMap before = uncompensatedMap(m, identified, o);
     data.machineModel = &m;
     data.maps.push_back({fmt::format("before compensation: the identified machine, tool length {:g} mm", o.toolLength), before, plane});
     if (names.empty()) return;
-    std::vector<AxisVector> samples;
-    const Kinematics nominal(m);
-    for (const AxisVector& q : controllers::workspaceSamples(m, 5))
-        if (!singularPose(nominal, q)) samples.push_back(q);
+    const std::vector<AxisVector> samples = regularWorkspaceSamples(m, 5);
     for (const std::string& name : names) {
         const controllers::Backend& b = controllers::backend(name);
         const controllers::EmitResult emitted = b.emit({m, identified, "identified deviations", "2000-01-01"});
@@ -194,8 +119,8 @@ void addCompensationSections(ReportData& data, const MachineModel& m, const Devi
             controllers::evaluateCompensation(m, identified, *comp, samples, o.toolLength);
         ControllerSection c;
         c.name = name;
-        for (const auto& x : emitted.compensated) c.compensated.emplace_back(x.deviation, x.note);
-        for (const auto& x : emitted.notCompensated) c.notCompensated.emplace_back(x.deviation, x.note);
+        for (const auto& x : emitted.compensated) c.compensated.push_back({x.deviation, x.note, kUnknown, ""});
+        for (const auto& x : emitted.notCompensated) c.notCompensated.push_back({x.deviation, x.note, kUnknown, ""});
         c.beforeMax = f.maxBefore;
         c.beforeRms = f.rmsBefore;
         c.afterMax = f.maxAfter;

@@ -13,6 +13,7 @@
 
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/measured_observations.hpp"
+#include "cnccomp/report/compensation_map.hpp"
 #include "cnccomp/report/report_data.hpp"
 
 namespace cnccomp::report {
@@ -24,15 +25,6 @@ std::vector<RunSection> measuredRunSections(const MachineModel& machine, const M
 
 /// The deviations of a report: every requested one, identified or not (display units um / arcsec).
 std::vector<DeviationRow> deviationRows(const IdentificationReport& report);
-
-struct MapOptions {
-    /// Grid as for `cnccomp map`; empty = X and Y over their travel (at most ±200 mm, 21 × 21 points), the other linear
-    /// axes at 0 (or the nearest end of their travel), the rotary axes at 0 unless the tool axis would be parallel to a
-    /// rotary axis there (then 30°, 45°, −30° or 60°: a TCP controller has no unique answer at such a pose).
-    std::string grid;
-    std::string plane = "XY";  ///< as `cnccomp map --plane`
-    double toolLength = 0;     ///< mm
-};
 
 /// Map of the identified machine ("before") and, per controller backend name, the coverage and the residual of that
 /// controller compensating the identified deviations (figures over workspaceSamples(machine, 5) less the poses whose

@@ -90,15 +90,17 @@ std::string renderPolarPlot(const RunSection& run, const std::string& idPrefix) 
             if (e.label == l) return;
         legend.push_back({c, l});
     };
-    for (int after = 0; after < 2; ++after)
-        for (const PolarPass& p : run.passes) {
-            const std::vector<double>& v = after ? p.after : p.before;
-            if (v.empty()) continue;
-            const char* colour = p.direction > 0 ? (after ? kCcwAfter : kCcwBefore) : (after ? kCwAfter : kCwBefore);
-            s += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" stroke-linejoin=\"round\" points=\"{}\"/>\n",
-                             colour, polyline(sc, p.angleDeg, v));
-            addLegend(colour, fmt::format("{} {}", p.direction > 0 ? "CCW" : "CW", after ? "after compensation" : "before"));
-        }
+    // CW wide and first, CCW narrow on top: where the passes coincide (no hysteresis) both colours stay visible.
+    for (int direction : {-1, +1})
+        for (int after = 0; after < 2; ++after)
+            for (const PolarPass& p : run.passes) {
+                const std::vector<double>& v = after ? p.after : p.before;
+                if (v.empty() || (p.direction > 0) != (direction > 0)) continue;
+                const char* colour = p.direction > 0 ? (after ? kCcwAfter : kCcwBefore) : (after ? kCwAfter : kCwBefore);
+                s += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linejoin=\"round\" points=\"{}\"/>\n",
+                                 colour, p.direction > 0 ? kPolarCcwWidthPx : kPolarCwWidthPx, polyline(sc, p.angleDeg, v));
+                addLegend(colour, fmt::format("{} {}", p.direction > 0 ? "CCW" : "CW", after ? "after compensation" : "before"));
+            }
     // Legend and the ISO 230-4 figures.
     double y = kPolarCy + outer + 40;
     for (size_t i = 0; i < legend.size(); ++i) {

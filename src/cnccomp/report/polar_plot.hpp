@@ -1,7 +1,8 @@
 #pragma once
 // Polar plot of a ball-bar run in the style of ball-bar software: the nominal circle (radius LB) drawn at a fixed
 // size, the radial deviation ΔL magnified around it, scale rings every `ringUm` µm, the CCW and CW passes and the
-// traces before and after compensation overlaid in four colours, ISO 230-4 figures underneath.
+// traces before and after compensation overlaid in four colours (CW wide underneath, CCW narrow on top), ISO 230-4
+// figures underneath.
 #include <string>
 
 #include "cnccomp/report/report_data.hpp"
@@ -18,6 +19,8 @@ inline constexpr const char* kCwAfter = "#f08c00";
 inline constexpr double kPolarWidth = 600, kPolarHeight = 720, kPolarCx = 300, kPolarCy = 340;
 inline constexpr double kPolarNominalPx = 150;  ///< radius of the nominal circle
 inline constexpr double kPolarBandPx = 100;     ///< the outermost scale ring is this far from the nominal circle
+/// Line widths: CW drawn wide underneath, CCW narrow on top, so that passes without hysteresis show both colours.
+inline constexpr double kPolarCwWidthPx = 4, kPolarCcwWidthPx = 1.8;
 
 /// Magnification of a run: ring spacing (a round number of µm), ring count on each side, px per µm.
 struct PolarScale {

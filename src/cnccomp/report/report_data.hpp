@@ -1,7 +1,8 @@
 #pragma once
 // The data of an HTML report (report/html_report.hpp), as plain values: whoever has the numbers fills what it has
-// (identify: runs, ISO 230-4 values, deviations, maps; verify and the main job: also the controller files and
-// measured "after" runs) and leaves the rest empty; empty sections are not shown.
+// (identify: runs, ISO 230-4 values, deviations, maps, predicted controller sections — identification_report.hpp;
+// verify: runs before/after the compensation, spans per pass, maps, the compensation used and the deviations it
+// leaves — verification_report.hpp) and leaves the rest empty; empty sections and unknown columns are not shown.
 //
 // Units: every length in this struct is in mm and every angle in deg, except DeviationRow, which holds display
 // values in its own `unit` (um or arcsec). NaN means "not known" and is shown as "–" (null in the JSON summary).
@@ -55,7 +56,7 @@ struct RunSection {
     double LB = 0;      ///< nominal bar length = radius of the plot's reference circle, mm
     std::vector<PolarPass> passes;
     IsoFigures before, after;  ///< `after` from the passes' `after` values, NaN without them
-    double rmsBefore = kUnknown, rmsAfter = kUnknown;  ///< fit residual RMS of the run, mm
+    double rmsBefore = kUnknown, rmsAfter = kUnknown;  ///< fit residual RMS of the run, mm (columns shown when known)
     std::vector<std::string> notes;  ///< shown under the plot (import summary, relative length offset, …)
 };
 
@@ -74,14 +75,31 @@ struct MapPicture {
     MapPlane plane;
 };
 
+/// What the instrument reads on one pass of a run before and after compensation (verify): the span (max − min) of ΔL
+/// for a ball bar, of the largest displacement component for an R-test.
+struct PassSpan {
+    std::string run, type, pass;      ///< run name, run type, "CW" / "CCW" / "forward" / "reverse"
+    std::string quantity;             ///< "dL" or "displacement"
+    double before = kUnknown, after = kUnknown;  ///< mm
+    std::string warning;              ///< e.g. the compensated commands leave an axis' travel; empty = none
+};
+
+/// One deviation a compensation takes (how) or leaves (why not), with its value where known.
+struct CoverageRow {
+    std::string deviation, note;
+    double value = kUnknown;          ///< in `unit` (um or arcsec), in the machine the figures are for; NaN = not shown
+    std::string unit;
+};
+
 /// A controller's compensation: files, coverage and the predicted (or verified) residual tool-tip error.
 struct ControllerSection {
-    std::string name;                 ///< backend name, e.g. linuxcnc
-    std::vector<std::string> files;   ///< paths of the files written; empty = not written by this command
-    std::vector<std::pair<std::string, std::string>> compensated, notCompensated;  ///< deviation, how / why not
+    std::string name;                 ///< backend name, e.g. linuxcnc ("ideal", "corrected test programs" in verify)
+    std::vector<std::string> files;   ///< paths of the files written or read; empty = not written by this command
+    std::vector<CoverageRow> compensated, notCompensated;  ///< deviation, how / why not
     double beforeMax = kUnknown, beforeRms = kUnknown;  ///< tool-tip error without compensation, mm
     double afterMax = kUnknown, afterRms = kUnknown;    ///< with the controller's compensation, mm
     int points = 0;                   ///< workspace poses the figures are taken over
+    double spanBefore = kUnknown, spanAfter = kUnknown; ///< largest ΔL span of the plan's runs (verify's residual), mm
     std::string basis;                ///< what the figures are ("predicted on the identified machine", …)
 };
 
@@ -91,7 +109,9 @@ struct ReportData {
     const MachineModel* machineModel = nullptr;  ///< needed to draw `maps` (axis kinds); may be null without maps
     std::vector<std::pair<std::string, std::string>> facts;  ///< shown in the page header (inputs, solver, …)
     std::vector<std::string> warnings;
+    std::string afterNote;             ///< what "after" means in the runs' figures (shown under their table)
     std::vector<RunSection> runs;
+    std::vector<PassSpan> spans;       ///< verify: every pass of every run, ball bar and R-test
     std::vector<DeviationRow> deviations;
     std::vector<std::string> combinations;  ///< identifiable combinations of unidentified deviations, as text
     std::vector<MapPicture> maps;
