@@ -323,5 +323,53 @@ TEST(Verify, NotCompensatedListReadFromAnyCommentSyntax) {
     EXPECT_TRUE(readNotCompensated({{"c.ini", "# NOT compensated:\n#   (none)\n"}}).empty());
 }
 
+TEST(Verify, EmitWarnsWhenItsFilesLeaveMoreThanNoCompensation) {
+    // On the multi-tasking sample the LinuxCNC files correct the spindle and C offsets but cannot hold the squareness
+    // and tilts, which partly cancelled them: the predicted ball-bar span grows (86.7 against 70.2 um). The ISG files
+    // hold every deviation: no warning.
+    test::ScratchDir dir("emit-worse");
+    const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
+                      t = src("samples/deviations/multitasking-truth.csv");
+    auto r = test::runCli("emit --controller linuxcnc --machine " + m + " --deviations " + t + " --plan " + p + " --out " +
+                          dir.file("l"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("WARNING: on this machine these files leave MORE error than no compensation (ball-bar span)"),
+              std::string::npos)
+        << r.out;
+    r = test::runCli("emit --controller isg --machine " + m + " --deviations " + t + " --plan " + p + " --out " + dir.file("i"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_EQ(r.out.find("WARNING"), std::string::npos) << r.out;
+}
+
+TEST(Verify, AShiftedDatumPassesTheSpanGateAndFailsTheVolumetricGate) {
+    // The Heidenhain TAB's Trans X row of C on the A/C cradle moves the workpiece datum along A's axis line (see
+    // ControllerHeidenhain.ATransRowThatShiftsTheDatum...): a sign flipped there is invisible to an R-test or ball bar
+    // set at each run's start, so --max-residual-um passes; the volumetric figure sees the 10 um.
+    test::ScratchDir dir("verify-datum");
+    const std::string m = src("samples/machines/table-table-ac.xml"), p = src("samples/plans/table-table-ac-rtest.xml"),
+                      t = src("samples/deviations/table-table-ac-truth.csv");
+    auto r = test::runCli("emit --controller heidenhain-tnc --machine " + m + " --deviations " + t + " --out " + dir.file("f"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    std::string tabName;
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("f")))
+        if (e.path().extension() == ".TAB") tabName = e.path().string();
+    ASSERT_FALSE(tabName.empty());
+    std::string tab = test::readText(tabName);
+    const std::string row = "Trans     X     -0.005000000";
+    ASSERT_NE(tab.find(row), std::string::npos) << tab;
+    tab.replace(tab.find(row), row.size(), "Trans     X     0.005000000 ");
+    test::writeText(tabName, tab);
+    const std::string verify = "verify --machine " + m + " --plan " + p + " --truth " + t + " --compensation " + dir.file("f");
+    r = test::runCli(verify + " --max-residual-um 0.1 --json " + dir.file("a.json"));
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli(verify + " --max-residual-um 0.1 --max-volumetric-um 1 --json " + dir.file("b.json"));
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_NE(r.out.find("volumetric tool-tip error"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("is above --max-volumetric-um 1"), std::string::npos) << r.out;
+    EXPECT_NE(test::readText(dir.file("b.json")).find("\"max_volumetric_um\": 1,\n  \"passed\": false"), std::string::npos);
+    r = test::runCli(verify + " --max-volumetric-um -1");
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+}
+
 }  // namespace
 }  // namespace cnccomp

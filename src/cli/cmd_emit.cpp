@@ -26,6 +26,16 @@ struct Options {
 
 /// What the files just written leave on the identified machine: `cnccomp verify` with the plan's test programs through
 /// the backend's apply model, or (without a plan) the tool-tip error over the travel.
+/// The files correct some deviations and leave others; where those partly cancelled, correcting only some makes the
+/// machine worse. Said loudly: loading such files is a step back.
+void warnIfWorse(bool spanWorse, bool volumetricWorse) {
+    if (!spanWorse && !volumetricWorse) return;
+    fmt::print("WARNING: on this machine these files leave MORE error than no compensation ({}): the deviations they cannot "
+               "hold (NOT compensated above) partly cancelled those they correct. Consider corrected programs (cnccomp "
+               "correct) or a controller whose files hold the rest.\n",
+               spanWorse && volumetricWorse ? "ball-bar span and volumetric error" : spanWorse ? "ball-bar span" : "volumetric error");
+}
+
 void predict(const controllers::Backend& b, const MachineModel& m, const DeviationSet& d, const controllers::EmitResult& r,
              const Options& o) {
     try {
@@ -44,12 +54,14 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                        "volumetric max {:.3f} -> {:.3f} um\n",
                        std::filesystem::path(o.plan).filename().string(), v.residual / kUm, v.residualBefore / kUm,
                        v.volumetric.maxBefore / kUm, v.volumetric.maxAfter / kUm);
+            warnIfWorse(v.residual > v.residualBefore, v.volumetric.maxAfter > v.volumetric.maxBefore);
             return;
         }
         const auto f = controllers::evaluateCompensation(m, d, *model, controllers::workspaceSamples(m, 5), 0.0);
         fmt::print("predicted tool-tip error on the identified machine over the travel ({} poses, tool length 0; give --plan for "
                    "the ball-bar residual): max {:.3f} -> {:.3f} um, RMS {:.3f} -> {:.3f} um\n",
                    f.points, f.maxBefore / kUm, f.maxAfter / kUm, f.rmsBefore / kUm, f.rmsAfter / kUm);
+        warnIfWorse(false, f.maxAfter > f.maxBefore);
     } catch (const std::exception& e) {
         fmt::print("predicted residual: not available ({})\n", e.what());
     }

@@ -27,7 +27,7 @@ namespace {
 struct Options {
     std::string machine, plan, compensation, controller, truth, identified, json, dialect = "linuxcnc";
     std::string report, reportGrid, reportPlane = "XY";
-    std::optional<double> maxResidualUm;
+    std::optional<double> maxResidualUm, maxVolumetricUm;
     int grid = 5;
 };
 
@@ -83,6 +83,7 @@ void run(const Options& o) {
     const auto dialect = testprog::parseProgramDialect(o.dialect);
     if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (linuxcnc, fanuc, sinumerik, heidenhain)", o.dialect));
     if (o.maxResidualUm && !(*o.maxResidualUm >= 0)) throw InputError("--max-residual-um", 0, "expected a number >= 0");
+    if (o.maxVolumetricUm && !(*o.maxVolumetricUm >= 0)) throw InputError("--max-volumetric-um", 0, "expected a number >= 0");
     namespace fs = std::filesystem;
     if (!o.report.empty()) {
         if (!report::isHtmlPath(o.report)) throw InputError(o.report, 0, "--report writes an HTML page: give R.html");
@@ -118,7 +119,7 @@ void run(const Options& o) {
     OutputSet staged(inputs);
     for (const std::string& out : {o.json, o.report})  // missing folders are created (and removed again on failure)
         if (!out.empty() && !fs::path(out).parent_path().empty()) staged.makeFolder(fs::path(out).parent_path().string());
-    if (!o.json.empty()) staged.add(o.json, formatVerifyJson(r, o.maxResidualUm));
+    if (!o.json.empty()) staged.add(o.json, formatVerifyJson(r, o.maxResidualUm, o.maxVolumetricUm));
     if (!o.report.empty()) {
         report::VerificationReportInputs in;
         in.machineFile = o.machine;
@@ -126,6 +127,7 @@ void run(const Options& o) {
         in.compensationPath = source;
         in.dialect = o.dialect;
         in.gateUm = o.maxResidualUm;
+        in.volumetricGateUm = o.maxVolumetricUm;
         in.compensationSet = c.identified ? &*c.identified : nullptr;
         in.map.grid = o.reportGrid;
         in.map.plane = o.reportPlane;
@@ -141,6 +143,19 @@ void run(const Options& o) {
                                                  r.residual / kUm, *o.maxResidualUm));
         fmt::print("verification passed: residual {:.3f} um <= {:g} um\n", r.residual / kUm, *o.maxResidualUm);
     }
+    if (o.maxVolumetricUm) {
+        // A ball bar cannot see everything (e.g. a shift of the workpiece datum): the volumetric error can.
+        if (!r.volumetric.available)
+            throw std::runtime_error(fmt::format("verification failed: --max-volumetric-um needs the volumetric figure, "
+                                                 "which this compensation has none of ({})",
+                                                 r.volumetric.note));
+        if (r.volumetric.maxAfter / kUm > *o.maxVolumetricUm)
+            throw std::runtime_error(fmt::format("verification failed: volumetric tool-tip error {:.3f} um is above "
+                                                 "--max-volumetric-um {:g}",
+                                                 r.volumetric.maxAfter / kUm, *o.maxVolumetricUm));
+        fmt::print("verification passed: volumetric tool-tip error {:.3f} um <= {:g} um\n", r.volumetric.maxAfter / kUm,
+                   *o.maxVolumetricUm);
+    }
 }
 
 const RegisterCommand reg([](CLI::App& app) {
@@ -152,8 +167,9 @@ const RegisterCommand reg([](CLI::App& app) {
         "dL span), the volumetric error over the plan's workspace, and the deviations left.\n"
         "--compensation: a deviation CSV (ideal compensation), a folder written by `cnccomp emit` (backend recognised\n"
         "from the file names, or --controller), or a folder of test programs corrected by `cnccomp correct`.\n"
-        "Exit status: 0 verified (residual at or below --max-residual-um, or no gate); 1 residual above\n"
-        "--max-residual-um (report printed and --json written first; 1 also for an unexpected internal error);\n"
+        "Exit status: 0 verified (residual at or below --max-residual-um and volumetric error at or below\n"
+        "--max-volumetric-um, or no gate); 1 a gate failed (report printed and --json written first; 1 also for an\n"
+        "unexpected internal error);\n"
         "2 bad input (unreadable or unrecognised files, unknown names, commands outside the travel);\n"
         "105/106/109 command-line usage (invalid value, missing option, unknown option).");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
@@ -167,6 +183,9 @@ const RegisterCommand reg([](CLI::App& app) {
                   "(alone: the compensation itself, ideal)")
         ->check(CLI::ExistingFile);
     c->add_option("--max-residual-um", o->maxResidualUm, "gate: exit status 1 when the residual (largest span after) is above");
+    c->add_option("--max-volumetric-um", o->maxVolumetricUm,
+                  "gate: exit status 1 when the volumetric tool-tip error after compensation (max over the plan's "
+                  "workspace) is above; it sees what a ball bar cannot, e.g. a shifted workpiece datum");
     c->add_option("--json", o->json, "write the result as JSON (schema cnccomp-verify/1)");
     c->add_option("--report", o->report,
                   "write an HTML page R.html: polar plots of every run before and after (CW and CCW), ISO 230-4 G, F, H, "

@@ -64,13 +64,22 @@ std::string pass(const VerifyPass& p) {
 
 }  // namespace
 
-std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm) {
+bool verifyGatePassed(const VerifyResult& r, std::optional<double> gateUm, std::optional<double> volumetricGateUm) {
+    if (gateUm && !(r.residual / kUm <= *gateUm)) return false;
+    if (volumetricGateUm && !(r.volumetric.available && r.volumetric.maxAfter / kUm <= *volumetricGateUm)) return false;
+    return true;
+}
+
+std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm, std::optional<double> volumetricGateUm) {
     std::string o = "{\n  \"schema\": \"cnccomp-verify/1\",\n";
     o += fmt::format("  \"machine\": {},\n  \"simulated\": {},\n  \"compensation\": {},\n", str(r.machine), str(r.simulated),
                      str(r.compensation));
     o += fmt::format("  \"residual_before_um\": {},\n  \"residual_um\": {},\n", um(r.residualBefore), um(r.residual));
-    o += fmt::format("  \"max_residual_um\": {},\n  \"passed\": {},\n", gateUm ? num(*gateUm) : "null",
-                     gateUm ? (r.residual / kUm <= *gateUm ? "true" : "false") : "null");
+    const bool gated = gateUm || volumetricGateUm;
+    const bool passed = verifyGatePassed(r, gateUm, volumetricGateUm);
+    o += fmt::format("  \"max_residual_um\": {},\n  \"max_volumetric_um\": {},\n  \"passed\": {},\n",
+                     gateUm ? num(*gateUm) : "null", volumetricGateUm ? num(*volumetricGateUm) : "null",
+                     gated ? (passed ? "true" : "false") : "null");
     o += "  \"runs\": [\n";
     for (size_t i = 0; i < r.runs.size(); ++i) {
         const VerifyRun& run = r.runs[i];

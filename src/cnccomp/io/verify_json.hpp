@@ -10,7 +10,12 @@
 
 namespace cnccomp {
 
-/// `gateUm`: the --max-residual-um gate, if any (the JSON says whether it passed).
-std::string formatVerifyJson(const VerifyResult& result, std::optional<double> gateUm = std::nullopt);
+/// The gates of `cnccomp verify`: the residual (largest ΔL span after) at most `gateUm`, and the volumetric tool-tip
+/// error after at most `volumetricGateUm` (failed when there is no volumetric figure). Unset gates pass.
+bool verifyGatePassed(const VerifyResult& result, std::optional<double> gateUm, std::optional<double> volumetricGateUm);
+/// `gateUm`, `volumetricGateUm`: the --max-residual-um / --max-volumetric-um gates, if any (the JSON says whether they
+/// passed).
+std::string formatVerifyJson(const VerifyResult& result, std::optional<double> gateUm = std::nullopt,
+                             std::optional<double> volumetricGateUm = std::nullopt);
 
 }  // namespace cnccomp

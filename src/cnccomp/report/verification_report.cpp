@@ -1,5 +1,7 @@
 #include "cnccomp/report/verification_report.hpp"
 
+#include "cnccomp/io/verify_json.hpp"
+
 #include <cmath>
 
 #include <fmt/format.h>
@@ -97,6 +99,11 @@ ReportData verificationReport(const MachineModel& m, const DeviationSet& simulat
     if (in.gateUm)
         d.facts.push_back({"gate", fmt::format("--max-residual-um {:g}: {}", *in.gateUm,
                                                r.residual / kUm <= *in.gateUm ? "passed" : "FAILED (exit status 1)")});
+    if (in.volumetricGateUm)
+        d.facts.push_back({"volumetric gate",
+                           fmt::format("--max-volumetric-um {:g}: {}", *in.volumetricGateUm,
+                                       verifyGatePassed(r, std::nullopt, in.volumetricGateUm) ? "passed"
+                                                                                               : "FAILED (exit status 1)")});
     d.afterNote = fmt::format("the same test programs through the compensation ({})", r.compensation);
     for (const VerifyRun& run : r.runs) {
         if (auto s = circleSection(run)) d.runs.push_back(std::move(*s));

@@ -25,6 +25,7 @@ struct VerificationReportInputs {
     std::string machineFile, planFile, compensationPath;  ///< as given on the command line (shown in the page)
     std::string dialect;                                  ///< of the in-memory test programs, e.g. "linuxcnc"
     std::optional<double> gateUm;                         ///< --max-residual-um
+    std::optional<double> volumetricGateUm;               ///< --max-volumetric-um
     /// The deviation set when the compensation is one (ideal compensation): its deviations are listed as compensated.
     const DeviationSet* compensationSet = nullptr;
     /// Grid and plane of the maps; the tool length is the first run's (VerifyResult::volumetric.toolLengths).
