@@ -1,5 +1,7 @@
 #include "controllers/generic/json.hpp"
 
+#include "cnccomp/io/markup.hpp"
+
 #include <cmath>
 
 #include <fmt/format.h>
@@ -161,17 +163,7 @@ Json parseJson(std::string_view text, const std::string& file) {
     return v;
 }
 
-std::string jsonString(std::string_view s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\', out += c;
-        else if (c == '\n') out += "\\n";
-        else if (c == '\t') out += "\\t";
-        else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
-        else out += c;
-    }
-    return out + "\"";
-}
+std::string jsonString(std::string_view s) { return cnccomp::jsonString(s); }
 
 std::string jsonNumber(double v) {
     if (!std::isfinite(v)) throw ModelError("JSON cannot hold a number that is not finite");

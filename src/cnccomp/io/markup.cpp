@@ -29,4 +29,23 @@ std::string escapeXml(std::string_view text, std::string_view what) {
     return o;
 }
 
+std::string jsonString(std::string_view s) {
+    std::string o = "\"";
+    for (size_t i = 0; i < s.size(); ++i) {
+        const char c = s[i];
+        switch (c) {
+            case '"': o += "\\\""; break;
+            case '\\': o += "\\\\"; break;
+            case '\n': o += "\\n"; break;
+            case '\r': o += "\\r"; break;
+            case '\t': o += "\\t"; break;
+            case '/': o += i > 0 && s[i - 1] == '<' ? "\\/" : "/"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20) o += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+                else o += c;
+        }
+    }
+    return o + "\"";
+}
+
 }  // namespace cnccomp

@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "cnccomp/io/markup.hpp"
+
 #include "cnccomp/error.hpp"
 #include "cnccomp/geometry.hpp"
 #include "cnccomp/io/text_util.hpp"
@@ -16,22 +18,7 @@ namespace cnccomp {
 
 namespace {
 
-std::string quote(const std::string& s) {
-    std::string o = "\"";
-    for (unsigned char c : s) {
-        switch (c) {
-            case '"': o += "\\\""; break;
-            case '\\': o += "\\\\"; break;
-            case '\n': o += "\\n"; break;
-            case '\t': o += "\\t"; break;
-            case '\r': o += "\\r"; break;
-            default:
-                if (c < 0x20) o += fmt::format("\\u{:04x}", c);
-                else o += static_cast<char>(c);
-        }
-    }
-    return o + "\"";
-}
+std::string quote(const std::string& s) { return jsonString(s); }
 
 std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : "null"; }
 

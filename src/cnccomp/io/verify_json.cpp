@@ -4,25 +4,13 @@
 
 #include <fmt/format.h>
 
+#include "cnccomp/io/markup.hpp"
+
 
 namespace cnccomp {
 namespace {
 
-std::string str(std::string_view s) {
-    std::string o = "\"";
-    for (char c : s) {
-        switch (c) {
-            case '"': o += "\\\""; break;
-            case '\\': o += "\\\\"; break;
-            case '\n': o += "\\n"; break;
-            case '\t': o += "\\t"; break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20) o += fmt::format("\\u{:04x}", static_cast<int>(c));
-                else o += c;
-        }
-    }
-    return o + "\"";
-}
+std::string str(std::string_view s) { return jsonString(s); }
 
 std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
 

@@ -20,25 +20,6 @@ std::string fixed(double v, int decimals) {
     return fmt::format("{:.{}f}", v, decimals);
 }
 
-std::string jsonString(std::string_view s) {
-    std::string o = "\"";
-    for (size_t i = 0; i < s.size(); ++i) {
-        const char c = s[i];
-        switch (c) {
-            case '"': o += "\\\""; break;
-            case '\\': o += "\\\\"; break;
-            case '\n': o += "\\n"; break;
-            case '\r': o += "\\r"; break;
-            case '\t': o += "\\t"; break;
-            case '/': o += i > 0 && s[i - 1] == '<' ? "\\/" : "/"; break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20) o += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-                else o += c;
-        }
-    }
-    return o + "\"";
-}
-
 std::string jsonNumber(double v) {
     if (!std::isfinite(v)) return "null";
     if (v == 0) return "0";

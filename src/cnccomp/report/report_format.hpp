@@ -3,15 +3,15 @@
 #include <string>
 #include <string_view>
 
+#include "cnccomp/io/markup.hpp"
+
 namespace cnccomp::report {
 
 /// The smallest of 1, 2, 2.5, 5 × 10^k that is ≥ x (x > 0; 1 otherwise).
 double niceNumber(double x);
 /// `v` with `decimals` decimals; "–" when not finite.
 std::string fixed(double v, int decimals);
-/// JSON string literal (quotes, backslashes and control characters escaped; "</" written as "<\/" so that the text
-/// can sit inside an HTML <script> element).
-std::string jsonString(std::string_view s);
+using cnccomp::jsonString;  // io/markup.hpp
 /// JSON number with 9 significant digits, or null when not finite.
 std::string jsonNumber(double v);
 
