@@ -261,6 +261,8 @@ void symmetricEigen(const double G[kMaxAxes][kMaxAxes], int k, double lambda[kMa
 
 /// Smallest eigenvalue of the symmetric k × k matrix G.
 double smallestEigenvalue(const double G[kMaxAxes][kMaxAxes], int k) {
+    if (k == 1) return G[0][0];
+    if (k == 2) return 0.5 * (G[0][0] + G[1][1]) - std::hypot(0.5 * (G[0][0] - G[1][1]), G[0][1]);
     double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
     symmetricEigen(G, k, lambda, V);
     return lambda[0];
@@ -272,7 +274,7 @@ bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, dou
     if (!cache.valid || cache.toolLength != toolLength || cache.q.size() != q.size()) return false;
     for (int i = 0; i < q.size(); ++i) {
         const double d = std::fabs(q[i] - cache.q[i]);
-        if ((rotary_ & (1u << i)) ? d > 0.5 * kDeg : d > 10.0) return false;
+        if ((rotary_ & (1u << i)) ? d > 2.0 * kDeg : d > 50.0) return false;
     }
     return true;
 }
@@ -354,10 +356,13 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
     };
     if (cache_.valid && cache_.toolLength == toolLength) {
         gram(cache_.J, 1.0 / (options_.axisWeight * options_.axisWeight));
-        // The kept Jacobian lies within 0.5 deg of each rotary axis and belongs to the erroneous machine: its singular
-        // values differ from the nominal ones at cNom by < 0.03 (0.5 deg per axis, deviations ≪ 0.01 rad).
+        // The kept Jacobian belongs to the erroneous machine at nearby commands: turning rotary axis j by δⱼ turns each
+        // column (a unit rotary direction × the tool axis) by at most 2|δⱼ|, so the singular values differ from the
+        // nominal ones at cNom by at most 2√k Σ|δⱼ| plus the deviations' share (≪ 0.01 rad).
+        double moved = 0;
+        for (int a = 0; a < k; ++a) moved += std::fabs(cache_.q[axes[a]] - (cNom[axes[a]] + zero_[axes[a]]));
         const double s = std::sqrt(std::max(0.0, smallestEigenvalue(G, k)));
-        if (s >= s0 + 0.05) return;
+        if (s >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
     }
     // The nominal machine's at the target, exactly: D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ, φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, so
     // that damping and continuity act only in the ill-conditioned directions and fade smoothly into the exact solution.
@@ -501,11 +506,26 @@ SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, 
     return res;
 }
 
+Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
+    if (s.mode == ProgramMode::Joints) return nominalTip(p.p, s.toolLength);
+    // TCP: the programmed point is the controlled point (world frame), the nominal tip lies along the tool axis from
+    // it; the axis depends on the rotary angles only (or is the programmed vector). No inverse kinematics needed.
+    Vec3 axis;
+    if (s.mode == ProgramMode::TcpVector) {
+        axis = tcp_.axisFromWorld(p.v.normalized());
+    } else {
+        Vec3 tip;
+        nominal_.toolPose(p.p + zero_, 0.0, tip, axis);
+    }
+    const int* lin = tcp_.linearAxes();
+    return tcp_.pointFromWorld(Vec3(p.p[lin[0]], p.p[lin[1]], p.p[lin[2]])) + (s.toolLength - s.controlLength) * axis;
+}
+
 double Corrector::deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected,
                               double t) const {
-    AxisVector cn, cc;
-    if (!toJoints(ctx.space, nominal, ctx.guess, cn) || !toJoints(ctx.space, corrected, ctx.guess, cc)) return HUGE_VAL;
-    const Vec3 e = actualTip(cc, ctx.space.toolLength) - nominalTip(cn, ctx.space.toolLength) - (1.0 - t) * ctx.startOffset;
+    AxisVector cc;
+    if (!toJoints(ctx.space, corrected, ctx.guess, cc)) return HUGE_VAL;
+    const Vec3 e = actualTip(cc, ctx.space.toolLength) - nominalTipOf(ctx.space, nominal) - (1.0 - t) * ctx.startOffset;
     return e.norm();
 }
 

@@ -139,6 +139,8 @@ public:
     /// Tip of the erroneous machine at c.
     Vec3 actualTip(const AxisVector& c, double toolLength) const;
     Vec3 nominalTip(const AxisVector& c, double toolLength) const;
+    /// Tip (at s.toolLength) of the nominal machine at program position p, in the workpiece frame.
+    Vec3 nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const;
 
     /// Corrected program position for the nominal one: joints `cNom` (out), solved joints `c` (start `start`,
     /// reference rotary positions `reference`), the program position `out`.
