@@ -176,39 +176,38 @@ void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame&
     }
 }
 
-void CompiledKinematics::cached(const ChainOps& c, ChainCache& cache, const AxisVector& q, Frame& f, Lines* lines) const {
+const CompiledKinematics::ChainEntry& CompiledKinematics::cached(const ChainOps& c, ChainCache& cache, const AxisVector& q,
+                                                                 bool lines) const {
+    if (c.affine.ok) {  // cheaper to evaluate than to look up
+        ChainEntry& e = cache.entry[0];
+        e.lines.count = 0;
+        evaluate(c, q, e.frame, lines ? &e.lines : nullptr);
+        e.valid = false;
+        return e;
+    }
     for (ChainEntry& e : cache.entry) {
         bool hit = e.valid && (e.hasLines || !lines);
         for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == q[c.axes[k]];
         if (!hit) continue;
-        f = e.frame;
-        if (lines)
-            for (int k = 0; k < e.lines.count; ++k) lines->items[lines->count++] = e.lines.items[k];
         cache.next = static_cast<int>(&e == &cache.entry[0]);  // keep the one just used
-        return;
+        return e;
     }
     ChainEntry& e = cache.entry[cache.next];
     cache.next ^= 1;
-    if (lines) {
-        e.lines.count = 0;
-        evaluate(c, q, f, &e.lines);
-        for (int k = 0; k < e.lines.count; ++k) lines->items[lines->count++] = e.lines.items[k];
-    } else {
-        evaluate(c, q, f, nullptr);
-    }
-    e.frame = f;
-    e.hasLines = lines != nullptr;
+    e.lines.count = 0;
+    evaluate(c, q, e.frame, lines ? &e.lines : nullptr);
+    e.hasLines = lines;
     e.valid = true;
     for (size_t k = 0; k < c.axes.size(); ++k) e.key[k] = q[c.axes[k]];
+    return e;
 }
 
 void CompiledKinematics::toolPose(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
-    Frame w, t;
-    cached(workpiece_, workpieceCache_, q, w, nullptr);
-    cached(tool_, toolCache_, q, t, nullptr);
+    const Frame& w = cached(workpiece_, workpieceCache_, q, false).frame;
+    const Frame& t = cached(tool_, toolCache_, q, false).frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
-    tip = w.R.transpose() * (t.t + length * dirB - w.t);
-    axis = w.R.transpose() * dirB;
+    tip.noalias() = w.R.transpose() * (t.t + length * dirB - w.t);
+    axis.noalias() = w.R.transpose() * dirB;
 }
 
 Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {
@@ -218,68 +217,58 @@ Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {
 }
 
 void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const {
-    Lines lines;
-    Frame w, t;
-    cached(workpiece_, workpieceCache_, q, w, &lines);
-    const int workpieceLines = lines.count;
-    cached(tool_, toolCache_, q, t, &lines);
+    const ChainEntry& we = cached(workpiece_, workpieceCache_, q, true);
+    const ChainEntry& te = cached(tool_, toolCache_, q, true);
+    const Frame &w = we.frame, &t = te.frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
     const Mat3 wRb = w.R.transpose();
     tip = wRb * (tipB - w.t);
     axis = wRb * dirB;
     J.setZero(6, q.size());
-    for (int k = 0; k < lines.count; ++k) {
-        const JointLine& j = lines.items[k];
-        // Tool-side motion moves the tool; workpiece-side motion moves the workpiece, i.e. the tool relative to it
-        // the other way (as cnccomp::toolPoseJacobian; component errors' own slopes are neglected).
-        const double sign = k < workpieceLines ? -1.0 : 1.0;
-        if (j.rotary) {
-            J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction.cross(tipB - j.point));
-            J.block<3, 1>(3, j.axis) = sign * (wRb * j.direction.cross(dirB));
-        } else {
-            J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction);
+    // Tool-side motion moves the tool; workpiece-side motion moves the workpiece, i.e. the tool relative to it the
+    // other way (as cnccomp::toolPoseJacobian; component errors' own slopes are neglected).
+    for (const ChainEntry* e : {&we, &te}) {
+        const double sign = e == &we ? -1.0 : 1.0;
+        for (int k = 0; k < e->lines.count; ++k) {
+            const JointLine& j = e->lines.items[k];
+            if (j.rotary) {
+                J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction.cross(tipB - j.point));
+                J.block<3, 1>(3, j.axis) = sign * (wRb * j.direction.cross(dirB));
+            } else {
+                J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction);
+            }
         }
     }
 }
 
 void CompiledKinematics::pointJacobian(const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const {
-    Lines lines;
-    Frame w, t;
     // Joint lines only of the chains that hold one of the axes.
     auto holds = [&](const ChainOps& c) {
         for (int a : c.axes)
             if (a == axes[0] || a == axes[1] || a == axes[2]) return true;
         return false;
     };
-    cached(workpiece_, workpieceCache_, q, w, holds(workpiece_) ? &lines : nullptr);
-    const int workpieceLines = lines.count;
-    cached(tool_, toolCache_, q, t, holds(tool_) ? &lines : nullptr);
+    const ChainEntry& we = cached(workpiece_, workpieceCache_, q, holds(workpiece_));
+    const ChainEntry& te = cached(tool_, toolCache_, q, holds(tool_));
+    const Frame &w = we.frame, &t = te.frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
     const Mat3 wRb = w.R.transpose();
     tip = wRb * (tipB - w.t);
     J.setZero();
-    for (int k = 0; k < lines.count; ++k) {
-        const JointLine& j = lines.items[k];
-        for (int c = 0; c < 3; ++c) {
-            if (axes[c] != j.axis) continue;
-            const double sign = k < workpieceLines ? -1.0 : 1.0;
-            J.col(c) = sign * (wRb * (j.rotary ? j.direction.cross(tipB - j.point) : j.direction));
+    for (const ChainEntry* e : {&we, &te}) {
+        const double sign = e == &we ? -1.0 : 1.0;
+        for (int k = 0; k < e->lines.count; ++k) {
+            const JointLine& j = e->lines.items[k];
+            for (int c = 0; c < 3; ++c)
+                if (axes[c] == j.axis) J.col(c) = sign * (wRb * (j.rotary ? j.direction.cross(tipB - j.point) : j.direction));
         }
     }
 }
 
-Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const {
-    Frame f;
-    cached(workpiece_, workpieceCache_, q, f, nullptr);
-    return f;
-}
+Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const { return cached(workpiece_, workpieceCache_, q, false).frame; }
 
-Frame CompiledKinematics::baseToTool(const AxisVector& q) const {
-    Frame f;
-    cached(tool_, toolCache_, q, f, nullptr);
-    return f;
-}
+Frame CompiledKinematics::baseToTool(const AxisVector& q) const { return cached(tool_, toolCache_, q, false).frame; }
 
 }  // namespace cnccomp::pp

@@ -94,7 +94,8 @@ private:
     };
     void compile(const Chain& chain, Side side, ChainOps& c);
     void evaluate(const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const;
-    void cached(const ChainOps& c, ChainCache& cache, const AxisVector& q, Frame& f, Lines* lines) const;
+    /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
+    const ChainEntry& cached(const ChainOps& c, ChainCache& cache, const AxisVector& q, bool lines) const;
 
     const MachineModel* machine_;
     Eigen::VectorXd values_;
