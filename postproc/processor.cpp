@@ -136,7 +136,7 @@ struct Record {
     bool forgetOutput = false;      ///< the output position is unknown after it (TCP on a machine without X Y Z)
     MoveSpace space;
     bool nomStartKnown = false, corrected = false, unconverged = false, outsideTravel = false, jointsComputed = false;
-    ProgramPoint nomStart, nomEnd, qEnd;
+    ProgramPoint nomStart, nomEnd;
     AxisVector cNom, cEnd;
     double tipResidual = 0, axisResidual = 0;  ///< of the end point's solution
     std::vector<std::pair<bool, std::string>> notices;  ///< (warning, text) raised by the front end, in order
@@ -321,7 +321,6 @@ void FrontEnd::move(Record& rec) {
     rec.tipResidual = rec.axisResidual = 0;
     if (identity) {
         cEnd = cNom;
-        rec.qEnd = nomEnd;
     } else {
         // Near the previous end point's correction (warm start and continuity) and the programmed value.
         const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd,
@@ -333,12 +332,10 @@ void FrontEnd::move(Record& rec) {
             rec.note(true, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
                                        s.tipError / kUm));
             cEnd = cNom;
-            rec.qEnd = nomEnd;
         } else {
             lastDelta_ = cEnd - cNom;
             haveDelta_ = true;
-            rec.corrected = true;
-            corrector_.toProgram(space, cEnd, rec.qEnd);
+            rec.corrected = true;  // the back end writes cEnd's program position (toProgram)
         }
     }
     if (!(identity && tcp && !vector)) checkTravel(rec);
@@ -890,7 +887,6 @@ void ProgramCorrector::move(Record& rec) {
     const ProgramPoint& nomEnd = rec.nomEnd;
     const AxisVector& cNom = rec.cNom;
     const AxisVector& cEnd = rec.cEnd;
-    const ProgramPoint& qEnd0 = rec.qEnd;
     if (vector) {
         outStartKnown = outStartKnown && (outVectorKnown_ || vectorOf(corrector_, outAt_, cNom));
         if (outStartKnown && !outVectorKnown_) {
@@ -914,7 +910,9 @@ void ProgramCorrector::move(Record& rec) {
         }
     }
     if (rec.outsideTravel) ++summary_.outsideTravel;
-    ProgramPoint qEnd = qEnd0;
+    // Program position of the corrected end point (the nominal one when nothing was corrected).
+    ProgramPoint qEnd = nomEnd;
+    if (rec.corrected) corrector_.toProgram(space, cEnd, qEnd);
 
     // Pieces.
     pieces_.clear();
