@@ -176,7 +176,7 @@ namespace {
 /// Inverse of the symmetric positive definite n × n matrix A (n ≤ kMaxAxes, row-major arrays) by Cholesky: a few
 /// hundred flops for the post-processor's 5 × 5 normal matrices. False when A is not positive definite.
 bool invertSpd(const double A[kMaxAxes][kMaxAxes], int n, double inv[kMaxAxes][kMaxAxes]) {
-    double L[kMaxAxes][kMaxAxes] = {}, Li[kMaxAxes][kMaxAxes] = {};
+    double L[kMaxAxes][kMaxAxes], Li[kMaxAxes][kMaxAxes];
     for (int j = 0; j < n; ++j) {
         double d = A[j][j];
         for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
@@ -262,7 +262,10 @@ void symmetricEigen(const double G[kMaxAxes][kMaxAxes], int k, double lambda[kMa
 /// Smallest eigenvalue of the symmetric k × k matrix G.
 double smallestEigenvalue(const double G[kMaxAxes][kMaxAxes], int k) {
     if (k == 1) return G[0][0];
-    if (k == 2) return 0.5 * (G[0][0] + G[1][1]) - std::hypot(0.5 * (G[0][0] - G[1][1]), G[0][1]);
+    if (k == 2) {
+        const double h = 0.5 * (G[0][0] - G[1][1]);
+        return 0.5 * (G[0][0] + G[1][1]) - std::sqrt(h * h + G[0][1] * G[0][1]);
+    }
     double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
     symmetricEigen(G, k, lambda, V);
     return lambda[0];
@@ -291,6 +294,7 @@ void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cach
     cache.toolLength = toolLength;
     cache.valid = true;
     cache.factored = false;
+    cache.sigmaFree = ~0u;
 }
 
 void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask free) const {
@@ -355,14 +359,17 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
                 G[a][b] = G[b][a] = J.block<3, 1>(3, axes[a]).dot(J.block<3, 1>(3, axes[b])) * scale;
     };
     if (cache_.valid && cache_.toolLength == toolLength) {
-        gram(cache_.J, 1.0 / (options_.axisWeight * options_.axisWeight));
         // The kept Jacobian belongs to the erroneous machine at nearby commands: turning rotary axis j by δⱼ turns each
         // column (a unit rotary direction × the tool axis) by at most 2|δⱼ|, so the singular values differ from the
         // nominal ones at cNom by at most 2√k Σ|δⱼ| plus the deviations' share (≪ 0.01 rad).
         double moved = 0;
         for (int a = 0; a < k; ++a) moved += std::fabs(cache_.q[axes[a]] - (cNom[axes[a]] + zero_[axes[a]]));
-        const double s = std::sqrt(std::max(0.0, smallestEigenvalue(G, k)));
-        if (s >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
+        if (cache_.sigmaFree != free) {  // once per kept Jacobian
+            gram(cache_.J, 1.0 / (options_.axisWeight * options_.axisWeight));
+            cache_.sigma = std::sqrt(std::max(0.0, smallestEigenvalue(G, k)));
+            cache_.sigmaFree = free;
+        }
+        if (cache_.sigma >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
     }
     // The nominal machine's at the target, exactly: D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ, φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, so
     // that damping and continuity act only in the ill-conditioned directions and fade smoothly into the exact solution.

@@ -180,6 +180,8 @@ private:
         double D[kMaxAxes][kMaxAxes] = {};       ///< damping of the factorisation
         double Ainv[kMaxAxes][kMaxAxes] = {};    ///< (JᵀJ + D)⁻¹
         double gain[kMaxAxes][6] = {};           ///< Ainv · Jᵀ (zero rows for fixed axes)
+        AxisMask sigmaFree = ~0u;                ///< free axes `sigma` was computed for (~0: not computed)
+        double sigma = 0;                        ///< smallest singular value of J's axis rows by the free rotary axes
     };
     /// Rotary damping of one solve: D (n × n, non-zero in the rotary rows and columns of ill-conditioned directions).
     struct Damping {

@@ -59,6 +59,12 @@ const char* warningText(Warning w) {
 
 double circular(double d) { return d - 360.0 * std::round(d / 360.0); }
 
+/// 10^e for the decimals of a written number (e in −15 … 0; beyond: std::pow).
+double tenTo(int e) {
+    static constexpr double kNeg[] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15};
+    return e <= 0 && e >= -15 ? kNeg[-e] : std::pow(10.0, e);
+}
+
 /// How the words of one block are spaced and aligned, so that words added to it (or lines added after it) look like
 /// its own: the white space between words, between a letter and its number, and whether positive numbers take the
 /// place of a minus sign ("X  16.339  Y -25.409").
@@ -666,7 +672,7 @@ void ProgramCorrector::vectorWords(const Vec3& v, bool onBlock, char* buf, size_
     st.decimals = options_.decimals >= 0 ? options_.decimals : std::max(vectorStyle_.maxDecimals, 7);
     st.fixed = vectorStyle_.trailingZero;
     st.bareFraction = vectorStyle_.bare;
-    const double res = std::pow(10.0, -st.decimals);
+    const double res = tenTo(-st.decimals);
     // Unchanged at the written resolution: keep the program's words (or its kept vector).
     Vec3 given = outVector_;
     bool anyWord = false;
@@ -836,12 +842,12 @@ double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
         if (layout_.rotary[a]) rotDecimals = std::min(rotDecimals, dd);
         else linDecimals = std::min(linDecimals, dd);
     }
-    const double linStep = std::pow(10.0, -linDecimals) * (r_->inch ? 25.4 : 1.0);
+    const double linStep = tenTo(-linDecimals) * (r_->inch ? 25.4 : 1.0);
     double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearCount_, 1)));
     if (space.mode == ProgramMode::Joints && rotaryCount_ > 0) {
         // Lever arm of the rotary axes at this pose: the tip's distance from the workpiece origin plus the tool.
         const double lever = corrector_.nominalTip(r_->end, space.toolLength).norm() + std::fabs(space.toolLength);
-        floor += 0.5 * std::pow(10.0, -rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
+        floor += 0.5 * tenTo(-rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
     }
     if (tol >= floor) return tol;
     ++summary_.clampedTolerance;
