@@ -1314,6 +1314,14 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     LineReader reader(in, options.bufferSize);
     const std::string_view head = reader.head();
     checkTextHead(head, options.inputName);
+    // HEIDENHAIN Klartext is not ISO G-code: its L / C / CC blocks would be read as words and passed through one by one.
+    // Refused before anything is written, whatever --dialect says.
+    const int klartext = klartextHeaderLine(head);
+    if (klartext > 0 || options.dialect == Dialect::Heidenhain)
+        throw InputError(options.inputName, klartext,
+                         "a HEIDENHAIN Klartext program (BEGIN PGM): `correct` rewrites ISO G-code only (RS274NGC/LinuxCNC, "
+                         "Fanuc, Sinumerik ISO mode, printers), nothing was written. For a TNC load the compensation into the "
+                         "control instead (cnccomp emit --controller heidenhain-tnc); `cnccomp poses` reads Klartext");
     if (options.dialect) {
         s.dialect = *options.dialect;
     } else {
