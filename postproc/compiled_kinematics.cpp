@@ -8,9 +8,8 @@ namespace {
 
 bool isIdentity(const Mat3& R, const Vec3& t) { return R == Mat3::Identity() && t == Vec3::Zero(); }
 
-/// R ← R · Rot(unit axis k, angle): two columns change.
-inline void rotateAboutUnit(Mat3& R, int k, double angle) {
-    const double c = std::cos(angle), s = std::sin(angle);
+/// R ← R · Rot(unit axis k, angle) given c = cos(angle), s = sin(angle): two columns change.
+inline void rotateAboutUnit(Mat3& R, int k, double c, double s) {
     const int i = (k + 1) % 3, j = (k + 2) % 3;  // Rx: (y, z), Ry: (z, x), Rz: (x, y)
     const Vec3 a = R.col(i), b = R.col(j);
     R.col(i) = c * a + s * b;
@@ -22,11 +21,31 @@ inline void rotateAboutUnit(Mat3& R, int k, double angle) {
 CompiledKinematics::CompiledKinematics(const MachineModel& machine, const DeviationSet* deviations)
     : machine_(&machine),
       values_(deviations ? deviations->values : Eigen::VectorXd::Zero(machine.parameterCount())) {
-    compile(machine.workpiece, Side::Workpiece, workpiece_, workpieceAxes_);
-    compile(machine.tool, Side::Tool, tool_, toolAxes_);
+    compile(machine.workpiece, Side::Workpiece, workpiece_);
+    compile(machine.tool, Side::Tool, tool_);
 }
 
-void CompiledKinematics::compile(const Chain& chain, Side side, std::vector<Op>& ops, std::vector<int>& axes) {
+void CompiledKinematics::Trig::at(double angle, double& c, double& s) const {
+    const double d = angle - last;
+    if (std::fabs(d) <= 0.05) {
+        // Near the last angle (consecutive evaluations: Newton steps, neighbouring blocks): angle addition with the
+        // Taylor series of the difference, whose first omitted terms (d¹¹/11!, d¹²/12! < 1e-22) are far below a
+        // rounding of the result.
+        const double d2 = d * d;
+        const double sd = d * (1 + d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880)))));
+        const double cd = 1 + d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720 + d2 * (1.0 / 40320 + d2 * (-1.0 / 3628800)))));
+        c = lastC * cd - lastS * sd;
+        s = lastS * cd + lastC * sd;
+        return;
+    }
+    c = std::cos(angle);
+    s = std::sin(angle);
+    last = angle, lastC = c, lastS = s;  // only exact evaluations become bases: no drift
+}
+
+void CompiledKinematics::compile(const Chain& chain, Side side, ChainOps& c) {
+    std::vector<Op>& ops = c.ops;
+    std::vector<int>& axes = c.axes;
     ops.clear();
     axes.clear();
     Frame pending;  // constant transforms not emitted yet
@@ -34,6 +53,7 @@ void CompiledKinematics::compile(const Chain& chain, Side side, std::vector<Op>&
         if (isIdentity(pending.R, pending.t)) return;
         Op op;
         op.kind = OpKind::Constant;
+        op.identityR = pending.R == Mat3::Identity();
         op.R = pending.R;
         op.t = pending.t;
         ops.push_back(op);
@@ -79,26 +99,68 @@ void CompiledKinematics::compile(const Chain& chain, Side side, std::vector<Op>&
         }
     }
     flush();
+    // Affine chains (linear axes and constant transforms only: most tool chains of table-table machines).
+    Affine& a = c.affine;
+    a = Affine{};
+    a.ok = true;
+    for (const Op& op : ops) a.ok = a.ok && (op.kind == OpKind::Constant || op.kind == OpKind::Linear);
+    if (!a.ok) return;
+    for (const Op& op : ops) {
+        if (op.kind == OpKind::Constant) {
+            a.t0 += a.R * op.t;
+            a.R = a.R * op.R;
+        } else {
+            a.axis[a.count] = op.axis;
+            a.col[a.count] = a.R * op.dir;
+            a.start[a.count] = a.t0;
+            ++a.count;
+        }
+    }
 }
 
-void CompiledKinematics::evaluate(const std::vector<Op>& ops, const AxisVector& q, Frame& f, Lines* lines) const {
+void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const {
+    if (c.affine.ok) {
+        const Affine& a = c.affine;
+        f.R = a.R;
+        f.t = a.t0;
+        Vec3 moved = Vec3::Zero();  // by the axes before the current one
+        for (int k = 0; k < a.count; ++k) {
+            if (lines) lines->items[lines->count++] = {a.axis[k], false, a.col[k], a.start[k] + moved};
+            moved += a.col[k] * q[a.axis[k]];
+        }
+        f.t += moved;
+        return;
+    }
+    const std::vector<Op>& ops = c.ops;
     f.R.setIdentity();
     f.t.setZero();
     for (const Op& op : ops) {
         switch (op.kind) {
             case OpKind::Constant:
                 f.t += f.R * op.t;
-                f.R = f.R * op.R;
+                if (!op.identityR) f.R = f.R * op.R;
                 break;
             case OpKind::Linear:
                 if (lines) lines->items[lines->count++] = {op.axis, false, f.R * op.dir, f.t};
                 f.t += f.R * (op.dir * q[op.axis]);
                 break;
-            case OpKind::Rotary:
+            case OpKind::Rotary: {
                 if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
-                if (op.unit >= 0) rotateAboutUnit(f.R, op.unit, q[op.axis]);
-                else f.R = f.R * axisRotation(op.dir, q[op.axis]);
+                double c, sn;
+                op.trig.at(q[op.axis], c, sn);
+                if (op.unit >= 0) {
+                    rotateAboutUnit(f.R, op.unit, c, sn);
+                } else {
+                    // Rodrigues: R(u, θ) = c I + s [u]× + (1 − c) u uᵀ.
+                    const Vec3& u = op.dir;
+                    Mat3 Ru;
+                    Ru << c + u.x() * u.x() * (1 - c), u.x() * u.y() * (1 - c) - u.z() * sn, u.x() * u.z() * (1 - c) + u.y() * sn,
+                        u.y() * u.x() * (1 - c) + u.z() * sn, c + u.y() * u.y() * (1 - c), u.y() * u.z() * (1 - c) - u.x() * sn,
+                        u.z() * u.x() * (1 - c) - u.y() * sn, u.z() * u.y() * (1 - c) + u.x() * sn, c + u.z() * u.z() * (1 - c);
+                    f.R = f.R * Ru;
+                }
                 break;
+            }
             case OpKind::Component: {
                 Vec6 e = Vec6::Zero();
                 for (int k : op.components) {
@@ -114,37 +176,38 @@ void CompiledKinematics::evaluate(const std::vector<Op>& ops, const AxisVector& 
     }
 }
 
-void CompiledKinematics::cached(const std::vector<Op>& ops, const std::vector<int>& axes, ChainCache& cache,
-                                const AxisVector& q, Frame& f, Lines* lines) const {
-    bool hit = cache.valid && (cache.hasLines || !lines);
-    for (size_t k = 0; k < axes.size() && hit; ++k) hit = cache.key[k] == q[axes[k]];
-    if (hit) {
-        f = cache.frame;
-        if (lines) {
-            for (int k = 0; k < cache.lines.count; ++k) lines->items[lines->count++] = cache.lines.items[k];
-        }
-        return;
+const CompiledKinematics::ChainEntry& CompiledKinematics::cached(const ChainOps& c, ChainCache& cache, const AxisVector& q,
+                                                                 bool lines) const {
+    if (c.affine.ok) {  // cheaper to evaluate than to look up
+        ChainEntry& e = cache.entry[0];
+        e.lines.count = 0;
+        evaluate(c, q, e.frame, lines ? &e.lines : nullptr);
+        e.valid = false;
+        return e;
     }
-    if (lines) {
-        cache.lines.count = 0;
-        evaluate(ops, q, f, &cache.lines);
-        for (int k = 0; k < cache.lines.count; ++k) lines->items[lines->count++] = cache.lines.items[k];
-    } else {
-        evaluate(ops, q, f, nullptr);
+    for (ChainEntry& e : cache.entry) {
+        bool hit = e.valid && (e.hasLines || !lines);
+        for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == q[c.axes[k]];
+        if (!hit) continue;
+        cache.next = static_cast<int>(&e == &cache.entry[0]);  // keep the one just used
+        return e;
     }
-    cache.frame = f;
-    cache.hasLines = lines != nullptr;
-    cache.valid = true;
-    for (size_t k = 0; k < axes.size(); ++k) cache.key[k] = q[axes[k]];
+    ChainEntry& e = cache.entry[cache.next];
+    cache.next ^= 1;
+    e.lines.count = 0;
+    evaluate(c, q, e.frame, lines ? &e.lines : nullptr);
+    e.hasLines = lines;
+    e.valid = true;
+    for (size_t k = 0; k < c.axes.size(); ++k) e.key[k] = q[c.axes[k]];
+    return e;
 }
 
 void CompiledKinematics::toolPose(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
-    Frame w, t;
-    cached(workpiece_, workpieceAxes_, workpieceCache_, q, w, nullptr);
-    cached(tool_, toolAxes_, toolCache_, q, t, nullptr);
+    const Frame& w = cached(workpiece_, workpieceCache_, q, false).frame;
+    const Frame& t = cached(tool_, toolCache_, q, false).frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
-    tip = w.R.transpose() * (t.t + length * dirB - w.t);
-    axis = w.R.transpose() * dirB;
+    tip.noalias() = w.R.transpose() * (t.t + length * dirB - w.t);
+    axis.noalias() = w.R.transpose() * dirB;
 }
 
 Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {
@@ -154,62 +217,58 @@ Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {
 }
 
 void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const {
-    Lines lines;
-    Frame w, t;
-    cached(workpiece_, workpieceAxes_, workpieceCache_, q, w, &lines);
-    const int workpieceLines = lines.count;
-    cached(tool_, toolAxes_, toolCache_, q, t, &lines);
+    const ChainEntry& we = cached(workpiece_, workpieceCache_, q, true);
+    const ChainEntry& te = cached(tool_, toolCache_, q, true);
+    const Frame &w = we.frame, &t = te.frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
     const Mat3 wRb = w.R.transpose();
     tip = wRb * (tipB - w.t);
     axis = wRb * dirB;
     J.setZero(6, q.size());
-    for (int k = 0; k < lines.count; ++k) {
-        const JointLine& j = lines.items[k];
-        // Tool-side motion moves the tool; workpiece-side motion moves the workpiece, i.e. the tool relative to it
-        // the other way (as cnccomp::toolPoseJacobian; component errors' own slopes are neglected).
-        const double sign = k < workpieceLines ? -1.0 : 1.0;
-        if (j.rotary) {
-            J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction.cross(tipB - j.point));
-            J.block<3, 1>(3, j.axis) = sign * (wRb * j.direction.cross(dirB));
-        } else {
-            J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction);
+    // Tool-side motion moves the tool; workpiece-side motion moves the workpiece, i.e. the tool relative to it the
+    // other way (as cnccomp::toolPoseJacobian; component errors' own slopes are neglected).
+    for (const ChainEntry* e : {&we, &te}) {
+        const double sign = e == &we ? -1.0 : 1.0;
+        for (int k = 0; k < e->lines.count; ++k) {
+            const JointLine& j = e->lines.items[k];
+            if (j.rotary) {
+                J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction.cross(tipB - j.point));
+                J.block<3, 1>(3, j.axis) = sign * (wRb * j.direction.cross(dirB));
+            } else {
+                J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction);
+            }
         }
     }
 }
 
 void CompiledKinematics::pointJacobian(const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const {
-    Lines lines;
-    Frame w, t;
-    cached(workpiece_, workpieceAxes_, workpieceCache_, q, w, &lines);
-    const int workpieceLines = lines.count;
-    cached(tool_, toolAxes_, toolCache_, q, t, &lines);
+    // Joint lines only of the chains that hold one of the axes.
+    auto holds = [&](const ChainOps& c) {
+        for (int a : c.axes)
+            if (a == axes[0] || a == axes[1] || a == axes[2]) return true;
+        return false;
+    };
+    const ChainEntry& we = cached(workpiece_, workpieceCache_, q, holds(workpiece_));
+    const ChainEntry& te = cached(tool_, toolCache_, q, holds(tool_));
+    const Frame &w = we.frame, &t = te.frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
     const Mat3 wRb = w.R.transpose();
     tip = wRb * (tipB - w.t);
     J.setZero();
-    for (int k = 0; k < lines.count; ++k) {
-        const JointLine& j = lines.items[k];
-        for (int c = 0; c < 3; ++c) {
-            if (axes[c] != j.axis) continue;
-            const double sign = k < workpieceLines ? -1.0 : 1.0;
-            J.col(c) = sign * (wRb * (j.rotary ? j.direction.cross(tipB - j.point) : j.direction));
+    for (const ChainEntry* e : {&we, &te}) {
+        const double sign = e == &we ? -1.0 : 1.0;
+        for (int k = 0; k < e->lines.count; ++k) {
+            const JointLine& j = e->lines.items[k];
+            for (int c = 0; c < 3; ++c)
+                if (axes[c] == j.axis) J.col(c) = sign * (wRb * (j.rotary ? j.direction.cross(tipB - j.point) : j.direction));
         }
     }
 }
 
-Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const {
-    Frame f;
-    cached(workpiece_, workpieceAxes_, workpieceCache_, q, f, nullptr);
-    return f;
-}
+Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const { return cached(workpiece_, workpieceCache_, q, false).frame; }
 
-Frame CompiledKinematics::baseToTool(const AxisVector& q) const {
-    Frame f;
-    cached(tool_, toolAxes_, toolCache_, q, f, nullptr);
-    return f;
-}
+Frame CompiledKinematics::baseToTool(const AxisVector& q) const { return cached(tool_, toolCache_, q, false).frame; }
 
 }  // namespace cnccomp::pp

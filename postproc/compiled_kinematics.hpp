@@ -4,6 +4,7 @@
 // rotations), with the constant transforms between two motions folded into one, rotations about a coordinate axis
 // built from one sincos, component errors whose coefficients are all zero left out, no allocation per call.
 // The tests compare it with cnccomp::Kinematics and toolPoseJacobian.
+#include <cmath>
 #include <vector>
 
 #include "cnccomp/deviations.hpp"
@@ -37,6 +38,11 @@ public:
 
 private:
     enum class OpKind : uint8_t { Constant, Linear, Rotary, Component };
+    /// cos and sin of a rotary op's angle, from the last exactly computed angle when it is close.
+    struct Trig {
+        mutable double last = HUGE_VAL, lastC = 1, lastS = 0;
+        void at(double angle, double& c, double& s) const;
+    };
     struct Op {
         OpKind kind = OpKind::Constant;
         int axis = -1;
@@ -45,6 +51,8 @@ private:
         Vec3 t = Vec3::Zero();
         Vec3 dir = Vec3::UnitZ();
         bool modulo = false;
+        bool identityR = false;  ///< Constant op without rotation
+        Trig trig;               ///< Rotary op
         std::vector<int> components;  ///< deviation definitions of a Component op
     };
     struct JointLine {
@@ -56,23 +64,42 @@ private:
         JointLine items[kMaxAxes];
         int count = 0;
     };
-    /// The last evaluation of a chain, reused while the positions of its own axes are unchanged (consecutive
+    /// A chain without rotary motion or component errors is affine in its axes: R constant, t = t0 + Σ colₖ qₖ
+    /// (evaluated without walking its operations).
+    struct Affine {
+        bool ok = false;
+        Mat3 R = Mat3::Identity();
+        Vec3 t0 = Vec3::Zero();
+        int count = 0;
+        int axis[kMaxAxes] = {};
+        Vec3 col[kMaxAxes];    ///< base-frame direction of each axis (also its joint line's direction)
+        Vec3 start[kMaxAxes];  ///< where each axis' joint line starts with the axes before it at 0
+    };
+    /// The last two evaluations of a chain, reused while the positions of its own axes are unchanged (consecutive
     /// evaluations often share the rotary positions: the nominal target, the TCP world point, the check).
-    struct ChainCache {
+    struct ChainEntry {
         bool valid = false, hasLines = false;
         double key[kMaxAxes] = {};
         Frame frame;
         Lines lines;
     };
-    void compile(const Chain& chain, Side side, std::vector<Op>& ops, std::vector<int>& axes);
-    void evaluate(const std::vector<Op>& ops, const AxisVector& q, Frame& f, Lines* lines) const;
-    void cached(const std::vector<Op>& ops, const std::vector<int>& axes, ChainCache& cache, const AxisVector& q,
-                Frame& f, Lines* lines) const;
+    struct ChainCache {
+        ChainEntry entry[2];
+        int next = 0;  ///< entry replaced next
+    };
+    struct ChainOps {
+        std::vector<Op> ops;
+        std::vector<int> axes;
+        Affine affine;
+    };
+    void compile(const Chain& chain, Side side, ChainOps& c);
+    void evaluate(const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const;
+    /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
+    const ChainEntry& cached(const ChainOps& c, ChainCache& cache, const AxisVector& q, bool lines) const;
 
     const MachineModel* machine_;
     Eigen::VectorXd values_;
-    std::vector<Op> workpiece_, tool_;
-    std::vector<int> workpieceAxes_, toolAxes_;
+    ChainOps workpiece_, tool_;
     mutable ChainCache workpieceCache_, toolCache_;  ///< not thread-safe: one object per thread
 };
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Cholesky>
 
 namespace cnccomp::pp {
 
@@ -172,94 +171,285 @@ void Corrector::toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint&
     }
 }
 
-bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength, double lambda2) const {
-    if (!cache.valid || cache.toolLength != toolLength || cache.lambda2 != lambda2 || cache.q.size() != q.size())
-        return false;
+namespace {
+
+/// Inverse of the symmetric positive definite n × n matrix A (n ≤ kMaxAxes, row-major arrays) by Cholesky: a few
+/// hundred flops for the post-processor's 5 × 5 normal matrices. False when A is not positive definite.
+bool invertSpd(const double A[kMaxAxes][kMaxAxes], int n, double inv[kMaxAxes][kMaxAxes]) {
+    double L[kMaxAxes][kMaxAxes], Li[kMaxAxes][kMaxAxes];
+    for (int j = 0; j < n; ++j) {
+        double d = A[j][j];
+        for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+        if (!(d > 0)) return false;
+        L[j][j] = std::sqrt(d);
+        for (int i = j + 1; i < n; ++i) {
+            double v = A[i][j];
+            for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
+            L[i][j] = v / L[j][j];
+        }
+    }
+    for (int j = 0; j < n; ++j) {  // L⁻¹, lower triangular
+        Li[j][j] = 1.0 / L[j][j];
+        for (int i = j + 1; i < n; ++i) {
+            double v = 0;
+            for (int k = j; k < i; ++k) v -= L[i][k] * Li[k][j];
+            Li[i][j] = v / L[i][i];
+        }
+    }
+    for (int i = 0; i < n; ++i)  // A⁻¹ = L⁻ᵀ L⁻¹
+        for (int j = 0; j <= i; ++j) {
+            double v = 0;
+            for (int k = i; k < n; ++k) v += Li[k][i] * Li[k][j];
+            inv[i][j] = inv[j][i] = v;
+        }
+    return true;
+}
+
+/// Eigenvalues (ascending) and unit eigenvectors (columns of V) of the symmetric k × k matrix G.
+void symmetricEigen(const double G[kMaxAxes][kMaxAxes], int k, double lambda[kMaxAxes], double V[kMaxAxes][kMaxAxes]) {
+    if (k == 1) {
+        lambda[0] = G[0][0];
+        V[0][0] = 1.0;
+    } else if (k == 2) {
+        const double mean = 0.5 * (G[0][0] + G[1][1]), half = 0.5 * (G[0][0] - G[1][1]);
+        const double r = std::hypot(half, G[0][1]), th = 0.5 * std::atan2(G[0][1], half);
+        lambda[0] = mean - r;  // eigenvector (−sin θ, cos θ)
+        lambda[1] = mean + r;  // eigenvector (cos θ, sin θ)
+        V[0][0] = -std::sin(th), V[1][0] = std::cos(th);
+        V[0][1] = std::cos(th), V[1][1] = std::sin(th);
+    } else {
+        // Cyclic Jacobi rotations (k ≤ kMaxAxes; machines with three rotary axes or more).
+        double M[kMaxAxes][kMaxAxes];
+        for (int i = 0; i < k; ++i)
+            for (int j = 0; j < k; ++j) M[i][j] = G[i][j], V[i][j] = i == j ? 1.0 : 0.0;
+        for (int sweep = 0; sweep < 50; ++sweep) {
+            double off = 0, diag = 0;
+            for (int i = 0; i < k; ++i) {
+                diag += M[i][i] * M[i][i];
+                for (int j = i + 1; j < k; ++j) off += M[i][j] * M[i][j];
+            }
+            if (off <= 1e-30 * diag) break;
+            for (int p = 0; p < k; ++p)
+                for (int q = p + 1; q < k; ++q) {
+                    if (M[p][q] == 0.0) continue;
+                    const double th = 0.5 * std::atan2(2 * M[p][q], M[q][q] - M[p][p]);
+                    const double c = std::cos(th), s = std::sin(th);
+                    for (int i = 0; i < k; ++i) {  // M ← M Rᵀ-columns, V ← V R
+                        const double mp = M[i][p], mq = M[i][q];
+                        M[i][p] = c * mp - s * mq, M[i][q] = s * mp + c * mq;
+                        const double vp = V[i][p], vq = V[i][q];
+                        V[i][p] = c * vp - s * vq, V[i][q] = s * vp + c * vq;
+                    }
+                    for (int j = 0; j < k; ++j) {
+                        const double mp = M[p][j], mq = M[q][j];
+                        M[p][j] = c * mp - s * mq, M[q][j] = s * mp + c * mq;
+                    }
+                }
+        }
+        int order[kMaxAxes];
+        for (int i = 0; i < k; ++i) order[i] = i;
+        std::sort(order, order + k, [&](int a, int b) { return M[a][a] < M[b][b]; });
+        double W[kMaxAxes][kMaxAxes];
+        for (int e = 0; e < k; ++e) {
+            lambda[e] = M[order[e]][order[e]];
+            for (int i = 0; i < k; ++i) W[i][e] = V[i][order[e]];
+        }
+        for (int i = 0; i < k; ++i)
+            for (int e = 0; e < k; ++e) V[i][e] = W[i][e];
+    }
+}
+
+/// Smallest eigenvalue of the symmetric k × k matrix G.
+double smallestEigenvalue(const double G[kMaxAxes][kMaxAxes], int k) {
+    if (k == 1) return G[0][0];
+    if (k == 2) {
+        const double h = 0.5 * (G[0][0] - G[1][1]);
+        return 0.5 * (G[0][0] + G[1][1]) - std::sqrt(h * h + G[0][1] * G[0][1]);
+    }
+    double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
+    symmetricEigen(G, k, lambda, V);
+    return lambda[0];
+}
+
+}  // namespace
+
+bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength) const {
+    if (!cache.valid || cache.toolLength != toolLength || cache.q.size() != q.size()) return false;
     for (int i = 0; i < q.size(); ++i) {
         const double d = std::fabs(q[i] - cache.q[i]);
-        if ((rotary_ & (1u << i)) ? d > 0.5 * kDeg : d > 10.0) return false;
+        if ((rotary_ & (1u << i)) ? d > 2.0 * kDeg : d > 50.0) return false;
     }
     return true;
 }
 
-void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength,
-                                double lam2, AxisMask free) const {
+void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q,
+                                double toolLength) const {
     const int n = static_cast<int>(q.size());
-    const double w = options_.axisWeight;
     Vec3 tip, axis;
     k.jacobian(q, toolLength, cache.J, tip, axis);
-    cache.J.bottomRows<3>() *= w;
-    cache.A.resize(n, n);
-    cache.A.noalias() = cache.J.transpose() * cache.J;
-    for (int i = 0; i < n; ++i) {
-        if (!(free & (1u << i))) {
-            cache.A.row(i).setZero();
-            cache.A.col(i).setZero();
-            cache.A(i, i) = 1.0;
-        } else if (rotary_ & (1u << i)) {
-            cache.A(i, i) += lam2;
-        }
-        cache.A(i, i) += 1e-12 * (1.0 + cache.A(i, i));
-    }
-    // n ≤ 9: an explicit inverse makes every chord step two small matrix-vector products.
-    cache.Ainv = cache.A.llt().solve(decltype(cache.A)::Identity(n, n));
-    cache.gain.noalias() = cache.Ainv * cache.J.transpose();
+    cache.J.bottomRows<3>() *= options_.axisWeight;
     for (int i = 0; i < n; ++i)
-        if (!(free & (1u << i))) cache.gain.row(i).setZero();
+        for (int j = 0; j <= i; ++j) cache.JtJ[i][j] = cache.JtJ[j][i] = cache.J.col(i).dot(cache.J.col(j));
     cache.q = q;
     cache.toolLength = toolLength;
-    cache.lambda2 = lam2;
     cache.valid = true;
+    cache.factored = false;
+    cache.sigmaFree = ~0u;
+}
+
+void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask free) const {
+    const int n = static_cast<int>(cache.q.size());
+    double A[kMaxAxes][kMaxAxes];
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const bool both = (free & (1u << i)) && (free & (1u << j));
+            A[i][j] = both ? cache.JtJ[i][j] + damping.D[i][j] : (i == j ? 1.0 : 0.0);
+        }
+    for (int i = 0; i < n; ++i) A[i][i] += 1e-12 * (1.0 + A[i][i]);
+    if (!invertSpd(A, n, cache.Ainv)) {
+        for (int i = 0; i < n; ++i)  // not positive definite (NaN): no step, the solve reports non-convergence
+            for (int j = 0; j < n; ++j) cache.Ainv[i][j] = 0.0;
+    }
+    for (int i = 0; i < n; ++i)
+        for (int r = 0; r < 6; ++r) {
+            double v = 0;
+            if (free & (1u << i))
+                for (int j = 0; j < n; ++j) v += cache.Ainv[i][j] * cache.J(r, j);
+            cache.gain[i][r] = v;
+        }
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) cache.D[i][j] = damping.D[i][j];
+    cache.free = free;
+    cache.factored = true;
+}
+
+bool Corrector::factorUsable(const JacobianCache& cache, const Damping& damping, AxisMask free) const {
+    if (!cache.factored || cache.free != free) return false;
+    const int n = static_cast<int>(cache.q.size());
+    // The damping enters the fixed point through the gradient exactly; the factorisation only sets the rate, so a
+    // close one is kept (a changed damping near a singular pose refactors).
+    double size = 0, diff = 0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            size = std::max(size, std::fabs(damping.D[i][j]));
+            diff = std::max(diff, std::fabs(damping.D[i][j] - cache.D[i][j]));
+        }
+    return diff <= 0.1 * size;
+}
+
+void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask free, const AxisVector* neighbourDelta,
+                           Damping& damping, AxisVector& reference) const {
+    const int n = static_cast<int>(cNom.size());
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) damping.D[i][j] = 0.0;
+    damping.any = false;
+    reference = cNom;
+    int axes[kMaxAxes], k = 0;
+    for (int i = 0; i < n; ++i)
+        if (free & rotary_ & (1u << i)) axes[k++] = i;
+    if (k == 0) return;
+    // Conditioning of the orientation: singular values of the tool axis' derivatives by the rotary axes (rad/rad,
+    // the sine of the angle between the tool axis and a rotary axis for one axis). First estimated from the kept
+    // Jacobian of the erroneous machine near this point; where that is clearly well conditioned, nothing is damped.
+    const double s0 = options_.singularSine;
+    double G[kMaxAxes][kMaxAxes];
+    auto gram = [&](const PoseJacobian& J, double scale) {
+        for (int a = 0; a < k; ++a)
+            for (int b = 0; b <= a; ++b)
+                G[a][b] = G[b][a] = J.block<3, 1>(3, axes[a]).dot(J.block<3, 1>(3, axes[b])) * scale;
+    };
+    if (cache_.valid && cache_.toolLength == toolLength) {
+        // The kept Jacobian belongs to the erroneous machine at nearby commands: turning rotary axis j by δⱼ turns each
+        // column (a unit rotary direction × the tool axis) by at most 2|δⱼ|, so the singular values differ from the
+        // nominal ones at cNom by at most 2√k Σ|δⱼ| plus the deviations' share (≪ 0.01 rad).
+        double moved = 0;
+        for (int a = 0; a < k; ++a) moved += std::fabs(cache_.q[axes[a]] - (cNom[axes[a]] + zero_[axes[a]]));
+        if (cache_.sigmaFree != free) {  // once per kept Jacobian
+            gram(cache_.J, 1.0 / (options_.axisWeight * options_.axisWeight));
+            cache_.sigma = std::sqrt(std::max(0.0, smallestEigenvalue(G, k)));
+            cache_.sigmaFree = free;
+        }
+        if (cache_.sigma >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
+    }
+    // The nominal machine's at the target, exactly: D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ, φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, so
+    // that damping and continuity act only in the ill-conditioned directions and fade smoothly into the exact solution.
+    PoseJacobian Jn;
+    Vec3 tip, axis;
+    nominal_.jacobian(cNom + zero_, toolLength, Jn, tip, axis);
+    gram(Jn, 1.0);
+    double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
+    symmetricEigen(G, k, lambda, V);
+    const double lp2 = options_.rotaryDamping * options_.rotaryDamping;
+    const double lc2 = neighbourDelta ? options_.continuity * options_.continuity : 0.0;
+    const double lam2 = lp2 + lc2;
+    for (int e = 0; e < k; ++e) {
+        const double sigma = std::sqrt(std::max(0.0, lambda[e]));
+        if (sigma >= s0) continue;
+        const double phi = (1.0 - sigma / s0) * (1.0 - sigma / s0);
+        for (int a = 0; a < k; ++a)
+            for (int b = 0; b < k; ++b) damping.D[axes[a]][axes[b]] += lam2 * phi * V[a][e] * V[b][e];
+        damping.any = true;
+    }
+    // Two pulls on the rotary corrections d = c − cNom in the damped directions: λp²|d|² + λc²|d − dNeighbour|² =
+    // (λp² + λc²)|d − dRef|² + const, dRef = λc² dNeighbour / (λp² + λc²).
+    if (damping.any && neighbourDelta)
+        for (int a = 0; a < k; ++a) reference[axes[a]] += (lc2 / lam2) * (*neighbourDelta)[axes[a]];
 }
 
 SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip,
                                const Vec3& targetAxis, double toolLength, const AxisVector& start,
-                               const AxisVector& reference, double lam2, AxisMask free, AxisVector& c) const {
+                               const AxisVector& reference, const Damping& damping, AxisMask free,
+                               AxisVector& c) const {
     SolveResult res;
     const int n = static_cast<int>(start.size());
     AxisVector q = start + zero_;
     const AxisVector ref = reference + zero_;
     const double w = options_.axisWeight;
-    AxisVector g(n), step(n);
-    Eigen::Matrix<double, 6, 1> r;
-    bool fresh = false;
-    if (!cacheUsable(cache, q, toolLength, lam2)) {
-        refreshJacobian(k, cache, q, toolLength, lam2, free);
-        fresh = true;
-    }
+    double step[kMaxAxes], g[kMaxAxes], r[6];
+    if (!cacheUsable(cache, q, toolLength)) refreshJacobian(k, cache, q, toolLength);
+    bool fresh = cache.q == q;  // evaluated at this very start (here or by solve())
+    if (!factorUsable(cache, damping, free)) factor(cache, damping, free);
     double lastStep = HUGE_VAL, linStep = 0.0, rotStep = 0.0;
     auto newtonStep = [&]() {
-        // step = A⁻¹ (Jᵀ r − λ² S (q − ref)); fixed axes have zero rows in A⁻¹ Jᵀ.
-        step.noalias() = cache.gain * r;
-        if (rotary_ & free) {
-            for (int i = 0; i < n; ++i) g[i] = (free & rotary_ & (1u << i)) ? lam2 * (q[i] - ref[i]) : 0.0;
-            step.noalias() -= cache.Ainv * g;
-        }
+        // step = A⁻¹ (Jᵀ r − D (q − ref)); fixed axes have zero rows in A⁻¹ Jᵀ.
+        if (damping.any)
+            for (int i = 0; i < n; ++i) {
+                double v = 0;
+                for (int j = 0; j < n; ++j) v += damping.D[i][j] * (q[j] - ref[j]);
+                g[i] = v;
+            }
         linStep = rotStep = 0.0;
         for (int i = 0; i < n; ++i) {
-            if (!(free & (1u << i))) step[i] = 0.0;
-            if (rotary_ & (1u << i)) rotStep = std::max(rotStep, std::fabs(step[i]));
-            else linStep = std::max(linStep, std::fabs(step[i]));
+            double v = 0;
+            if (free & (1u << i)) {
+                for (int j = 0; j < 6; ++j) v += cache.gain[i][j] * r[j];
+                if (damping.any)
+                    for (int j = 0; j < n; ++j) v -= cache.Ainv[i][j] * g[j];
+            }
+            step[i] = v;
+            if (rotary_ & (1u << i)) rotStep = std::max(rotStep, std::fabs(v));
+            else linStep = std::max(linStep, std::fabs(v));
         }
         return linStep + 100.0 * rotStep;
     };
     Vec3 tip, axis;
     for (res.iterations = 0; res.iterations < options_.maxIterations; ++res.iterations) {
         k.toolPose(q, toolLength, tip, axis);
-        r.head<3>() = targetTip - tip;
-        r.tail<3>() = (targetAxis - axis) * w;
-        res.tipError = r.head<3>().norm();
-        res.axisError = (targetAxis - axis).norm();
+        const Vec3 et = targetTip - tip, ea = targetAxis - axis;
+        for (int j = 0; j < 3; ++j) r[j] = et[j], r[3 + j] = ea[j] * w;
+        res.tipError = et.norm();
+        res.axisError = ea.norm();
         if (!std::isfinite(res.tipError)) break;
         double size = newtonStep();
         // Chord method: the kept Jacobian while the steps shrink fast, a fresh one when they do not.
         if (!fresh && size > 0.25 * lastStep) {
-            refreshJacobian(k, cache, q, toolLength, lam2, free);
+            refreshJacobian(k, cache, q, toolLength);
+            factor(cache, damping, free);
             fresh = true;
             size = newtonStep();
         }
         lastStep = size;
-        q += step;
+        for (int i = 0; i < n; ++i) q[i] += step[i];
         if (linStep <= options_.solveTolerance && rotStep <= 1e-9) {
             // The residual before this last (tiny) step bounds the one after it.
             res.converged = true;
@@ -270,6 +460,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
     if (!std::isfinite(res.tipError) || !q.allFinite()) {
         res.converged = false;
         cache.valid = false;
+        cache.factored = false;
     }
     c = q - zero_;
     return res;
@@ -291,19 +482,14 @@ SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const Ax
         for (int i = 0; i < n; ++i)
             if (rotary_ & (1u << i)) s[i] = cNom[i];
     }
-    // Two pulls on the rotary corrections d = c − cNom: λp²|d|² + λc²|d − dNeighbour|² = (λp² + λc²)|d − dRef|² + const,
-    // dRef = λc² dNeighbour / (λp² + λc²).
-    const double lp2 = options_.rotaryDamping * options_.rotaryDamping, lc2 = options_.continuity * options_.continuity;
-    double lam2 = lp2;
-    AxisVector reference = cNom;
-    if (neighbourDelta && lc2 > 0) {
-        lam2 = lp2 + lc2;
-        for (int i = 0; i < n; ++i)
-            if (rotary_ & (1u << i)) reference[i] += (lc2 / lam2) * (*neighbourDelta)[i];
-    }
+    // The kept Jacobian near the start first: it tells whether the pose is well conditioned (no damping at all).
+    if (!cacheUsable(cache_, s + zero_, toolLength)) refreshJacobian(actual_, cache_, s + zero_, toolLength);
+    Damping damping;
+    AxisVector reference;
+    dampingFor(cNom, toolLength, free, neighbourDelta, damping, reference);
     Vec3 tip, axis;
     nominal_.toolPose(cNom + zero_, toolLength, tip, axis);
-    return solveOn(actual_, cache_, tip + tipShift, axis, toolLength, s, reference, lam2, free, c);
+    return solveOn(actual_, cache_, tip + tipShift, axis, toolLength, s, reference, damping, free, c);
 }
 
 SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess,
@@ -327,11 +513,26 @@ SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, 
     return res;
 }
 
+Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
+    if (s.mode == ProgramMode::Joints) return nominalTip(p.p, s.toolLength);
+    // TCP: the programmed point is the controlled point (world frame), the nominal tip lies along the tool axis from
+    // it; the axis depends on the rotary angles only (or is the programmed vector). No inverse kinematics needed.
+    Vec3 axis;
+    if (s.mode == ProgramMode::TcpVector) {
+        axis = tcp_.axisFromWorld(p.v.normalized());
+    } else {
+        Vec3 tip;
+        nominal_.toolPose(p.p + zero_, 0.0, tip, axis);
+    }
+    const int* lin = tcp_.linearAxes();
+    return tcp_.pointFromWorld(Vec3(p.p[lin[0]], p.p[lin[1]], p.p[lin[2]])) + (s.toolLength - s.controlLength) * axis;
+}
+
 double Corrector::deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected,
                               double t) const {
-    AxisVector cn, cc;
-    if (!toJoints(ctx.space, nominal, ctx.guess, cn) || !toJoints(ctx.space, corrected, ctx.guess, cc)) return HUGE_VAL;
-    const Vec3 e = actualTip(cc, ctx.space.toolLength) - nominalTip(cn, ctx.space.toolLength) - (1.0 - t) * ctx.startOffset;
+    AxisVector cc;
+    if (!toJoints(ctx.space, corrected, ctx.guess, cc)) return HUGE_VAL;
+    const Vec3 e = actualTip(cc, ctx.space.toolLength) - nominalTipOf(ctx.space, nominal) - (1.0 - t) * ctx.startOffset;
     return e.norm();
 }
 

@@ -18,11 +18,16 @@ namespace cnccomp::pp {
 struct CorrectorOptions {
     double toleranceMm = 1e-3;     ///< largest allowed distance of the tool tip from the nominal path
     bool tipOnly = false;          ///< rotary axes keep their commands; only the tool tip is corrected
-    double rotaryDamping = 5.0;    ///< mm (weighted residual) per rad of rotary correction: a rotary axis corrects at most
-                                   ///< about axisWeight / (2 · rotaryDamping) = 10 times the tool-axis error it removes,
-                                   ///< so near a singular pose (tool axis along a rotary axis) it does not swing
-    double continuity = 20.0;      ///< mm per rad of change of a rotary correction from the previous end point: keeps the
-                                   ///< solution on the branch of the previous block (see Corrector::solve)
+    double rotaryDamping = 5.0;    ///< mm (weighted residual) per rad of rotary correction, in the ill-conditioned
+                                   ///< directions only (see singularSine): near a singular pose (tool axis along a
+                                   ///< rotary axis) a rotary axis corrects at most about axisWeight / (2 · rotaryDamping)
+                                   ///< = 10 times the tool-axis error it removes instead of swinging
+    double continuity = 20.0;      ///< mm per rad of change of a damped rotary correction from the previous end point:
+                                   ///< keeps the solution on the branch of the previous block (see Corrector::solve)
+    double singularSine = 0.1;     ///< damping and continuity act in the directions where a singular value of the tool
+                                   ///< axis' derivatives by the rotary axes (rad/rad) is below this, weighted
+                                   ///< (1 − σ/singularSine)²; at or above it (tool axis ≥ 5.7° from every rotary axis
+                                   ///< on a 5-axis machine) the solution is exact
     double axisWeight = 100.0;     ///< mm per rad: how much a tool-axis error counts against a tip error
     double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (and 1e-9 rad)
     int maxIterations = 30;
@@ -114,12 +119,14 @@ public:
     void toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) const;
 
     /// Machine coordinates `c` near `start` at which the erroneous machine puts the point at `toolLength` along the
-    /// tool, and the tool axis, where the nominal machine puts them at `cNom`. Regularised Gauss–Newton on the exact
-    /// model: the tip is matched exactly (linear axes are free), the tool axis in the least-squares sense with the rotary
-    /// corrections (c − cNom) pulled towards 0 by options().rotaryDamping and, given `neighbour` (the corrected
-    /// rotary positions next to this point: the previous end point, or the interpolation of a move's corrected ends),
-    /// towards neighbour − its nominal by options().continuity. Exact away from singular poses; near them the rotary
-    /// axes stay on the branch of their neighbours and of the programmed value instead of swinging.
+    /// tool, and the tool axis, where the nominal machine puts them at `cNom`. Gauss–Newton on the exact model: the tip
+    /// is matched exactly (linear axes are free), the tool axis exactly where the rotary axes can turn it (least
+    /// squares where they cannot, e.g. a four-axis machine). Only in ill-conditioned directions — where a singular value
+    /// σ of the tool axis' derivatives by the rotary axes is below options().singularSine, i.e. near a singular pose
+    /// (tool axis along a rotary axis) — the rotary corrections (c − cNom) are pulled, with weight (1 − σ/σ0)², towards 0
+    /// by options().rotaryDamping and, given `neighbourDelta` (the rotary corrections next to this point: at the
+    /// previous end point, or the interpolation of a move's corrected ends), towards it by options().continuity: there
+    /// the rotary axes stay on the branch of their neighbours and of the programmed value instead of swinging.
     /// `tipShift` moves the target tip (a point of a path whose start offset is blended out).
     SolveResult solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
                       const AxisVector* neighbourDelta = nullptr, const Vec3& tipShift = Vec3::Zero()) const;
@@ -132,6 +139,8 @@ public:
     /// Tip of the erroneous machine at c.
     Vec3 actualTip(const AxisVector& c, double toolLength) const;
     Vec3 nominalTip(const AxisVector& c, double toolLength) const;
+    /// Tip (at s.toolLength) of the nominal machine at program position p, in the workpiece frame.
+    Vec3 nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const;
 
     /// Corrected program position for the nominal one: joints `cNom` (out), solved joints `c` (start `start`,
     /// reference rotary positions `reference`), the program position `out`.
@@ -162,19 +171,33 @@ private:
     /// Jacobian of the erroneous machine and its factorised normal matrix, kept from one solve to the next while the
     /// commands stay close (chord Newton): consecutive program points differ little.
     struct JacobianCache {
-        bool valid = false;
-        double toolLength = 0, lambda2 = 0;
+        bool valid = false, factored = false;
+        double toolLength = 0;
         AxisVector q;
-        PoseJacobian J;
-        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes> A, Ainv;  ///< normal matrix, inverse
-        Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxAxes, 6> gain;  ///< Ainv · Jᵀ (n × 6)
+        PoseJacobian J;                          ///< axis rows weighted by axisWeight
+        double JtJ[kMaxAxes][kMaxAxes] = {};
+        AxisMask free = 0;                       ///< of the factorisation
+        double D[kMaxAxes][kMaxAxes] = {};       ///< damping of the factorisation
+        double Ainv[kMaxAxes][kMaxAxes] = {};    ///< (JᵀJ + D)⁻¹
+        double gain[kMaxAxes][6] = {};           ///< Ainv · Jᵀ (zero rows for fixed axes)
+        AxisMask sigmaFree = ~0u;                ///< free axes `sigma` was computed for (~0: not computed)
+        double sigma = 0;                        ///< smallest singular value of J's axis rows by the free rotary axes
+    };
+    /// Rotary damping of one solve: D (n × n, non-zero in the rotary rows and columns of ill-conditioned directions).
+    struct Damping {
+        bool any = false;
+        double D[kMaxAxes][kMaxAxes];
     };
     SolveResult solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
-                        double toolLength, const AxisVector& start, const AxisVector& reference, double lambda2,
+                        double toolLength, const AxisVector& start, const AxisVector& reference, const Damping& damping,
                         AxisMask free, AxisVector& c) const;
-    void refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength,
-                         double lambda2, AxisMask free) const;
-    bool cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength, double lambda2) const;
+    void refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength) const;
+    bool cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength) const;
+    void factor(JacobianCache& cache, const Damping& damping, AxisMask free) const;
+    bool factorUsable(const JacobianCache& cache, const Damping& damping, AxisMask free) const;
+    /// The damping of a solve at target cNom, and the rotary reference it pulls towards (cNom + the neighbour's share).
+    void dampingFor(const AxisVector& cNom, double toolLength, AxisMask free, const AxisVector* neighbourDelta,
+                    Damping& damping, AxisVector& reference) const;
     void splitRecursive(const MovePath& path, const PathContext& ctx, double t0, const ProgramPoint& q0, double t1,
                         const ProgramPoint& q1, int depth, std::vector<Piece>& pieces, SplitStats& stats) const;
     /// Corrected program position of the nominal path at t, started near `near` (program space).
@@ -189,7 +212,7 @@ private:
     bool identity_ = false;
     bool affine_ = false;  ///< no component errors: with rotary axes fixed, the error is affine in the linear axes
     AxisMask rotary_ = 0;
-    mutable JacobianCache cache_, nominalCache_;  ///< not thread-safe: one Corrector per program being corrected
+    mutable JacobianCache cache_;  ///< not thread-safe: one Corrector per thread
 };
 
 }  // namespace cnccomp::pp

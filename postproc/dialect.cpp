@@ -69,6 +69,16 @@ bool hasExtruderWord(std::string_view code) {
 
 }  // namespace
 
+int klartextHeaderLine(std::string_view head) {
+    for (int line = 1; !head.empty() && line <= 2000; ++line) {
+        const size_t eol = head.find_first_of("\r\n");
+        if (isKlartextHeader(head.substr(0, eol))) return line;
+        if (eol == std::string_view::npos) break;
+        head.remove_prefix(eol + (head[eol] == '\r' && eol + 1 < head.size() && head[eol + 1] == '\n' ? 2 : 1));
+    }
+    return 0;
+}
+
 DetectedDialect detectDialect(std::string_view head) {
     enum { kNgc, kFanuc, kSiemens, kPrinter, kFamilies };
     std::array<int, kFamilies> score{};

@@ -30,5 +30,7 @@ struct DetectedDialect {
 /// variables (#100) exist in both Fanuc and RS274NGC and decide nothing.
 /// Ambiguous (clues of two families) or no clue → RS274NGC with certain = false.
 DetectedDialect detectDialect(std::string_view head);
+/// Line (1-based) of a HEIDENHAIN Klartext "BEGIN PGM" header among the first lines of `head`, 0 when there is none.
+int klartextHeaderLine(std::string_view head);
 
 }  // namespace cnccomp::pp

@@ -300,13 +300,14 @@ bool Interpreter::forgetOverlong(const OverlongLine& l, BlockResult& r) {
     return false;
 }
 
-bool Interpreter::isDimensionLetter(char c) const {
-    return layout_.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || c == 'U' || c == 'V' || c == 'W';
+namespace {
+bool isDimensionLetter(const AxisLayout& layout, char c) {
+    return layout.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || c == 'U' || c == 'V' || c == 'W';
 }
+}  // namespace
 
-double Interpreter::wordValue(const Word& w) const {
-    if (options_.dialect == Dialect::Fanuc && !w.point && isDimensionLetter(w.letter))
-        return w.value * (inch_ ? 1e-4 : 1e-3);
+double Interpreter::wordValue(const Word& w, Dialect dialect, bool inch, const AxisLayout& layout) {
+    if (dialect == Dialect::Fanuc && !w.point && isDimensionLetter(layout, w.letter)) return w.value * (inch ? 1e-4 : 1e-3);
     return w.value;
 }
 

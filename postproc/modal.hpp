@@ -150,14 +150,15 @@ public:
     AxisMask assumed() const { return assumed_; }
     Motion motion() const { return motion_; }
     /// Value of a word in program units (Fanuc integer increments applied to dimension words).
-    double wordValue(const Word& w) const;
+    double wordValue(const Word& w) const { return wordValue(w, options_.dialect, inch_, layout_); }
+    /// The same for a block read in `dialect` with G20 (`inch`) or G21 in effect (BlockResult::inch).
+    static double wordValue(const Word& w, Dialect dialect, bool inch, const AxisLayout& layout);
 
 private:
     void resetPositions();
     void warn(BlockResult& r, Warning w, int code);
     void passThrough(BlockResult& r, const char* reason, int code, bool report = true);
     void unknownAll(BlockResult& r);
-    bool isDimensionLetter(char c) const;
     const AxisVector* offsetValues(int code) const;
     AxisMask offsetUnknown(int code) const;
     void fillConversions(BlockResult& r) const;

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <istream>
 #include <ostream>
 
@@ -55,6 +59,12 @@ const char* warningText(Warning w) {
 
 double circular(double d) { return d - 360.0 * std::round(d / 360.0); }
 
+/// 10^e for the decimals of a written number (e in −15 … 0; beyond: std::pow).
+double tenTo(int e) {
+    static constexpr double kNeg[] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15};
+    return e <= 0 && e >= -15 ? kNeg[-e] : std::pow(10.0, e);
+}
+
 /// How the words of one block are spaced and aligned, so that words added to it (or lines added after it) look like
 /// its own: the white space between words, between a letter and its number, and whether positive numbers take the
 /// place of a minus sign ("X  16.339  Y -25.409").
@@ -65,6 +75,280 @@ struct BlockStyle {
     bool anchorNeg = false;
 };
 
+/// Where the nominal program or the output program is (unrounded), in the space it was read in; machine coordinates
+/// and the tool vector there are computed when needed.
+struct Where {
+    bool known = false;
+    MoveSpace space;
+    ProgramPoint point;
+    AxisVector joints;
+    bool jointsValid = false;
+    Vec3 vector = Vec3(0, 0, -1);
+    bool vectorValid = false;
+};
+
+bool jointsOf(const Corrector& corrector, Where& w, const AxisVector& guess) {
+    if (!w.known) return false;
+    if (!w.jointsValid) w.jointsValid = corrector.toJoints(w.space, w.point, guess, w.joints);
+    return w.jointsValid;
+}
+
+bool vectorOf(const Corrector& corrector, Where& w, const AxisVector& guess) {
+    if (!w.known) return false;
+    if (w.vectorValid) return true;
+    if (w.space.mode == ProgramMode::TcpVector) {
+        w.vector = w.point.v;
+    } else {
+        if (!jointsOf(corrector, w, guess)) return false;
+        ProgramPoint p;
+        corrector.toProgram(MoveSpace{ProgramMode::TcpVector, w.space.controlLength, w.space.toolLength}, w.joints, p);
+        w.vector = p.v;
+    }
+    w.vectorValid = true;
+    return true;
+}
+
+/// After a TCP mode switch: the same machine position read in the new mode (false when it is not known).
+bool convertWhere(const Corrector& corrector, Where& w, const MoveSpace& space, const AxisVector& guess) {
+    if (!jointsOf(corrector, w, guess)) {
+        w.known = false;
+        return false;
+    }
+    const AxisVector joints = w.joints;
+    w.space = space;
+    corrector.toProgram(space, joints, w.point);
+    w.joints = joints;
+    w.jointsValid = true;
+    w.vectorValid = false;
+    return true;
+}
+
+/// One line as the front end read it — lexed, interpreted and, for a move, its end point corrected — handed in program
+/// order to the back end, which checks and splits the path and writes the text. Every value the back end needs from
+/// the front end's running state is in here, so the two can run on two threads with the same results as on one.
+struct Record {
+    std::string text;
+    std::array<char, 2> eol{};
+    uint8_t eolLen = 0;
+    uint64_t number = 0, bytesConsumed = 0;
+    bool partial = false, firstPiece = true, lastPiece = true;
+    LexedBlock b;
+    BlockResult r;
+    AxisMask assumed = 0;           ///< axes taken at an assumed position (Interpreter::assumed) after this block
+    bool overlongCode = false;      ///< last piece of an overlong line that holds code
+    bool overlongModal = false;     ///< … whose codes may change any mode (Interpreter::forgetOverlong)
+    // A move (r.kind Move), or one the front end refused (r.kind PassThrough, frontRefused):
+    bool frontRefused = false;      ///< counted as a move, then passed through (r.reason says why)
+    bool forgetOutput = false;      ///< the output position is unknown after it (TCP on a machine without X Y Z)
+    MoveSpace space;
+    bool nomStartKnown = false, corrected = false, unconverged = false, outsideTravel = false, jointsComputed = false;
+    ProgramPoint nomStart, nomEnd;
+    AxisVector cNom, cEnd;
+    double tipResidual = 0, axisResidual = 0;  ///< of the end point's solution
+    std::vector<std::pair<bool, std::string>> notices;  ///< (warning, text) raised by the front end, in order
+    std::string_view eolView() const { return {eol.data(), eolLen}; }
+    void note(bool warning, std::string message) { notices.emplace_back(warning, std::move(message)); }
+};
+
+/// The front end: reads lines, lexes and interprets them, follows the nominal program and corrects move end points
+/// (each from the previous one's correction: warm start and continuity).
+class FrontEnd {
+public:
+    FrontEnd(const MachineModel& m, const DeviationSet& d, const CorrectOptions& o, Dialect dialect, LineReader& reader)
+        : machine_(m),
+          options_(o),
+          dialect_(dialect),
+          layout_(AxisLayout::fromMachine(m)),
+          interp_(layout_, InterpreterOptions{dialect, o.setup, o.rotaryShortest, o.tcpOnM, o.tcpOffM}),
+          corrector_(m, d, o.corrector),
+          reader_(reader) {
+        lastDelta_ = AxisVector::Zero(layout_.count);
+        all_ = layout_.all();
+    }
+
+    /// The next line into `rec`; false at the end of the input.
+    bool next(Record& rec);
+
+private:
+    void afterPassThrough(const BlockResult& r);
+    void switchMode(const BlockResult& r);
+    void move(Record& rec);
+    void refuse(Record& rec, const char* reason);
+    void checkTravel(Record& rec);
+
+    const MachineModel& machine_;
+    const CorrectOptions& options_;
+    Dialect dialect_;
+    AxisLayout layout_;
+    Interpreter interp_;
+    Corrector corrector_;
+    LineReader& reader_;
+    Line line_;
+    OverlongLine long_;
+    Where nomAt_;
+    AxisVector lastDelta_;
+    bool haveDelta_ = false;  ///< lastDelta_ is the correction at the previous end point (continuity)
+    AxisMask all_ = 0;
+};
+
+bool FrontEnd::next(Record& rec) {
+    if (!reader_.next(line_)) return false;
+    const Line& ln = line_;
+    rec.text.assign(ln.text);
+    rec.eolLen = static_cast<uint8_t>(std::min<size_t>(ln.eol.size(), 2));
+    std::copy_n(ln.eol.begin(), rec.eolLen, rec.eol.begin());
+    rec.number = ln.number;
+    rec.bytesConsumed = reader_.bytesConsumed();
+    rec.partial = ln.partial;
+    rec.firstPiece = ln.firstPiece;
+    rec.lastPiece = ln.lastPiece;
+    rec.notices.clear();
+    rec.frontRefused = rec.forgetOutput = rec.corrected = rec.unconverged = rec.outsideTravel = false;
+    rec.overlongCode = rec.overlongModal = false;
+    if (ln.partial) {
+        if (ln.firstPiece) long_.reset();
+        long_.feed(ln.text);
+        if (ln.lastPiece && long_.code) {
+            rec.overlongCode = true;
+            rec.overlongModal = interp_.forgetOverlong(long_, rec.r);
+            if (rec.overlongModal || rec.r.words) nomAt_.known = false;
+        }
+        return true;
+    }
+    lexBlock(rec.text, dialect_, rec.b, ln.number == 1);
+    interp_.interpret(rec.text, rec.b, rec.r);
+    rec.assumed = interp_.assumed();
+    switch (rec.r.kind) {
+        case BlockKind::Empty: break;
+        case BlockKind::NoMotion:
+            if (rec.r.modeSwitch) switchMode(rec.r);
+            break;
+        case BlockKind::PassThrough: afterPassThrough(rec.r); break;
+        case BlockKind::Move: move(rec); break;
+    }
+    return true;
+}
+
+void FrontEnd::afterPassThrough(const BlockResult& r) {
+    // The machine is where the nominal program puts it (joint mode); in TCP mode its joints are not followed.
+    if (r.words || r.vectorGiven) {
+        if (r.mode != ProgramMode::Joints) {
+            nomAt_.known = false;
+        } else {
+            const MoveSpace joints{ProgramMode::Joints, 0.0, r.tipLength};
+            nomAt_ = Where{(r.endKnown & all_) == all_, joints, ProgramPoint{r.end, Vec3(0, 0, -1)}, r.end, true};
+        }
+    }
+    if (r.modeSwitch) nomAt_.known = false;  // a move in the block that switches TCP mode: unknown in the new mode
+}
+
+void FrontEnd::switchMode(const BlockResult& r) {
+    // The controller's position is the same machine; what the program's numbers mean changes (LinuxCNC re-reads the
+    // world position of the new kinematics at the switch: M66 E0 L0 in the M428/M429 remaps).
+    AxisMask rotary = 0;
+    for (int a = 0; a < layout_.count; ++a)
+        if (layout_.rotary[a]) rotary |= 1u << a;
+    if (convertWhere(corrector_, nomAt_, MoveSpace{r.mode, r.controlLength, r.tipLength}, r.end)) {
+        interp_.setPosition(nomAt_.point.p, all_);
+    } else {
+        // Rotary angles are the same numbers in both modes; the linear positions are not known in the new one.
+        interp_.setPosition(interp_.position(), interp_.known() & rotary);
+    }
+}
+
+void FrontEnd::refuse(Record& rec, const char* reason) {
+    rec.r.kind = BlockKind::PassThrough;
+    rec.r.reason = reason;
+    rec.r.report = true;
+    afterPassThrough(rec.r);
+}
+
+void FrontEnd::checkTravel(Record& rec) {
+    const AxisVector &cNom = rec.cNom, &c = rec.cEnd;
+    for (int a = 0; a < layout_.count; ++a) {
+        const Link& link = machine_.axisLink(a);
+        const double mz = link.machineZero;
+        const double lo = link.min - mz, hi = link.max - mz;  // in the controller's machine coordinates
+        const bool nomOut = cNom[a] < lo - 1e-9 || cNom[a] > hi + 1e-9;
+        const bool corOut = c[a] < lo - 1e-9 || c[a] > hi + 1e-9;
+        if (!nomOut && !corOut) continue;
+        rec.outsideTravel = true;
+        const double k = layout_.rotary[a] ? 1.0 / kDeg : 1.0;
+        const char* unit = layout_.rotary[a] ? "deg" : "mm";
+        rec.note(true, fmt::format("axis {} at {:.4f} {} ({}) is outside its travel [{:g}, {:g}] {}: corrected all the same",
+                                   layout_.letter[a], (nomOut ? cNom[a] : c[a]) * k, unit,
+                                   nomOut ? "as programmed" : "after correction", lo * k, hi * k, unit));
+    }
+}
+
+void FrontEnd::move(Record& rec) {
+    BlockResult& r = rec.r;
+    const MoveSpace space{r.mode, r.controlLength, r.tipLength};
+    rec.space = space;
+    const bool tcp = space.mode != ProgramMode::Joints;
+    if (tcp && !corrector_.tcp().supported()) {
+        refuse(rec, corrector_.tcp().why());
+        rec.forgetOutput = true;
+        return;
+    }
+    const bool identity = corrector_.identity();
+    const bool vector = space.mode == ProgramMode::TcpVector;
+    bool nomStartKnown = (r.startKnown & all_) == all_;
+    const AxisVector guess = nomAt_.known && nomAt_.jointsValid ? nomAt_.joints : r.end;
+
+    // Nominal end point in program space (vector mode: the programmed vector, tip → spindle, or the kept one).
+    ProgramPoint& nomEnd = rec.nomEnd;
+    ProgramPoint& nomStart = rec.nomStart;
+    nomEnd.p = r.end;
+    nomStart.p = r.start;
+    nomEnd.v = nomStart.v = Vec3(0, 0, -1);
+    if (vector) {
+        const bool nomVector = nomStartKnown && vectorOf(corrector_, nomAt_, guess);
+        nomStartKnown = nomStartKnown && nomVector;
+        nomStart.v = nomAt_.vector;
+        nomEnd.v = r.vectorGiven ? Vec3(-r.vector[0], -r.vector[1], -r.vector[2]).normalized() : nomAt_.vector;
+        if (!r.vectorGiven && !nomVector) {
+            refuse(rec, "tool vector not known yet (no I J K / A3 B3 C3 given since TCP was switched on)");
+            return;
+        }
+    }
+    rec.nomStartKnown = nomStartKnown;
+
+    // Corrected end point: nominal machine coordinates, the erroneous machine's solution, its program position.
+    AxisVector& cNom = rec.cNom;
+    AxisVector& cEnd = rec.cEnd;
+    if (identity && !vector) {
+        cNom = r.end;  // not the machine coordinates in TCP mode: not used for anything but guesses
+    } else if (!corrector_.toJoints(space, nomEnd, guess, cNom)) {
+        refuse(rec, "the controller's TCP kinematics cannot reach this tool vector (no rotary solution)");
+        rec.frontRefused = true;
+        return;
+    }
+    rec.tipResidual = rec.axisResidual = 0;
+    if (identity) {
+        cEnd = cNom;
+    } else {
+        // Near the previous end point's correction (warm start and continuity) and the programmed value.
+        const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd,
+                                               haveDelta_ ? &lastDelta_ : nullptr);
+        rec.tipResidual = s.tipError;
+        rec.axisResidual = s.axisError;
+        if (!s.converged || !(s.tipError < 1e-5)) {
+            rec.unconverged = true;
+            rec.note(true, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
+                                       s.tipError / kUm));
+            cEnd = cNom;
+        } else {
+            lastDelta_ = cEnd - cNom;
+            haveDelta_ = true;
+            rec.corrected = true;  // the back end writes cEnd's program position (toProgram)
+        }
+    }
+    if (!(identity && tcp && !vector)) checkTravel(rec);
+    rec.jointsComputed = !identity || vector || !tcp;
+    nomAt_ = Where{true, space, nomEnd, cNom, rec.jointsComputed, nomEnd.v, vector};
+}
+
 class ProgramCorrector {
 public:
     ProgramCorrector(const MachineModel& m, const DeviationSet& d, const CorrectOptions& o, Dialect dialect,
@@ -73,13 +357,11 @@ public:
           options_(o),
           dialect_(dialect),
           layout_(AxisLayout::fromMachine(m)),
-          interp_(layout_, InterpreterOptions{dialect, o.setup, o.rotaryShortest, o.tcpOnM, o.tcpOffM}),
           corrector_(m, d, o.corrector),
           summary_(s),
           out_(out) {
         const int n = layout_.count;
         outPos_ = AxisVector::Zero(n);
-        lastDelta_ = AxisVector::Zero(n);
         pieces_.reserve(static_cast<size_t>(o.corrector.maxPieces) + 4);
         all_ = layout_.all();
         for (int a = 0; a < n; ++a) {
@@ -88,27 +370,26 @@ public:
         }
     }
 
-    void line(const Line& ln);
+    void line(Record& rec);
 
 private:
     void notice(bool warning, uint64_t line, std::string message);
-    void overlong(uint64_t no);
+    void overlong(const Record& rec);
     void updateStyles(const LexedBlock& b, std::string_view text);
     void blockStyle(std::string_view text);
     void warnings(uint64_t no);
     void passThrough(const Line& ln, uint64_t no);
-    void move(const Line& ln, uint64_t no);
+    void move(Record& rec);
     void switchMode();
     void updateOutputAfterPassThrough();
     double toleranceFor(const MoveSpace& space, uint64_t no);
-    void checkTravel(const AxisVector& cNom, const AxisVector& c, uint64_t no);
     // Text helpers.
     int decimalsFor(char letter, bool rotary) const;
     NumberStyle styleFor(char letter, bool rotary, const Word* original, bool& increments) const;
     size_t number(char letter, bool rotary, double programValue, const Word* original, char* out, double& readBack,
                   double& resolution) const;
     size_t motionText(Motion m, char* out) const;
-    char letterCase(char c) const { return b_.lowerCase ? static_cast<char>(c | 0x20) : c; }
+    char letterCase(char c) const { return b_->lowerCase ? static_cast<char>(c | 0x20) : c; }
     /// A new word "X  -1.25" in the block's style (separator first when `separated`).
     size_t composeWord(char letter, const char* num, size_t n, int ext, bool separated, char* out) const;
     /// Replaces a word's number, keeping a sign-aligned column aligned.
@@ -126,12 +407,11 @@ private:
     const CorrectOptions& options_;
     Dialect dialect_;
     AxisLayout layout_;
-    Interpreter interp_;
     Corrector corrector_;
     CorrectSummary& summary_;
     OutputBuffer& out_;
-    LexedBlock b_;
-    BlockResult r_;
+    const LexedBlock* b_ = nullptr;  ///< the current record's block
+    BlockResult* r_ = nullptr;
     BlockEdits edits_;
     BlockStyle style_;
     std::array<LetterStyle, 26> styles_{};
@@ -148,26 +428,10 @@ private:
     AxisMask outKnown_ = 0, all_ = 0;
     Vec3 outVector_ = Vec3(0, 0, -1);  ///< tool vector as written (vector mode), world, spindle → tip
     bool outVectorKnown_ = false;
-    /// Where the nominal program and the output program are (unrounded), in the space they were read in; machine
-    /// coordinates and the tool vector there are computed when needed.
-    struct Where {
-        bool known = false;
-        MoveSpace space;
-        ProgramPoint point;
-        AxisVector joints;
-        bool jointsValid = false;
-        Vec3 vector = Vec3(0, 0, -1);
-        bool vectorValid = false;
-    };
-    Where nomAt_, outAt_;
-    bool jointsOf(Where& w, const AxisVector& guess);
-    bool vectorOf(Where& w, const AxisVector& guess);
-    AxisVector lastDelta_;
-    bool haveDelta_ = false;     ///< lastDelta_ is the correction at the previous end point (continuity)
+    Where outAt_;
     bool offCourse_ = true;      ///< the output's position is not the corrected nominal one (start, after pass-through)
     Motion outMotion_ = Motion::Unknown;
     std::vector<Piece> pieces_;
-    OverlongLine long_;
     int linearCount_ = 0, rotaryCount_ = 0;
     bool warnedCr_ = false, warnedTolerance_ = false;
     std::string lastEol_ = "\n";
@@ -227,9 +491,9 @@ void ProgramCorrector::updateStyles(const LexedBlock& b, std::string_view text) 
 void ProgramCorrector::blockStyle(std::string_view text) {
     // Anchor: the last axis word of the block, else its last word.
     int anchor = -1;
-    for (int i = 0; i < b_.count; ++i)
-        if (layout_.axis(b_.words[i].letter) >= 0 && !b_.words[i].ext) anchor = i;
-    if (anchor < 0) anchor = b_.count - 1;
+    for (int i = 0; i < b_->count; ++i)
+        if (layout_.axis(b_->words[i].letter) >= 0 && !b_->words[i].ext) anchor = i;
+    if (anchor < 0) anchor = b_->count - 1;
     style_ = BlockStyle{};
     auto setSep = [&](std::string_view ws) {
         style_.sepLen = std::min(ws.size(), style_.sep.size());
@@ -237,7 +501,7 @@ void ProgramCorrector::blockStyle(std::string_view text) {
     };
     setSep(std::string_view(programSep_.data(), programSepLen_));
     if (anchor < 0) return;
-    const Word& w = b_.words[anchor];
+    const Word& w = b_->words[anchor];
     style_.valueGap = static_cast<int>(w.valueBegin - w.begin) - 1;
     style_.anchorNeg = w.valueBegin < text.size() && text[w.valueBegin] == '-';
     if (anchor == 0) return;  // no word before it: the program's usual separator
@@ -291,8 +555,8 @@ void ProgramCorrector::replaceNumber(const Word& w, const char* num, size_t n) {
 }
 
 void ProgramCorrector::warnings(uint64_t no) {
-    for (int k = 0; k < r_.warningCount; ++k) {
-        const auto [w, code] = r_.warnings[k];
+    for (int k = 0; k < r_->warningCount; ++k) {
+        const auto [w, code] = r_->warnings[k];
         std::string detail;
         switch (w) {
             case Warning::OffsetNotGiven: detail = offsetCodeName(code); break;
@@ -307,14 +571,14 @@ void ProgramCorrector::warnings(uint64_t no) {
 
 int ProgramCorrector::decimalsFor(char letter, bool rotary) const {
     if (options_.decimals >= 0) return options_.decimals;
-    const int floor = rotary ? 4 : (r_.inch ? 5 : 4);
+    const int floor = rotary ? 4 : (r_->inch ? 5 : 4);
     return std::max(styles_[letter - 'A'].maxDecimals, floor);
 }
 
 NumberStyle ProgramCorrector::styleFor(char letter, bool rotary, const Word* original, bool& increments) const {
     const LetterStyle& ls = styles_[letter - 'A'];
     NumberStyle st;
-    increments = r_.integerIncrements && letter != 'F' &&
+    increments = r_->integerIncrements && letter != 'F' &&
                  ((original && !original->point) || (!original && ls.sawInteger && !ls.sawPoint));
     st.point = !increments;
     st.decimals = decimalsFor(letter, rotary);
@@ -329,9 +593,9 @@ size_t ProgramCorrector::number(char letter, bool rotary, double pv, const Word*
     bool increments = false;
     const NumberStyle st = styleFor(letter, rotary, original, increments);
     if (increments) {
-        const double counts = std::round(pv / r_.increment);
-        readBack = counts * r_.increment;
-        resolution = r_.increment;
+        const double counts = std::round(pv / r_->increment);
+        readBack = counts * r_->increment;
+        resolution = r_->increment;
         return formatNumber(counts, st, out);
     }
     static constexpr double kStep[] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15};
@@ -352,11 +616,11 @@ size_t ProgramCorrector::motionText(Motion m, char* out) const {
 bool ProgramCorrector::axisWord(int a, double q, int existing, char* text, size_t& len, bool& replace) {
     const AxisMask bit = 1u << a;
     const bool rotary = layout_.rotary[a];
-    const bool wrap = (r_.wrap & bit) != 0;
-    const bool absolute = r_.absolute || r_.machineCoordinates;
-    const double scale = r_.scale[a], off = r_.offset[a];
-    const Word* orig = existing >= 0 ? &b_.words[existing] : nullptr;
-    const double origPv = orig ? interp_.wordValue(*orig) : 0.0;
+    const bool wrap = (r_->wrap & bit) != 0;
+    const bool absolute = r_->absolute || r_->machineCoordinates;
+    const double scale = r_->scale[a], off = r_->offset[a];
+    const Word* orig = existing >= 0 ? &b_->words[existing] : nullptr;
+    const double origPv = orig ? Interpreter::wordValue(*orig, dialect_, r_->inch, layout_) : 0.0;
     replace = false;
     len = 0;
     if (!absolute && !(outKnown_ & bit)) {
@@ -401,19 +665,19 @@ bool ProgramCorrector::axisWord(int a, double q, int existing, char* text, size_
 void ProgramCorrector::vectorWords(const Vec3& v, bool onBlock, char* buf, size_t& used) {
     // Written vector: tip → spindle (Fanuc I J K, Sinumerik A3 B3 C3), all three components (omitted ones read as 0).
     const Vec3 w = -v.normalized();
-    const bool sinumerik = r_.tcpSource == TcpSource::Sinumerik;
+    const bool sinumerik = r_->tcpSource == TcpSource::Sinumerik;
     const char letters[3] = {sinumerik ? 'A' : 'I', sinumerik ? 'B' : 'J', sinumerik ? 'C' : 'K'};
     const int ext = sinumerik ? 3 : 0;
     NumberStyle st;
     st.decimals = options_.decimals >= 0 ? options_.decimals : std::max(vectorStyle_.maxDecimals, 7);
     st.fixed = vectorStyle_.trailingZero;
     st.bareFraction = vectorStyle_.bare;
-    const double res = std::pow(10.0, -st.decimals);
+    const double res = tenTo(-st.decimals);
     // Unchanged at the written resolution: keep the program's words (or its kept vector).
     Vec3 given = outVector_;
     bool anyWord = false;
-    if (onBlock && r_.vectorGiven) {
-        Vec3 g(r_.vector[0], r_.vector[1], r_.vector[2]);
+    if (onBlock && r_->vectorGiven) {
+        Vec3 g(r_->vector[0], r_->vector[1], r_->vector[2]);
         given = -g.normalized();
         anyWord = true;
     }
@@ -430,9 +694,9 @@ void ProgramCorrector::vectorWords(const Vec3& v, bool onBlock, char* buf, size_
         char num[kMaxNumberChars];
         const size_t n = formatNumber(w[k], st, num);
         back[k] = roundToStyle(w[k], st);
-        const int wi = onBlock ? r_.vectorWord[k] : -1;
+        const int wi = onBlock ? r_->vectorWord[k] : -1;
         if (wi >= 0) {
-            replaceNumber(b_.words[wi], num, n);
+            replaceNumber(b_->words[wi], num, n);
         } else {
             used += composeWord(letters[k], num, n, ext, true, buf + used);
         }
@@ -444,8 +708,8 @@ void ProgramCorrector::vectorWords(const Vec3& v, bool onBlock, char* buf, size_
 bool ProgramCorrector::insertMotionWord(Motion m) {
     char t[16];
     size_t n = 0;
-    const bool lead = b_.count > 0 && b_.words[0].letter == 'N';
-    uint32_t pos = lead ? b_.words[0].end : (b_.count > 0 ? b_.words[0].begin : b_.codeEnd);
+    const bool lead = b_->count > 0 && b_->words[0].letter == 'N';
+    uint32_t pos = lead ? b_->words[0].end : (b_->count > 0 ? b_->words[0].begin : b_->codeEnd);
     const bool spaced = style_.sepLen > 0;
     if (lead && spaced)
         for (size_t k = 0; k < style_.sepLen; ++k) t[n++] = style_.sep[k];
@@ -456,32 +720,31 @@ bool ProgramCorrector::insertMotionWord(Motion m) {
 }
 
 void ProgramCorrector::updateOutputAfterPassThrough() {
-    const bool tcp = r_.mode != ProgramMode::Joints;
+    const bool tcp = r_->mode != ProgramMode::Joints;
     for (int a = 0; a < layout_.count; ++a) {
         const AxisMask bit = 1u << a;
-        if (!(r_.endKnown & bit)) {
+        if (!(r_->endKnown & bit)) {
             outKnown_ &= ~bit;
             continue;
         }
-        if (!(r_.words & bit)) continue;
-        if (r_.absolute || r_.machineCoordinates) {
-            outPos_[a] = r_.end[a];
+        if (!(r_->words & bit)) continue;
+        if (r_->absolute || r_->machineCoordinates) {
+            outPos_[a] = r_->end[a];
             outKnown_ |= bit;
-        } else if ((outKnown_ & bit) && (r_.startKnown & bit)) {
-            outPos_[a] += r_.end[a] - r_.start[a];
+        } else if ((outKnown_ & bit) && (r_->startKnown & bit)) {
+            outPos_[a] += r_->end[a] - r_->start[a];
         } else {
             outKnown_ &= ~bit;
         }
     }
     // The machine is where the nominal program puts it (joint mode); in TCP mode its joints are not followed.
-    if (r_.words || r_.vectorGiven) {
+    if (r_->words || r_->vectorGiven) {
         offCourse_ = true;
         outVectorKnown_ = false;
         if (tcp) {
-            nomAt_.known = outAt_.known = false;
+            outAt_.known = false;
         } else {
-            const MoveSpace joints{ProgramMode::Joints, 0.0, r_.tipLength};
-            nomAt_ = Where{(r_.endKnown & all_) == all_, joints, ProgramPoint{r_.end, Vec3(0, 0, -1)}, r_.end, true};
+            const MoveSpace joints{ProgramMode::Joints, 0.0, r_->tipLength};
             outAt_ = Where{(outKnown_ & all_) == all_, joints, ProgramPoint{outPos_, Vec3(0, 0, -1)}, outPos_, true};
         }
     }
@@ -489,21 +752,21 @@ void ProgramCorrector::updateOutputAfterPassThrough() {
 
 void ProgramCorrector::passThrough(const Line& ln, uint64_t no) {
     ++summary_.passedThrough;
-    if (!r_.report) ++summary_.notCorrected;
+    if (!r_->report) ++summary_.notCorrected;
     edits_.clear();
     // After an arc was turned into lines, the output's modal motion differs: restore it where this block relies on it.
-    const bool relies = r_.words != 0 && !r_.motionCode;
-    const bool motionKnown = r_.motion == Motion::Rapid || r_.motion == Motion::Linear || r_.motion == Motion::ArcCw ||
-                             r_.motion == Motion::ArcCcw;
+    const bool relies = r_->words != 0 && !r_->motionCode;
+    const bool motionKnown = r_->motion == Motion::Rapid || r_->motion == Motion::Linear || r_->motion == Motion::ArcCw ||
+                             r_->motion == Motion::ArcCcw;
     bool restored = false;
-    if (relies && motionKnown && outMotion_ != r_.motion && !edits_.overflow()) restored = insertMotionWord(r_.motion);
-    if (r_.report) {
+    if (relies && motionKnown && outMotion_ != r_->motion && !edits_.overflow()) restored = insertMotionWord(r_->motion);
+    if (r_->report) {
         std::string detail;
-        if (r_.reasonLetter) detail = fmt::format(" (axis {})", r_.reasonLetter);
-        else if (r_.reasonCode)
-            detail = r_.reasonCode % 10 ? fmt::format(" (G{}.{})", r_.reasonCode / 10, r_.reasonCode % 10)
-                                        : fmt::format(" (G{})", r_.reasonCode / 10);
-        notice(false, no, fmt::format("{}{}{}", r_.reason ? r_.reason : "not evaluated", detail,
+        if (r_->reasonLetter) detail = fmt::format(" (axis {})", r_->reasonLetter);
+        else if (r_->reasonCode)
+            detail = r_->reasonCode % 10 ? fmt::format(" (G{}.{})", r_->reasonCode / 10, r_->reasonCode % 10)
+                                        : fmt::format(" (G{})", r_->reasonCode / 10);
+        notice(false, no, fmt::format("{}{}{}", r_->reason ? r_->reason : "not evaluated", detail,
                                       restored ? "; motion word inserted to keep the modal motion" : ""));
     }
     if (restored) {
@@ -513,28 +776,28 @@ void ProgramCorrector::passThrough(const Line& ln, uint64_t no) {
         out_.write(ln.text);
     }
     out_.write(ln.eol);
-    if (r_.motionCode) outMotion_ = r_.motion;
-    if (restored) outMotion_ = r_.motion;
+    if (r_->motionCode) outMotion_ = r_->motion;
+    if (restored) outMotion_ = r_->motion;
     updateOutputAfterPassThrough();
-    if (r_.modeSwitch) {
+    if (r_->modeSwitch) {
         // A move in the block that switches TCP mode: positions unknown in the new mode.
         outKnown_ = 0;
-        nomAt_.known = outAt_.known = outVectorKnown_ = false;
+        outAt_.known = outVectorKnown_ = false;
     }
 }
 
 size_t ProgramCorrector::arcWords(const ArcFit& fit, const AxisVector& outStart, uint32_t insertPos) {
     // Centre words of the plane: (I,J) G17, (K,I) G18, (J,K) G19, or R.
-    const int a0 = r_.arc.axis0, a1 = r_.arc.axis1;
+    const int a0 = r_->arc.axis0, a1 = r_->arc.axis1;
     const char l0 = layout_.letter[a0] == 'X' ? 'I' : layout_.letter[a0] == 'Y' ? 'J' : 'K';
     const char l1 = layout_.letter[a1] == 'X' ? 'I' : layout_.letter[a1] == 'Y' ? 'J' : 'K';
     size_t changes = 0;
     char num[kMaxNumberChars];
     double readBack, res;
-    if (r_.arc.radiusForm) {
-        const Word* R = b_.find('R');
-        const double radius = std::hypot(outStart[a0] - fit.c0, outStart[a1] - fit.c1) / r_.scale[a0];
-        const double origPv = interp_.wordValue(*R);
+    if (r_->arc.radiusForm) {
+        const Word* R = b_->find('R');
+        const double radius = std::hypot(outStart[a0] - fit.c0, outStart[a1] - fit.c1) / r_->scale[a0];
+        const double origPv = Interpreter::wordValue(*R, dialect_, r_->inch, layout_);
         const double pv = origPv < 0 ? -radius : radius;
         const size_t n = number('R', false, pv, R, num, readBack, res);
         if (std::fabs(pv - origPv) >= 0.5 * res) {
@@ -548,9 +811,9 @@ size_t ProgramCorrector::arcWords(const ArcFit& fit, const AxisVector& outStart,
     const char let[2] = {l0, l1};
     for (int k = 0; k < 2; ++k) {
         const int a = ax[k];
-        const double pv = r_.arcAbsolute ? (c[k] - r_.offset[a]) / r_.scale[a] : (c[k] - outStart[a]) / r_.scale[a];
-        const Word* w = b_.find(let[k]);
-        const double origPv = w ? interp_.wordValue(*w) : 0.0;
+        const double pv = r_->arcAbsolute ? (c[k] - r_->offset[a]) / r_->scale[a] : (c[k] - outStart[a]) / r_->scale[a];
+        const Word* w = b_->find(let[k]);
+        const double origPv = w ? Interpreter::wordValue(*w, dialect_, r_->inch, layout_) : 0.0;
         const size_t n = number(let[k], false, pv, w, num, readBack, res);
         if (std::fabs(pv - origPv) < 0.5 * res) continue;
         ++changes;
@@ -573,18 +836,18 @@ double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
     int linDecimals = 15, rotDecimals = 15;
     for (int a = 0; a < layout_.count; ++a) {
         const int d = decimalsFor(layout_.letter[a], layout_.rotary[a]);
-        const bool fanucInt = r_.integerIncrements && !styles_[layout_.letter[a] - 'A'].sawPoint &&
+        const bool fanucInt = r_->integerIncrements && !styles_[layout_.letter[a] - 'A'].sawPoint &&
                               styles_[layout_.letter[a] - 'A'].sawInteger;
-        const int dd = fanucInt ? static_cast<int>(std::lround(-std::log10(r_.increment))) : d;
+        const int dd = fanucInt ? static_cast<int>(std::lround(-std::log10(r_->increment))) : d;
         if (layout_.rotary[a]) rotDecimals = std::min(rotDecimals, dd);
         else linDecimals = std::min(linDecimals, dd);
     }
-    const double linStep = std::pow(10.0, -linDecimals) * (r_.inch ? 25.4 : 1.0);
+    const double linStep = tenTo(-linDecimals) * (r_->inch ? 25.4 : 1.0);
     double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearCount_, 1)));
     if (space.mode == ProgramMode::Joints && rotaryCount_ > 0) {
         // Lever arm of the rotary axes at this pose: the tip's distance from the workpiece origin plus the tool.
-        const double lever = corrector_.nominalTip(r_.end, space.toolLength).norm() + std::fabs(space.toolLength);
-        floor += 0.5 * std::pow(10.0, -rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
+        const double lever = corrector_.nominalTip(r_->end, space.toolLength).norm() + std::fabs(space.toolLength);
+        floor += 0.5 * tenTo(-rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
     }
     if (tol >= floor) return tol;
     ++summary_.clampedTolerance;
@@ -599,75 +862,12 @@ double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
     return floor;
 }
 
-void ProgramCorrector::checkTravel(const AxisVector& cNom, const AxisVector& c, uint64_t no) {
-    bool outside = false;
-    for (int a = 0; a < layout_.count; ++a) {
-        const Link& link = machine_.axisLink(a);
-        const double mz = link.machineZero;
-        const double lo = link.min - mz, hi = link.max - mz;  // in the controller's machine coordinates
-        const bool nomOut = cNom[a] < lo - 1e-9 || cNom[a] > hi + 1e-9;
-        const bool corOut = c[a] < lo - 1e-9 || c[a] > hi + 1e-9;
-        if (!nomOut && !corOut) continue;
-        outside = true;
-        const double k = layout_.rotary[a] ? 1.0 / kDeg : 1.0;
-        const char* unit = layout_.rotary[a] ? "deg" : "mm";
-        notice(true, no,
-               fmt::format("axis {} at {:.4f} {} ({}) is outside its travel [{:g}, {:g}] {}: corrected all the same",
-                           layout_.letter[a], (nomOut ? cNom[a] : c[a]) * k, unit,
-                           nomOut ? "as programmed" : "after correction", lo * k, hi * k, unit));
-    }
-    if (outside) ++summary_.outsideTravel;
-}
-
-bool ProgramCorrector::jointsOf(Where& w, const AxisVector& guess) {
-    if (!w.known) return false;
-    if (!w.jointsValid) w.jointsValid = corrector_.toJoints(w.space, w.point, guess, w.joints);
-    return w.jointsValid;
-}
-
-bool ProgramCorrector::vectorOf(Where& w, const AxisVector& guess) {
-    if (!w.known) return false;
-    if (w.vectorValid) return true;
-    if (w.space.mode == ProgramMode::TcpVector) {
-        w.vector = w.point.v;
-    } else {
-        if (!jointsOf(w, guess)) return false;
-        ProgramPoint p;
-        corrector_.toProgram(MoveSpace{ProgramMode::TcpVector, w.space.controlLength, w.space.toolLength}, w.joints, p);
-        w.vector = p.v;
-    }
-    w.vectorValid = true;
-    return true;
-}
-
 void ProgramCorrector::switchMode() {
-    // The controller's position is the same machine; what the program's numbers mean changes (LinuxCNC re-reads the
-    // world position of the new kinematics at the switch: M66 E0 L0 in the M428/M429 remaps).
-    const MoveSpace space{r_.mode, r_.controlLength, r_.tipLength};
+    // The same machine position read in the new mode (the front end did the same for the nominal program).
     AxisMask rotary = 0;
     for (int a = 0; a < layout_.count; ++a)
         if (layout_.rotary[a]) rotary |= 1u << a;
-    const AxisVector guess = r_.end;
-    auto convert = [&](Where& w) {
-        if (!jointsOf(w, guess)) {
-            w.known = false;
-            return false;
-        }
-        const AxisVector joints = w.joints;
-        w.space = space;
-        corrector_.toProgram(space, joints, w.point);
-        w.joints = joints;
-        w.jointsValid = true;
-        w.vectorValid = false;
-        return true;
-    };
-    if (convert(nomAt_)) {
-        interp_.setPosition(nomAt_.point.p, all_);
-    } else {
-        // Rotary angles are the same numbers in both modes; the linear positions are not known in the new one.
-        interp_.setPosition(interp_.position(), interp_.known() & rotary);
-    }
-    if (convert(outAt_)) {
+    if (convertWhere(corrector_, outAt_, MoveSpace{r_->mode, r_->controlLength, r_->tipLength}, r_->end)) {
         outPos_ = outAt_.point.p;
         outKnown_ = all_;
     } else {
@@ -677,84 +877,35 @@ void ProgramCorrector::switchMode() {
     offCourse_ = true;
 }
 
-void ProgramCorrector::move(const Line& ln, uint64_t no) {
+void ProgramCorrector::move(Record& rec) {
     const int n = layout_.count;
-    const MoveSpace space{r_.mode, r_.controlLength, r_.tipLength};
+    const Line ln{rec.text, rec.eolView(), rec.number, false, true, true};
+    const uint64_t no = rec.number;
+    const MoveSpace space = rec.space;
     const bool tcp = space.mode != ProgramMode::Joints;
-    if (tcp && !corrector_.tcp().supported()) {
-        r_.kind = BlockKind::PassThrough;
-        r_.reason = corrector_.tcp().why();
-        r_.report = true;
-        passThrough(ln, no);
-        outKnown_ = 0;
-        return;
-    }
     const bool identity = corrector_.identity();
-    const bool isArc = r_.motion == Motion::ArcCw || r_.motion == Motion::ArcCcw;
-    const bool isRapid = r_.motion == Motion::Rapid && !r_.rapidIsFeed;
+    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
+    const bool isRapid = r_->motion == Motion::Rapid && !r_->rapidIsFeed;
     const bool vector = space.mode == ProgramMode::TcpVector;
     bool outStartKnown = (outKnown_ & all_) == all_;
-    bool nomStartKnown = (r_.startKnown & all_) == all_;
-    const AxisVector guess = nomAt_.known && nomAt_.jointsValid ? nomAt_.joints : r_.end;
-
-    // Nominal end point in program space (vector mode: the programmed vector, tip → spindle, or the kept one).
-    ProgramPoint nomEnd, nomStart;
-    nomEnd.p = r_.end;
-    nomStart.p = r_.start;
+    const bool nomStartKnown = rec.nomStartKnown;
+    const ProgramPoint& nomStart = rec.nomStart;
+    const ProgramPoint& nomEnd = rec.nomEnd;
+    const AxisVector& cNom = rec.cNom;
+    const AxisVector& cEnd = rec.cEnd;
     if (vector) {
-        const bool nomVector = nomStartKnown && vectorOf(nomAt_, guess);
-        outStartKnown = outStartKnown && (outVectorKnown_ || vectorOf(outAt_, guess));
+        outStartKnown = outStartKnown && (outVectorKnown_ || vectorOf(corrector_, outAt_, cNom));
         if (outStartKnown && !outVectorKnown_) {
             outVector_ = outAt_.vector;
             outVectorKnown_ = true;
         }
-        nomStartKnown = nomStartKnown && nomVector;
-        nomStart.v = nomAt_.vector;
-        nomEnd.v = r_.vectorGiven ? Vec3(-r_.vector[0], -r_.vector[1], -r_.vector[2]).normalized() : nomAt_.vector;
-        if (!r_.vectorGiven && !nomVector) {
-            r_.kind = BlockKind::PassThrough;
-            r_.reason = "tool vector not known yet (no I J K / A3 B3 C3 given since TCP was switched on)";
-            r_.report = true;
-            passThrough(ln, no);
-            return;
-        }
     }
     ++summary_.moves;
     if (tcp) ++summary_.tcpMoves;
-
-    // Corrected end point: nominal machine coordinates, the erroneous machine's solution, its program position.
-    AxisVector cNom, cEnd;
-    ProgramPoint qEnd;
-    if (identity && !vector) {
-        cNom = r_.end;  // not the machine coordinates in TCP mode: not used for anything but guesses
-    } else if (!corrector_.toJoints(space, nomEnd, guess, cNom)) {
-        r_.kind = BlockKind::PassThrough;
-        r_.reason = "the controller's TCP kinematics cannot reach this tool vector (no rotary solution)";
-        r_.report = true;
-        --summary_.moves;
-        passThrough(ln, no);
-        return;
-    }
-    if (identity) {
-        cEnd = cNom;
-        qEnd = nomEnd;
-    } else {
-        // Near the previous end point's correction (continuity) and the programmed value.
-        const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd,
-                                               haveDelta_ ? &lastDelta_ : nullptr);
-        summary_.maxTipResidual = std::max(summary_.maxTipResidual, s.tipError);
-        summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, s.axisError);
-        if (!s.converged || !(s.tipError < 1e-5)) {
-            ++summary_.unconverged;
-            notice(true, no, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
-                                         s.tipError / kUm));
-            cEnd = cNom;
-            qEnd = nomEnd;
-        } else {
-            lastDelta_ = cEnd - cNom;
-            haveDelta_ = true;
-            corrector_.toProgram(space, cEnd, qEnd);
-        }
+    if (!identity) {
+        summary_.maxTipResidual = std::max(summary_.maxTipResidual, rec.tipResidual);
+        summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, rec.axisResidual);
+        if (rec.unconverged) ++summary_.unconverged;
         for (int a = 0; a < n; ++a) {
             const double d = std::fabs(cEnd[a] - cNom[a]);
             if (layout_.rotary[a]) {
@@ -764,7 +915,10 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
             }
         }
     }
-    if (!(identity && tcp && !vector)) checkTravel(cNom, cEnd, no);
+    if (rec.outsideTravel) ++summary_.outsideTravel;
+    // Program position of the corrected end point (the nominal one when nothing was corrected).
+    ProgramPoint qEnd = nomEnd;
+    if (rec.corrected) corrector_.toProgram(space, cEnd, qEnd);
 
     // Pieces.
     pieces_.clear();
@@ -789,25 +943,25 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     ctx.tolerance = identity ? options_.corrector.toleranceMm : toleranceFor(space, no);
     if (isArc) {
         if (!outStartKnown) {
-            r_.reason = "arc from an output position that is not known";
-            r_.report = true;
+            r_->reason = "arc from an output position that is not known";
+            r_->report = true;
             --summary_.moves;
             passThrough(ln, no);
             return;
         }
-        MovePath path = MovePath::arc(r_.start, r_.end, r_.arc);
+        MovePath path = MovePath::arc(r_->start, r_->end, r_->arc);
         path.vector = vector;
         path.v0 = nomStart.v;
         path.v1 = nomEnd.v;
-        const bool closed = std::hypot(r_.end[r_.arc.axis0] - r_.start[r_.arc.axis0],
-                                       r_.end[r_.arc.axis1] - r_.start[r_.arc.axis1]) < 1e-12;
+        const bool closed = std::hypot(r_->end[r_->arc.axis0] - r_->start[r_->arc.axis0],
+                                       r_->end[r_->arc.axis1] - r_->start[r_->arc.axis1]) < 1e-12;
         if (closed && !identity) {
             // A full circle must end exactly where the controller starts it, digit for digit.
-            qEnd.p[r_.arc.axis0] = outStart[r_.arc.axis0];
-            qEnd.p[r_.arc.axis1] = outStart[r_.arc.axis1];
+            qEnd.p[r_->arc.axis0] = outStart[r_->arc.axis0];
+            qEnd.p[r_->arc.axis1] = outStart[r_->arc.axis1];
         }
         fit = corrector_.fitArc(path, ctx, qEnd, closed);
-        if (fit.ok || r_.stop) {
+        if (fit.ok || r_->stop) {
             if (!fit.ok)
                 notice(true, no, fmt::format("arc kept although {:.3f} um off the nominal path: the block holds a program stop",
                                              fit.maxDeviation / kUm));
@@ -820,12 +974,12 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
             ++summary_.arcsToLines;
         }
     } else {
-        MovePath path = MovePath::line(r_.start, r_.end);
+        MovePath path = MovePath::line(r_->start, r_->end);
         path.vector = vector;
         path.v0 = nomStart.v;
         path.v1 = nomEnd.v;
         const bool measurable = nomStartKnown && outStartKnown && !identity;
-        const bool subdivide = measurable && !isRapid && !r_.stop;
+        const bool subdivide = measurable && !isRapid && !r_->stop;
         if (measurable && !isRapid) corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
         else pieces_.push_back({1.0, qEnd});
     }
@@ -834,16 +988,16 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         ++summary_.limited;
         notice(true, no, fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
     }
-    const bool inverseTime = r_.feedMode == FeedMode::InverseTime;
-    if (pieces_.size() > 1 && inverseTime && r_.feedWord < 0)
+    const bool inverseTime = r_->feedMode == FeedMode::InverseTime;
+    if (pieces_.size() > 1 && inverseTime && r_->feedWord < 0)
         notice(true, no, "inverse-time move without F split: the pieces carry no feed");
 
     // Piece 1 goes onto the original block.
     edits_.clear();
-    const Motion pieceMotion = arcToLines ? Motion::Linear : r_.motion;
-    if (r_.motionWord >= 0) {
+    const Motion pieceMotion = arcToLines ? Motion::Linear : r_->motion;
+    if (r_->motionWord >= 0) {
         if (arcToLines) {
-            const Word& g = b_.words[r_.motionWord];
+            const Word& g = b_->words[r_->motionWord];
             char t[4];
             size_t k = 0;
             if (g.digitsBefore >= 2) t[k++] = '0';
@@ -857,15 +1011,15 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     // of the code.
     uint32_t insertPos = 0;
     bool anchor = false;
-    for (int i = 0; i < b_.count; ++i) {
-        const Word& w = b_.words[i];
+    for (int i = 0; i < b_->count; ++i) {
+        const Word& w = b_->words[i];
         const char c = w.letter;
         if (layout_.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || w.ext) {
             insertPos = std::max(insertPos, w.end);
             anchor = true;
         }
     }
-    if (!anchor) insertPos = r_.motionWord >= 0 ? b_.words[r_.motionWord].end : b_.codeEnd;
+    if (!anchor) insertPos = r_->motionWord >= 0 ? b_->words[r_->motionWord].end : b_->codeEnd;
     char text[BlockEdits::kArena / 4];
     size_t textLen = 0;
     static constexpr char kOrder[] = "XYZUVWABC";
@@ -873,13 +1027,13 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         // Existing words in place; missing ones appended in X Y Z U V W A B C order (vector mode: no rotary words).
         auto one = [&](int a) {
             if (vector && layout_.rotary[a]) return;
-            const int existing = onBlock ? r_.axisWord[a] : -1;
+            const int existing = onBlock ? r_->axisWord[a] : -1;
             char w[kMaxNumberChars + 16];
             size_t len = 0;
             bool replace = false;
             if (!axisWord(a, q.p[a], existing, w, len, replace)) return;
-            if (replace && existing >= 0 && existing < b_.count) {
-                replaceNumber(b_.words[static_cast<size_t>(existing)], w, len);
+            if (replace && existing >= 0 && existing < b_->count) {
+                replaceNumber(b_->words[static_cast<size_t>(existing)], w, len);
             } else {
                 std::memcpy(buf + used, w, len);
                 used += len;
@@ -894,8 +1048,8 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     axesOf(pieces_[0].q, true, text, textLen);
     if (arcKept && !identity) arcWords(fit, outStart, insertPos);
     if (arcToLines) {
-        for (int i = 0; i < b_.count; ++i) {
-            const Word& w = b_.words[i];
+        for (int i = 0; i < b_->count; ++i) {
+            const Word& w = b_->words[i];
             const bool centre = w.letter == 'I' || w.letter == 'J' || w.letter == 'K' || w.letter == 'R' ||
                                 (w.letter == 'P' && dialect_ == Dialect::Rs274ngc);
             if (!centre || w.ext) continue;
@@ -908,17 +1062,17 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
     double readBack, res;
     auto feedOf = [&](size_t k) {
         const double dt = pieces_[k].t - (k == 0 ? 0.0 : pieces_[k - 1].t);
-        return r_.feed / std::max(dt, 1e-12);
+        return r_->feed / std::max(dt, 1e-12);
     };
-    if (inverseTime && pieces_.size() > 1 && r_.feedWord >= 0) {
-        const Word& f = b_.words[r_.feedWord];
+    if (inverseTime && pieces_.size() > 1 && r_->feedWord >= 0) {
+        const Word& f = b_->words[r_->feedWord];
         const size_t k = number('F', false, feedOf(0), &f, num, readBack, res);
         edits_.add(f.valueBegin, f.end, std::string_view(num, k));
     }
     if (textLen > 0) edits_.add(insertPos, insertPos, std::string_view(text, textLen));
     if (edits_.overflow()) {
-        r_.reason = "block too long to rewrite";
-        r_.report = true;
+        r_->reason = "block too long to rewrite";
+        r_->report = true;
         --summary_.moves;
         passThrough(ln, no);
         return;
@@ -941,20 +1095,20 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         while (indent < ln.text.size() && (ln.text[indent] == ' ' || ln.text[indent] == '\t')) ++indent;
         std::string_view prefix = ln.text.substr(0, indent);
         std::string_view skip;
-        if (b_.blockDelete >= 0) {
-            size_t e = static_cast<size_t>(b_.blockDelete) + 1;
+        if (b_->blockDelete >= 0) {
+            size_t e = static_cast<size_t>(b_->blockDelete) + 1;
             while (e < ln.text.size() && std::isdigit(static_cast<unsigned char>(ln.text[e]))) ++e;
-            skip = ln.text.substr(static_cast<size_t>(b_.blockDelete), e - static_cast<size_t>(b_.blockDelete));
+            skip = ln.text.substr(static_cast<size_t>(b_->blockDelete), e - static_cast<size_t>(b_->blockDelete));
         }
-        const Motion lineMotion = r_.motion == Motion::Rapid ? Motion::Rapid : Motion::Linear;
+        const Motion lineMotion = r_->motion == Motion::Rapid ? Motion::Rapid : Motion::Linear;
         for (size_t k = 1; k < pieces_.size(); ++k) {
             out_.write(ln.eol.empty() ? std::string_view(lastEol_) : ln.eol);
             char buf[1024];
             size_t used = 0;
             used += motionText(lineMotion, buf);
             axesOf(pieces_[k].q, false, buf, used);
-            if (inverseTime && r_.feedWord >= 0) {
-                const size_t fn = number('F', false, feedOf(k), &b_.words[r_.feedWord], num, readBack, res);
+            if (inverseTime && r_->feedWord >= 0) {
+                const size_t fn = number('F', false, feedOf(k), &b_->words[r_->feedWord], num, readBack, res);
                 used += composeWord('F', num, fn, 0, true, buf + used);
             }
             out_.write(prefix);
@@ -963,43 +1117,44 @@ void ProgramCorrector::move(const Line& ln, uint64_t no) {
         }
     }
     out_.write(ln.eol);
-    outMotion_ = arcToLines ? Motion::Linear : r_.motion;
+    outMotion_ = arcToLines ? Motion::Linear : r_->motion;
     // Where the nominal and the output programs now are.
-    const bool jointsComputed = !identity || vector || !tcp;
-    nomAt_ = Where{true, space, nomEnd, cNom, jointsComputed, nomEnd.v, vector};
-    outAt_ = Where{outStartKnown || (r_.absolute && !isArc), space, pieces_.back().q, cEnd, jointsComputed && !isArc,
+    outAt_ = Where{outStartKnown || (r_->absolute && !isArc), space, pieces_.back().q, cEnd, rec.jointsComputed && !isArc,
                  pieces_.back().q.v, vector};
     if (!vector) outVectorKnown_ = false;
     offCourse_ = false;
 }
 
-void ProgramCorrector::overlong(uint64_t no) {
-    if (!long_.code) return;  // white space and comments only: nothing it could change
+void ProgramCorrector::overlong(const Record& rec) {
+    if (!rec.overlongCode) return;  // white space and comments only: nothing it could change
     ++summary_.blocks;
     ++summary_.passedThrough;
-    const bool modal = interp_.forgetOverlong(long_, r_);
+    const bool modal = rec.overlongModal;
     std::string axes;
     for (int a = 0; a < layout_.count; ++a)
-        if (r_.words & (1u << a)) axes.push_back(layout_.letter[a]);
+        if (r_->words & (1u << a)) axes.push_back(layout_.letter[a]);
     if (modal) {
         outKnown_ = 0;
         outMotion_ = Motion::Unknown;
     } else {
-        outKnown_ &= ~r_.words;
+        outKnown_ &= ~r_->words;
     }
-    if (modal || r_.words) {
-        nomAt_.known = outAt_.known = outVectorKnown_ = false;
+    if (modal || r_->words) {
+        outAt_.known = outVectorKnown_ = false;
         offCourse_ = true;
     }
-    notice(false, no,
+    notice(false, rec.number,
            fmt::format("line longer than {} bytes: passed through unparsed; {}", options_.bufferSize,
                        modal ? "it holds codes that may change any mode: every position is unknown afterwards"
                              : axes.empty() ? "it names no axis: positions kept"
                                             : fmt::format("positions of {} unknown afterwards", axes)));
 }
 
-void ProgramCorrector::line(const Line& ln) {
+void ProgramCorrector::line(Record& rec) {
+    const Line ln{rec.text, rec.eolView(), rec.number, rec.partial, rec.firstPiece, rec.lastPiece};
     const uint64_t no = ln.number;
+    b_ = &rec.b;
+    r_ = &rec.r;
     if (ln.firstPiece) ++summary_.lines;  // the pieces of an overlong line count as one line
     if (ln.eol.size() == 1 && ln.eol[0] == '\r' && !warnedCr_) {
         warnedCr_ = true;
@@ -1008,24 +1163,21 @@ void ProgramCorrector::line(const Line& ln) {
     if (ln.partial) {
         out_.write(ln.text);
         out_.write(ln.eol);
-        if (ln.firstPiece) long_.reset();
-        long_.feed(ln.text);
-        if (ln.lastPiece) overlong(no);
+        if (ln.lastPiece) overlong(rec);
         return;
     }
     lineText_ = ln.text;
-    lexBlock(ln.text, dialect_, b_, no == 1);
-    updateStyles(b_, ln.text);
-    if (b_.count > 0) blockStyle(ln.text);
-    interp_.interpret(ln.text, b_, r_);
+    updateStyles(*b_, ln.text);
+    if (b_->count > 0) blockStyle(ln.text);
     warnings(no);
+    for (auto& [warning, message] : rec.notices) notice(warning, no, std::move(message));
     // Axes taken at 0 until commanded are at 0 for the output controller too.
-    if (const AxisMask fresh = interp_.assumed() & ~outKnown_) {
+    if (const AxisMask fresh = rec.assumed & ~outKnown_) {
         for (int a = 0; a < layout_.count; ++a)
-            if (fresh & (1u << a)) outPos_[a] = r_.start[a];
+            if (fresh & (1u << a)) outPos_[a] = r_->start[a];
         outKnown_ |= fresh;
     }
-    switch (r_.kind) {
+    switch (r_->kind) {
         case BlockKind::Empty:
             out_.write(ln.text);
             out_.write(ln.eol);
@@ -1034,19 +1186,125 @@ void ProgramCorrector::line(const Line& ln) {
             ++summary_.blocks;
             out_.write(ln.text);
             out_.write(ln.eol);
-            if (r_.motionCode) outMotion_ = r_.motion;
-            if (r_.modeSwitch) switchMode();
+            if (r_->motionCode) outMotion_ = r_->motion;
+            if (r_->modeSwitch) switchMode();
             return;
         case BlockKind::PassThrough:
             ++summary_.blocks;
+            if (rec.frontRefused && rec.space.mode != ProgramMode::Joints) ++summary_.tcpMoves;
             passThrough(ln, no);
+            if (rec.forgetOutput) outKnown_ = 0;
             return;
         case BlockKind::Move:
             ++summary_.blocks;
-            move(ln, no);
+            move(rec);
             return;
     }
 }
+
+/// Threads for a correction: --threads, or the machine's cores; two are used at most (front end and back end).
+int threadsFor(const CorrectOptions& o) {
+    if (o.threads > 0) return o.threads;
+    return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+/// The front end on its own thread, handing records to the back end (the calling thread) in batches, in program
+/// order: the same computations as on one thread, so the same output byte for byte. Constant memory: a fixed number
+/// of batches, each closed after kLines records or kBytes of text (a piece of an overlong line fills one alone).
+class Pipeline {
+public:
+    static constexpr int kBatches = 4, kLines = 128;
+    static constexpr size_t kBytes = size_t{256} << 10;
+
+    Pipeline() {
+        for (Batch& b : batches_) b.records.resize(kLines);
+    }
+
+    template <class Consume>
+    void run(FrontEnd& front, Consume&& consume) {
+        std::thread producer([&] { produce(front); });
+        try {
+            for (int i = 0;; i = (i + 1) % kBatches) {
+                Batch& b = batches_[i];
+                {
+                    std::unique_lock lock(mutex_);
+                    changed_.wait(lock, [&] { return b.full; });
+                }
+                for (size_t k = 0; k < b.count; ++k) {
+                    consume(b.records[k]);
+                    std::string& t = b.records[k].text;
+                    if (t.capacity() > (size_t{64} << 10)) std::string().swap(t);  // a long line's buffer goes
+                }
+                const bool last = b.last;
+                const std::exception_ptr error = b.error;
+                {
+                    std::lock_guard lock(mutex_);
+                    b.full = b.last = false;
+                    b.error = nullptr;
+                }
+                changed_.notify_all();
+                if (error) std::rethrow_exception(error);
+                if (last) break;
+            }
+        } catch (...) {
+            {
+                std::lock_guard lock(mutex_);
+                abort_ = true;
+            }
+            changed_.notify_all();
+            producer.join();
+            throw;
+        }
+        producer.join();
+    }
+
+private:
+    struct Batch {
+        std::vector<Record> records;
+        size_t count = 0;
+        bool full = false, last = false;
+        std::exception_ptr error;
+    };
+
+    void produce(FrontEnd& front) {
+        for (int i = 0;; i = (i + 1) % kBatches) {
+            Batch& b = batches_[i];
+            {
+                std::unique_lock lock(mutex_);
+                changed_.wait(lock, [&] { return !b.full || abort_; });
+                if (abort_) return;
+            }
+            b.count = 0;
+            size_t bytes = 0;
+            try {
+                while (b.count < kLines && bytes < kBytes) {
+                    Record& rec = b.records[b.count];
+                    if (!front.next(rec)) {
+                        b.last = true;
+                        break;
+                    }
+                    bytes += rec.text.size();
+                    ++b.count;
+                }
+            } catch (...) {
+                b.error = std::current_exception();
+                b.last = true;
+            }
+            const bool last = b.last;
+            {
+                std::lock_guard lock(mutex_);
+                b.full = true;
+            }
+            changed_.notify_all();
+            if (last) return;
+        }
+    }
+
+    std::array<Batch, kBatches> batches_;
+    std::mutex mutex_;
+    std::condition_variable changed_;
+    bool abort_ = false;
+};
 
 }  // namespace
 
@@ -1056,6 +1314,14 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     LineReader reader(in, options.bufferSize);
     const std::string_view head = reader.head();
     checkTextHead(head, options.inputName);
+    // HEIDENHAIN Klartext is not ISO G-code: its L / C / CC blocks would be read as words and passed through one by one.
+    // Refused before anything is written, whatever --dialect says.
+    const int klartext = klartextHeaderLine(head);
+    if (klartext > 0 || options.dialect == Dialect::Heidenhain)
+        throw InputError(options.inputName, klartext,
+                         "a HEIDENHAIN Klartext program (BEGIN PGM): `correct` rewrites ISO G-code only (RS274NGC/LinuxCNC, "
+                         "Fanuc, Sinumerik ISO mode, printers), nothing was written. For a TNC load the compensation into the "
+                         "control instead (cnccomp emit --controller heidenhain-tnc); `cnccomp poses` reads Klartext");
     if (options.dialect) {
         s.dialect = *options.dialect;
     } else {
@@ -1066,11 +1332,18 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
         s.dialectReason = d.reason;
     }
     OutputBuffer buffer(out);
-    ProgramCorrector pc(machine, deviations, options, s.dialect, s, buffer);
-    Line line;
-    while (reader.next(line)) {
-        pc.line(line);
-        if (options.progress && (line.number & 0x1fff) == 0 && line.lastPiece) options.progress(reader.bytesConsumed());
+    FrontEnd front(machine, deviations, options, s.dialect, reader);
+    ProgramCorrector back(machine, deviations, options, s.dialect, s, buffer);
+    auto consume = [&](Record& rec) {
+        back.line(rec);
+        if (options.progress && (rec.number & 0x1fff) == 0 && rec.lastPiece) options.progress(rec.bytesConsumed);
+    };
+    if (threadsFor(options) < 2) {
+        Record rec;
+        while (front.next(rec)) consume(rec);
+    } else {
+        Pipeline pipe;
+        pipe.run(front, consume);
     }
     buffer.flush();
     if (options.progress) options.progress(reader.bytesConsumed());

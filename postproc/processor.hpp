@@ -27,6 +27,10 @@ struct CorrectOptions {
     std::ostream* report = nullptr;  ///< optional CSV "line,kind,message" of every notice (unbounded, streamed)
     size_t bufferSize = size_t{1} << 20;  ///< read buffer: longest line parsed; longer lines pass through
     int tcpOnM = -1, tcpOffM = -1;   ///< user-declared TCP switches (--tcp-on M428 --tcp-off M429), -1 none
+    /// Threads: 1 reads, corrects and writes on the calling thread; 2 or more run the front end (reading, lexing,
+    /// interpreting, end-point correction) on a second thread, the back end (path check, splitting, writing) on the
+    /// calling one — the same output byte for byte; 0: the machine's cores.
+    int threads = 0;
 };
 
 struct Notice {

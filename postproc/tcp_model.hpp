@@ -38,6 +38,7 @@ public:
     Vec3 axisFromWorld(const Vec3& axisWorld) const { return R0_.transpose() * axisWorld; }
     Vec3 pointFromWorld(const Vec3& pWorld) const { return R0_.transpose() * (pWorld - t0_); }
     int linearAxis(int k) const { return lin_[k]; }
+    const int* linearAxes() const { return lin_; }
 
 private:
     const CompiledKinematics& nominal_;

@@ -24,6 +24,7 @@ struct Options {
     std::string machine, deviations, in, out, dialect = "auto", setup, report, toolTable, tcpOn, tcpOff;
     double tolUm = 1.0;
     int decimals = -1;
+    int threads = 0;
     std::vector<std::string> workOffsets, toolLengths, assume;
     bool tipOnly = false, rotaryShortest = false, strict = false;
     std::string units;
@@ -72,6 +73,7 @@ void run(const Options& o) {
     if (!(o.tolUm > 0) || !std::isfinite(o.tolUm) || o.tolUm > 1e4)
         throw InputError("--tol-um", 0, "the tolerance must be a positive number of um");
     if (o.decimals < -1 || o.decimals > 12) throw InputError("--decimals", 0, "decimals must be 0..12");
+    if (o.threads < 0 || o.threads > 256) throw InputError("--threads", 0, "threads must be 0 (the machine's cores) .. 256");
     pp::CorrectOptions co;
     co.dialect = dialectOf(o.dialect);
     co.setup = setupOf(o.setup, o.toolTable, o.workOffsets, o.toolLengths, o.assume, o.units);
@@ -82,6 +84,7 @@ void run(const Options& o) {
     co.corrector.toleranceMm = o.tolUm * kUm;
     co.corrector.tipOnly = o.tipOnly;
     co.decimals = o.decimals;
+    co.threads = o.threads;
     co.inputName = o.in;
     std::ifstream in(o.in, std::ios::binary);
     if (!in) throw InputError(o.in, 0, "cannot open the program");
@@ -153,6 +156,10 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--assume", o->assume, "positions of axes until the program commands them, e.g. Y=0 (mm, deg; rotary default 0)");
     c->add_option("--units", o->units, "units when the program sets neither G20 nor G21: mm (default) or inch");
     c->add_option("--report", o->report, "write every pass-through and warning as CSV line,kind,message");
+    c->add_option("--threads", o->threads,
+                  "threads: 1 reads, corrects and writes in one; 2 or more read and solve end points on a second "
+                  "(the same output byte for byte); 0 (default): the machine's cores")
+        ->capture_default_str();
     c->add_flag("--tip-only", o->tipOnly, "correct the tool tip with the linear axes only; rotary commands stay");
     c->add_flag("--rotary-shortest", o->rotaryShortest,
                 "modulo rotary axes: absolute positions in [0,360) reached the shortest way (rollover)");
