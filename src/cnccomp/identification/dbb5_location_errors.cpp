@@ -143,7 +143,9 @@ std::vector<int> axisDeviations(const MachineModel& m, const AxisRoles& a) {
     for (size_t i = 0; i < links.size(); ++i)
         if (links[i].axisIndex == axis) link = static_cast<int>(i);
     std::vector<int> out;
-    for (int c : {a.first, a.second, 3 + a.first, 3 + a.second}) {
+    const int components[4] = {a.first, a.second, 3 + a.first, 3 + a.second};
+    for (const int c : components) {
+        const char letter = c < 3 ? "XYZ"[c] : "ABC"[c - 3];
         int found = -1;
         for (size_t i = 0; i < m.deviations.size(); ++i) {
             const DeviationDef& d = m.deviations[i];
@@ -153,7 +155,7 @@ std::vector<int> axisDeviations(const MachineModel& m, const AxisRoles& a) {
         if (found < 0)
             throw ModelError(fmt::format("machine '{}' has no location deviation E{}0{} of axis {} (the DBB5 formulas "
                                          "identify it)",
-                                         m.name, (c < 3 ? "XYZ" : "ABC")[c % 3], a.axis, a.axis));
+                                         m.name, letter, a.axis, a.axis));
         out.push_back(found);
     }
     return out;
