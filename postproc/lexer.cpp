@@ -1,5 +1,7 @@
 #include "postproc/lexer.hpp"
 
+#include "postproc/number_format.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -25,8 +27,6 @@ const char* lexFlagReason(uint32_t flags) {
 
 namespace {
 
-constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
-                             1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
 inline bool isDigit(unsigned char c) { return c >= '0' && c <= '9'; }
 inline bool isAlpha(unsigned char c) { return (c | 0x20) >= 'a' && (c | 0x20) <= 'z'; }

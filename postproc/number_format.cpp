@@ -7,7 +7,6 @@
 namespace cnccomp::pp {
 
 namespace {
-constexpr double kPow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
 int clampDecimals(const NumberStyle& s) { return s.point ? (s.decimals < 0 ? 0 : (s.decimals > 15 ? 15 : s.decimals)) : 0; }
 }  // namespace
 

@@ -15,6 +15,10 @@ struct NumberStyle {
 
 inline constexpr size_t kMaxNumberChars = 48;
 
+/// 10^0 … 10^22: the powers of ten a double holds exactly (reading and writing decimal digits).
+inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
 /// Writes `value` into `out` (at least kMaxNumberChars bytes) and returns the length. Never writes "-0".
 /// Values too large for the style (|value| · 10^decimals ≥ 9e18) are written with as many digits as needed.
 size_t formatNumber(double value, const NumberStyle& style, char* out);

@@ -9,6 +9,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
+#include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "controllers/common/controller_model.hpp"
 #include "controllers/common/files.hpp"
@@ -20,10 +21,6 @@ namespace {
 // Machine-frame errors (version 2; version 1 had workpiece-frame columns dx_um ... dkz_urad, which the reader refuses).
 constexpr const char* kValueColumns[] = {"dx_machine_um",     "dy_machine_um",     "dz_machine_um",
                                          "dkx_machine_urad", "dky_machine_urad", "dkz_machine_urad"};
-
-std::string axisColumn(const MachineModel& m, int a) {
-    return m.axisNames[a] + (m.axisLink(a).kind == AxisKind::Rotary ? "_deg" : "_mm");
-}
 
 double unitOf(bool rotary) { return rotary ? kDeg : 1.0; }
 

@@ -10,9 +10,9 @@
 namespace cnccomp::controllers::isg {
 namespace {
 
-const std::string kLetters = "XYZABC";
+const std::string kAxisLetters = "XYZABC";
 
-Pose shifted(const Vec3& t) {
+Pose translation(const Vec3& t) {
     Pose p = Pose::Identity();
     p.translation() = t;
     return p;
@@ -42,7 +42,7 @@ IsgModel::IsgModel(const IsgConfig& config, const std::vector<std::pair<std::str
         throw InputError("compensation list", 0,
                          fmt::format("workpiece_axes {} exceeds the {} axes of chain {}", workpieceAxes_, chain_.size(), chain_));
     for (size_t i = 0; i < chain_.size(); ++i) {
-        const size_t k = kLetters.find(chain_[i]);
+        const size_t k = kAxisLetters.find(chain_[i]);
         if (k == std::string::npos || chain_.find(chain_[i]) != i)
             throw InputError("compensation list", 0, fmt::format("chain {}: each of X Y Z A B C at most once", chain_));
         Axis a;
@@ -61,7 +61,7 @@ IsgModel::IsgModel(const IsgConfig& config, const std::vector<std::pair<std::str
     for (const auto& [file, blocks] : files) {
         for (const IsgBlock& b : blocks) {
             const std::string& arg = b.columns[0];
-            if (arg.size() == 1 && kLetters.find(arg[0]) != std::string::npos) {
+            if (arg.size() == 1 && kAxisLetters.find(arg[0]) != std::string::npos) {
                 // Component errors over one axis: "X EXX EYX ..." (TF5280 "ISG CSV format").
                 Axis* a = axisOf(arg[0]);
                 if (!a) throw InputError(file, b.headerLine, fmt::format("axis {} is not in the chain {}", arg, chain_));
@@ -70,7 +70,7 @@ IsgModel::IsgModel(const IsgConfig& config, const std::vector<std::pair<std::str
                 std::vector<int> comp;
                 for (size_t c = 1; c < b.columns.size(); ++c) {
                     const std::string& col = b.columns[c];
-                    const size_t k = col.size() == 3 && col[0] == 'E' && col[2] == arg[0] ? kLetters.find(col[1]) : std::string::npos;
+                    const size_t k = col.size() == 3 && col[0] == 'E' && col[2] == arg[0] ? kAxisLetters.find(col[1]) : std::string::npos;
                     if (k == std::string::npos)
                         throw InputError(file, b.headerLine, fmt::format("'{}' is not a component error of {} (E<X..C>{})", col, arg, arg));
                     comp.push_back(static_cast<int>(k));
@@ -91,8 +91,8 @@ IsgModel::IsgModel(const IsgConfig& config, const std::vector<std::pair<std::str
             for (size_t c = 0; c < b.columns.size(); ++c) {
                 const std::string& col = b.columns[c];
                 const double v = b.rows[0][c];
-                const size_t k1 = col.size() == 3 ? kLetters.find(col[1]) : std::string::npos;
-                const size_t k2 = col.size() == 3 ? kLetters.find(col[2]) : std::string::npos;
+                const size_t k1 = col.size() == 3 ? kAxisLetters.find(col[1]) : std::string::npos;
+                const size_t k2 = col.size() == 3 ? kAxisLetters.find(col[2]) : std::string::npos;
                 if (col.size() == 3 && col[0] == 'P' && col[1] == '0' && k2 < 3) {
                     p0_[static_cast<int>(k2)] = v;
                 } else if (col.size() == 3 && col[0] == 'N' && col[1] == '0' && k2 < 3) {
@@ -102,10 +102,10 @@ IsgModel::IsgModel(const IsgConfig& config, const std::vector<std::pair<std::str
                     Axis* a = axisOf(col[2]);
                     if (!a) throw InputError(file, b.headerLine, fmt::format("{}: axis {} is not in the chain {}", col, col[2], chain_));
                     a->centre[static_cast<int>(k1)] = v;
-                } else if (col.size() == 3 && col[1] == '0' && kLetters.find(col[0]) != std::string::npos && k2 != std::string::npos) {
+                } else if (col.size() == 3 && col[1] == '0' && kAxisLetters.find(col[0]) != std::string::npos && k2 != std::string::npos) {
                     Axis* a = axisOf(col[2]);
                     if (!a) throw InputError(file, b.headerLine, fmt::format("{}: axis {} is not in the chain {}", col, col[2], chain_));
-                    a->position[static_cast<int>(kLetters.find(col[0]))] = v;
+                    a->position[static_cast<int>(kAxisLetters.find(col[0]))] = v;
                 } else {
                     throw InputError(file, b.headerLine,
                                      fmt::format("'{}' is not a parameter of the volumetric compensation (P0X.., N0X.., PXA.., X0X..C0C)", col));
@@ -122,7 +122,7 @@ Pose IsgModel::motion(const Axis& a, double value, bool withErrors) const {
     if (a.rotary) m.linear() = axisRotation(a.direction, value * kDeg);
     else m.translation() = a.direction * value;
     if (withErrors) m = errorTransform(a.position) * m * errorTransform(a.component.at(value));
-    return a.rotary ? shifted(a.centre) * m * shifted(-a.centre) : m;
+    return a.rotary ? translation(a.centre) * m * translation(-a.centre) : m;
 }
 
 Vec3 IsgModel::toolPoint(const std::map<char, double>& values, double length, bool withErrors) const {

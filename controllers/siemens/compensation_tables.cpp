@@ -30,12 +30,6 @@ struct RawTable {
     std::optional<int> input, output;  // machine axis indices
 };
 
-template <class T>
-void setOnce(std::optional<T>& slot, T v, const AssignmentFile& f, const Assignment& a) {
-    if (slot) throw InputError(f.path, a.line, fmt::format("{} is assigned twice", a.variable));
-    slot = v;
-}
-
 int flag(const AssignmentFile& f, const Assignment& a) {
     const double v = numberValue(f, a);
     if (v != 0.0 && v != 1.0) throw InputError(f.path, a.line, fmt::format("{} must be 0 or 1", a.variable));

@@ -124,12 +124,6 @@ struct Raw {
     std::optional<double> dir[3], aOff;
 };
 
-template <class T>
-void setOnce(std::optional<T>& slot, T value, const AssignmentFile& f, const Assignment& a) {
-    if (slot) throw InputError(f.path, a.line, fmt::format("{} is assigned twice", a.variable));
-    slot = std::move(value);
-}
-
 std::string stringValue(const AssignmentFile& f, const Assignment& a) {
     if (a.kind != Assignment::Kind::String) throw InputError(f.path, a.line, fmt::format("{} needs a \"string\"", a.variable));
     return a.value;

@@ -7,9 +7,15 @@
 //   CHANDATA(1)             channel selector
 //   $AN_CEC[0,1]=0.0012     assignment: variable, indices in brackets, value (number, "string" or (AXn))
 //   M17                     end of file (subprogram end)
+#include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
 
 namespace cnccomp::controllers::siemens {
 
@@ -37,5 +43,12 @@ int indexNumber(const AssignmentFile& f, const Assignment& a, size_t which);
 double numberValue(const AssignmentFile& f, const Assignment& a);
 /// Machine axis named AXn → n (≥ 1), or InputError.
 int axisNumber(const AssignmentFile& f, const Assignment& a, std::string_view text);
+
+/// Stores a value read from assignment `a`; InputError at its line when the slot was assigned already.
+template <class T>
+void setOnce(std::optional<T>& slot, T value, const AssignmentFile& f, const Assignment& a) {
+    if (slot) throw InputError(f.path, a.line, fmt::format("{} is assigned twice", a.variable));
+    slot = std::move(value);
+}
 
 }  // namespace cnccomp::controllers::siemens

@@ -7,6 +7,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
+#include "cnccomp/machine.hpp"
 
 namespace cnccomp {
 namespace {
@@ -84,6 +85,10 @@ CsvTable readCsv(const std::string& path) {
     }
     if (!haveHeader) throw InputError(path, n, "empty file; expected a CSV header line");
     return t;
+}
+
+std::string axisColumn(const MachineModel& m, int axis) {
+    return m.axisNames[static_cast<size_t>(axis)] + (m.axisLink(axis).kind == AxisKind::Rotary ? "_deg" : "_mm");
 }
 
 }  // namespace cnccomp

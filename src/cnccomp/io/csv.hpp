@@ -6,6 +6,8 @@
 
 namespace cnccomp {
 
+struct MachineModel;
+
 struct CsvRow {
     int line = 0;
     std::vector<std::string> cells;
@@ -28,5 +30,8 @@ struct CsvTable {
 /// Reads a CSV file whose first non-comment line is the header. Throws InputError on a missing file,
 /// binary content, or rows with more cells than the header.
 CsvTable readCsv(const std::string& path);
+
+/// Column of machine axis `axis` in cnccomp's CSV files: its name and unit, e.g. "X_mm", "C_deg".
+std::string axisColumn(const MachineModel& m, int axis);
 
 }  // namespace cnccomp

@@ -16,10 +16,6 @@ namespace {
 constexpr const char* kErrorColumns[] = {"x_mm", "y_mm", "z_mm", "dx_um", "dy_um", "dz_um", "e_um",
                                          "ea_arcsec", "eb_arcsec", "ec_arcsec", "tilt_arcsec", "ok"};
 
-std::string axisColumn(const MachineModel& m, int a) {
-    return m.axisNames[a] + (m.axisLink(a).kind == AxisKind::Rotary ? "_deg" : "_mm");
-}
-
 std::string where(const MapPoint& p, const MachineModel& m) {
     std::string s;
     for (int a = 0; a < m.axisCount(); ++a) {

@@ -13,10 +13,6 @@ namespace cnccomp {
 
 namespace {
 
-std::string axisColumn(const MachineModel& m, int i) {
-    return m.axisNames[static_cast<size_t>(i)] + (m.axisLink(i).kind == AxisKind::Rotary ? "_deg" : "_mm");
-}
-
 double axisUnit(const MachineModel& m, int i) { return m.axisLink(i).kind == AxisKind::Rotary ? kDeg : 1.0; }
 
 struct Parsed {

@@ -68,7 +68,21 @@ const char* kindOf(mode_t mode) {
     return "not a regular file";
 }
 
-/// An output stream buffer over a file descriptor (no allocation per write, EINTR retried).
+std::string randomSuffix() {
+    static constexpr char kAlphabet[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    std::random_device rd;  // getrandom(2) on Linux: unpredictable
+    std::string s;
+    for (int i = 0; i < 3; ++i) {
+        uint32_t v = rd();
+        for (int k = 0; k < 4; ++k, v >>= 8) s.push_back(kAlphabet[(v & 0xff) % 62]);
+    }
+    return s;
+}
+
+}  // namespace
+
+/// An output stream buffer over a file descriptor (no allocation per write, EINTR retried). Outside the anonymous
+/// namespace: AtomicFile::Impl, which has external linkage, holds one.
 class FdBuf : public std::streambuf {
 public:
     explicit FdBuf(int fd) : fd_(fd), buf_(size_t{1} << 16) { setp(buf_.data(), buf_.data() + buf_.size()); }
@@ -119,19 +133,6 @@ private:
     bool failed_ = false;
     int error_ = 0;
 };
-
-std::string randomSuffix() {
-    static constexpr char kAlphabet[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
-    std::random_device rd;  // getrandom(2) on Linux: unpredictable
-    std::string s;
-    for (int i = 0; i < 3; ++i) {
-        uint32_t v = rd();
-        for (int k = 0; k < 4; ++k, v >>= 8) s.push_back(kAlphabet[(v & 0xff) % 62]);
-    }
-    return s;
-}
-
-}  // namespace
 
 std::string checkOutputPath(const std::string& path) {
     if (path.empty()) throw InputError(path, 0, "the output path is empty");
