@@ -38,7 +38,7 @@ cd "$root"
 out=${out#"$root"/}  # relative to the repository when inside it (shorter to read)
 if ((build)); then
   bash tools/deps.sh
-  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCNCCOMP_UNITY=ON >/dev/null
   ninja -C build -j2 cnccomp
 fi
 cnccomp() { "$cnccomp" "$@"; }
