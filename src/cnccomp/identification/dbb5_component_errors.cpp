@@ -20,13 +20,6 @@ struct Used {
     double s = 0;  ///< ball position along the axis
 };
 
-/// Point and unit direction of axis `ai` on machine `k` at commands q.
-std::pair<Vec3, Vec3> axisLine(const Kinematics& k, int ai, const AxisVector& q) {
-    for (const JointFrame& f : k.jointFrames(q))
-        if (f.axis == ai) return {f.point, f.direction.normalized()};
-    throw ModelError(fmt::format("machine '{}': axis number {} has no joint frame", k.machine().name, ai));
-}
-
 bool othersAtZero(const Dbb5Run& r) {
     for (const auto& [a, v] : r.hold)
         if (std::abs(v) > 1e-9) return false;
@@ -98,7 +91,7 @@ Dbb5ComponentProfile dbb5ComponentProfile(const MachineModel& m, const std::vect
         u.cwiseAbs().maxCoeff(&kb);
         if (std::abs(u[kb]) < 0.99) continue;
         const AxisVector q0 = dbb5SetupCommands(m, r);
-        const auto [point, dir] = axisLine(nominal, ai, q0);
+        const auto [point, dir] = rotaryAxisLine(nominal, ai, q0);
         const Vec3 v = nominal.baseToWorkpiece(q0) * r.ball - point;
         if ((v - v.dot(dir) * dir).norm() > 0.01) continue;  // the ball must sit on the axis
         by[kb].push_back({static_cast<int>(i), (nominal.baseToWorkpiece(q0) * r.ball)[p.along]});
@@ -116,7 +109,7 @@ Dbb5ComponentProfile dbb5ComponentProfile(const MachineModel& m, const std::vect
     const auto [s1, s2] = lowHigh(by[p.second]);
     p.tilts = f2.s - f1.s > 1e-6 && s2.s - s1.s > 1e-6;
     p.axial = !by[p.along].empty();
-    p.reference = p.tilts ? axisLine(nominal, ai, AxisVector::Zero(m.axisCount())).first[p.along] : f1.s;
+    p.reference = p.tilts ? rotaryAxisLine(nominal, ai, AxisVector::Zero(m.axisCount())).first[p.along] : f1.s;
 
     std::vector<Used> used = {f1, s1};
     if (p.tilts) used.insert(used.end(), {f2, s2});

@@ -14,7 +14,7 @@ namespace cnccomp {
 
 namespace {
 
-constexpr const char* kXyz = "XYZ";
+constexpr const char* kLinearAxes = "XYZ";
 
 double held(const Dbb5Run& r, const std::string& axis) {
     for (const auto& [a, v] : r.hold)
@@ -90,7 +90,7 @@ Roles findRoles(const MachineModel& m, const std::vector<Dbb5Run>& runs, const s
             if (p->lo < 0 || !(p->sHi - p->sLo > 1e-6))
                 throw ModelError(fmt::format("DBB5 location errors need two {} runs with the bar along {} at different "
                                              "{} positions ({} at 0)",
-                                             a->axis, kXyz[k], kXyz[a->along], a->other));
+                                             a->axis, kLinearAxes[k], kLinearAxes[a->along], a->other));
     return r;
 }
 
@@ -196,13 +196,13 @@ std::vector<Dbb5FormulaValue> labelled(const Readings& r) {
             out.push_back({l->positionName(k),
                            fmt::format("{} position of the {} axis line at {} = 0, relative to the machine axes ({} at "
                                        "0); {}",
-                                       kXyz[k], l->axis, kXyz[l->along], other, equation(*l, inner, false, k)),
+                                       kLinearAxes[k], l->axis, kLinearAxes[l->along], other, equation(*l, inner, false, k)),
                            l->position[k], false});
         for (int k : {l->first, l->second})
             out.push_back({l->rotationName(k),
                            fmt::format("orientation of the {} axis line about {} relative to the machine axes ({} at 0), "
                                        "ISO 230-1 right-hand sign; {}",
-                                       l->axis, kXyz[k], other, equation(*l, inner, true, k)),
+                                       l->axis, kLinearAxes[k], other, equation(*l, inner, true, k)),
                            l->rotation[k], true});
     }
     return out;

@@ -141,4 +141,10 @@ BallbarTrace simulateDbb5(const Kinematics& k, const Dbb5Run& run) {
     return t;
 }
 
+std::pair<Vec3, Vec3> rotaryAxisLine(const Kinematics& k, int axis, const AxisVector& q) {
+    for (const JointFrame& f : k.jointFrames(q))
+        if (f.axis == axis) return {f.point, f.direction.normalized()};
+    throw ModelError(fmt::format("machine '{}': axis number {} has no joint frame", k.machine().name, axis));
+}
+
 }  // namespace cnccomp

@@ -55,4 +55,8 @@ AxisVector dbb5SetupCommands(const MachineModel& m, const Dbb5Run& run);
 /// the run when a command leaves an axis' travel.
 BallbarTrace simulateDbb5(const Kinematics& k, const Dbb5Run& run);
 
+/// Line of rotary axis `axis` (point, unit direction, bed frame) on machine `k` at commands q; ModelError when the axis
+/// has no joint frame.
+std::pair<Vec3, Vec3> rotaryAxisLine(const Kinematics& k, int axis, const AxisVector& q);
+
 }  // namespace cnccomp

@@ -10,16 +10,9 @@ namespace cnccomp {
 
 namespace {
 
-/// The turning axis' line (point, unit direction) on the nominal machine at commands q.
-std::pair<Vec3, Vec3> axisLine(const Kinematics& nominal, int axis, const AxisVector& q) {
-    for (const JointFrame& f : nominal.jointFrames(q))
-        if (f.axis == axis) return {f.point, f.direction.normalized()};
-    throw ModelError(fmt::format("machine '{}': axis number {} has no joint frame", nominal.machine().name, axis));
-}
-
 /// Ball position relative to the axis line, perpendicular part, bed frame.
 Vec3 radial(const Kinematics& nominal, const Dbb5Run& run, int axis, const AxisVector& q) {
-    const auto [p, w] = axisLine(nominal, axis, q);
+    const auto [p, w] = rotaryAxisLine(nominal, axis, q);
     const Vec3 v = nominal.baseToWorkpiece(q) * run.ball - p;
     return v - v.dot(w) * w;
 }
@@ -32,7 +25,7 @@ bool isDbb5XycTest(const MachineModel& m, const Dbb5Run& run) {
     if (axis < 0 || m.axisLink(axis).kind != AxisKind::Rotary) return false;
     const Kinematics nominal(m);
     const AxisVector q = dbb5SetupCommands(m, run);
-    const Vec3 w = axisLine(nominal, axis, q).second;
+    const Vec3 w = rotaryAxisLine(nominal, axis, q).second;
     return std::abs(run.barDirection.normalized().dot(w)) > 0.99 && radial(nominal, run, axis, q).norm() > 1.0;
 }
 
@@ -49,7 +42,7 @@ Dbb5XycResult evaluateDbb5XycTest(const MachineModel& m, const Dbb5Run& run, con
     Dbb5XycResult r;
     r.run = run.name;
     r.axis = run.axis;
-    const Vec3 w0 = axisLine(nominal, axis, dbb5SetupCommands(m, run)).second;
+    const Vec3 w0 = rotaryAxisLine(nominal, axis, dbb5SetupCommands(m, run)).second;
     w0.cwiseAbs().maxCoeff(&r.along);
     r.first = (r.along + 1) % 3;
     r.second = (r.along + 2) % 3;
