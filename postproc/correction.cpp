@@ -7,7 +7,6 @@
 namespace cnccomp::pp {
 
 namespace {
-constexpr double kTwoPi = 2.0 * kPi;
 
 void lerpPoint(const ProgramPoint& a, const ProgramPoint& b, double t, bool vector, ProgramPoint& out) {
     out.p = a.p + t * (b.p - a.p);

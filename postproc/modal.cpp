@@ -195,8 +195,6 @@ Keyword sinumerikKeyword(std::string_view id, bool call) {
     return Keyword::Unknown;
 }
 
-constexpr double kTwoPi = 2.0 * kPi;
-
 }  // namespace
 
 Interpreter::Interpreter(const AxisLayout& layout, const InterpreterOptions& options)

@@ -11,6 +11,7 @@ using Pose = Eigen::Isometry3d;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
 inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 inline constexpr double kDeg = kPi / 180.0;       ///< radians per degree
 inline constexpr double kArcsec = kDeg / 3600.0;  ///< radians per arc second
 inline constexpr double kUm = 1e-3;               ///< millimetres per micrometre
