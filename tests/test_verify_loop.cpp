@@ -325,6 +325,9 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
             comp.programs.push_back({motions[i].name, {set.programs[i].file, out.str()}});
         }
         const VerifyResult r = verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
+        std::cout << "[ corrected ] " << c.machine << (c.machineZero.empty() ? "" : " (machine-zero)")
+                  << (c.correctWithTruth ? " (truth set)" : "") << ": " << r.residual / kUm << " um (before "
+                  << r.residualBefore / kUm << " um)\n";
         EXPECT_LT(r.residual, 0.1 * kUm) << c.machine << ": before " << r.residualBefore / kUm << " um";
         EXPECT_GT(r.residualBefore, 1.0 * kUm) << c.machine;
         EXPECT_FALSE(r.volumetric.available);
