@@ -261,13 +261,17 @@ void Interpreter::unknownAll(BlockResult& r) {
     r.endKnown = 0;
 }
 
-void Interpreter::forgetAll(BlockResult& r, const char* reason) {
+void Interpreter::unreadLine(BlockResult& r, const char* reason) {
     r = BlockResult{};
     r.start = pos_;
     r.end = pos_;
     r.startKnown = known_;
     r.axisWord.fill(-1);
     passThrough(r, reason, 0);
+}
+
+void Interpreter::forgetAll(BlockResult& r, const char* reason) {
+    unreadLine(r, reason);
     unknownAll(r);
     motion_ = Motion::Unknown;
 }
@@ -285,12 +289,7 @@ bool Interpreter::forgetOverlong(const OverlongLine& l, BlockResult& r) {
     AxisMask named = 0;
     for (int a = 0; a < layout_.count; ++a)
         if (l.has(layout_.letter[a])) named |= 1u << a;
-    r = BlockResult{};
-    r.start = pos_;
-    r.end = pos_;
-    r.startKnown = known_;
-    r.axisWord.fill(-1);
-    passThrough(r, why, 0);
+    unreadLine(r, why);
     known_ &= ~named;
     assumed_ &= ~named;
     r.endKnown = known_;

@@ -155,6 +155,8 @@ public:
     static double wordValue(const Word& w, Dialect dialect, bool inch, const AxisLayout& layout);
 
 private:
+    /// A result for a line passed through unread: no words, start and end at the current position.
+    void unreadLine(BlockResult& r, const char* reason);
     void resetPositions();
     void warn(BlockResult& r, Warning w, int code);
     void passThrough(BlockResult& r, const char* reason, int code, bool report = true);

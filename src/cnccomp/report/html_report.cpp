@@ -92,6 +92,18 @@ std::vector<std::string> renderReportPlots(const ReportData& d) {
     return out;
 }
 
+namespace {
+
+/// `  "key": [` then one row a line (`row(item, index)`, a JSON object) and `],`: the summary's tables.
+template <class T, class Row>
+void appendRows(std::string& o, const char* key, const std::vector<T>& items, Row row) {
+    o += fmt::format("  \"{}\": [", key);
+    for (size_t i = 0; i < items.size(); ++i) o += (i ? ",\n    " : "\n    ") + row(items[i], i);
+    o += items.empty() ? "],\n" : "\n  ],\n";
+}
+
+}  // namespace
+
 std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& files) {
     std::string o = "{\n  \"schema\": \"cnccomp-report-summary/1\",\n";
     o += fmt::format("  \"title\": {},\n  \"machine\": {},\n", jsonString(d.title), jsonString(d.machine));
@@ -100,56 +112,42 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
          }) + ",\n";
     o += "  \"warnings\": " + jsonArray(d.warnings, [](const std::string& w) { return jsonString(w); }) + ",\n";
     o += "  \"after_note\": " + jsonString(d.afterNote) + ",\n";
-    o += "  \"runs\": [";
-    for (size_t i = 0; i < d.runs.size(); ++i) {
-        const RunSection& r = d.runs[i];
+    appendRows(o, "runs", d.runs, [&](const RunSection& r, size_t i) {
         int samples = 0;
         for (const PolarPass& p : r.passes) samples += static_cast<int>(p.before.size());
-        o += fmt::format("{}\n    {{\"name\": {}, \"test\": {}, \"LB_mm\": {}, \"samples\": {}, \"passes\": {}, \"before\": {}, "
-                         "\"after\": {}, \"rms_before_um\": {}, \"rms_after_um\": {}, \"plot\": {}}}",
-                         i ? "," : "", jsonString(r.name), jsonString(r.test), jsonNumber(r.LB), samples,
-                         jsonArray(r.passes, [](const PolarPass& p) { return jsonString(p.direction > 0 ? "ccw" : "cw"); }),
-                         isoJson(r.before), isoJson(r.after), jsonNumber(r.rmsBefore / kUm), jsonNumber(r.rmsAfter / kUm),
-                         jsonString(i < files.plots.size() ? fileName(files.plots[i]) : ""));
-    }
-    o += d.runs.empty() ? "],\n" : "\n  ],\n";
-    o += "  \"spans\": [";
-    for (size_t i = 0; i < d.spans.size(); ++i) {
-        const PassSpan& p = d.spans[i];
-        o += fmt::format("{}\n    {{\"run\": {}, \"type\": {}, \"pass\": {}, \"quantity\": {}, \"before_um\": {}, \"after_um\": {}, "
-                         "\"warning\": {}}}",
-                         i ? "," : "", jsonString(p.run), jsonString(p.type), jsonString(p.pass), jsonString(p.quantity),
-                         jsonNumber(p.before / kUm), jsonNumber(p.after / kUm), p.warning.empty() ? "null" : jsonString(p.warning));
-    }
-    o += d.spans.empty() ? "],\n" : "\n  ],\n";
-    o += "  \"deviations\": [";
-    for (size_t i = 0; i < d.deviations.size(); ++i) {
-        const DeviationRow& r = d.deviations[i];
-        o += fmt::format("{}\n    {{\"name\": {}, \"alias\": {}, \"unit\": {}, \"identified\": {}, \"value\": {}, \"low95\": {}, "
-                         "\"high95\": {}, \"truth\": {}}}",
-                         i ? "," : "", jsonString(r.name), jsonString(r.alias), jsonString(r.unit), r.identified ? "true" : "false",
-                         jsonNumber(r.value), jsonNumber(r.low95), jsonNumber(r.high95), jsonNumber(r.truth));
-    }
-    o += d.deviations.empty() ? "],\n" : "\n  ],\n";
+        return fmt::format("{{\"name\": {}, \"test\": {}, \"LB_mm\": {}, \"samples\": {}, \"passes\": {}, \"before\": {}, "
+                           "\"after\": {}, \"rms_before_um\": {}, \"rms_after_um\": {}, \"plot\": {}}}",
+                           jsonString(r.name), jsonString(r.test), jsonNumber(r.LB), samples,
+                           jsonArray(r.passes, [](const PolarPass& p) { return jsonString(p.direction > 0 ? "ccw" : "cw"); }),
+                           isoJson(r.before), isoJson(r.after), jsonNumber(r.rmsBefore / kUm), jsonNumber(r.rmsAfter / kUm),
+                           jsonString(i < files.plots.size() ? fileName(files.plots[i]) : ""));
+    });
+    appendRows(o, "spans", d.spans, [](const PassSpan& p, size_t) {
+        return fmt::format("{{\"run\": {}, \"type\": {}, \"pass\": {}, \"quantity\": {}, \"before_um\": {}, \"after_um\": {}, "
+                           "\"warning\": {}}}",
+                           jsonString(p.run), jsonString(p.type), jsonString(p.pass), jsonString(p.quantity),
+                           jsonNumber(p.before / kUm), jsonNumber(p.after / kUm), p.warning.empty() ? "null" : jsonString(p.warning));
+    });
+    appendRows(o, "deviations", d.deviations, [](const DeviationRow& r, size_t) {
+        return fmt::format("{{\"name\": {}, \"alias\": {}, \"unit\": {}, \"identified\": {}, \"value\": {}, \"low95\": {}, "
+                           "\"high95\": {}, \"truth\": {}}}",
+                           jsonString(r.name), jsonString(r.alias), jsonString(r.unit), r.identified ? "true" : "false",
+                           jsonNumber(r.value), jsonNumber(r.low95), jsonNumber(r.high95), jsonNumber(r.truth));
+    });
     std::vector<std::string> unidentified;
     for (const DeviationRow& r : d.deviations)
         if (!r.identified) unidentified.push_back(r.name);
     o += "  \"unidentified\": " + jsonArray(unidentified, [](const std::string& s) { return jsonString(s); }) + ",\n";
     o += "  \"combinations\": " + jsonArray(d.combinations, [](const std::string& s) { return jsonString(s); }) + ",\n";
     o += fmt::format("  \"map_scale_max_um\": {},\n", jsonNumber(d.maps.empty() ? kUnknown : sharedScaleUm(d)));
-    o += "  \"maps\": [";
-    for (size_t k = 0; k < d.maps.size(); ++k) {
-        const MapPicture& m = d.maps[k];
+    appendRows(o, "maps", d.maps, [&](const MapPicture& m, size_t k) {
         const size_t plot = d.runs.size() + k;
-        o += fmt::format("{}\n    {{\"title\": {}, \"plane_max_um\": {}, \"max_um\": {}, \"rms_um\": {}, \"points\": {}, \"plot\": {}}}",
-                         k ? "," : "", jsonString(m.title), jsonNumber(planeMaxError(m.map, m.plane) / kUm),
-                         jsonNumber(m.map.stats.norm.maxAbs / kUm), jsonNumber(m.map.stats.norm.rms / kUm), m.map.stats.points,
-                         jsonString(plot < files.plots.size() ? fileName(files.plots[plot]) : ""));
-    }
-    o += d.maps.empty() ? "],\n" : "\n  ],\n";
-    o += "  \"controllers\": [";
-    for (size_t k = 0; k < d.controllers.size(); ++k) {
-        const ControllerSection& c = d.controllers[k];
+        return fmt::format("{{\"title\": {}, \"plane_max_um\": {}, \"max_um\": {}, \"rms_um\": {}, \"points\": {}, \"plot\": {}}}",
+                           jsonString(m.title), jsonNumber(planeMaxError(m.map, m.plane) / kUm),
+                           jsonNumber(m.map.stats.norm.maxAbs / kUm), jsonNumber(m.map.stats.norm.rms / kUm), m.map.stats.points,
+                           jsonString(plot < files.plots.size() ? fileName(files.plots[plot]) : ""));
+    });
+    appendRows(o, "controllers", d.controllers, [](const ControllerSection& c, size_t) {
         const auto names = [](const std::vector<CoverageRow>& v) {
             return jsonArray(v, [](const CoverageRow& r) { return jsonString(r.deviation); });
         };
@@ -157,15 +155,14 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
             return fmt::format("{{\"deviation\": {}, \"value\": {}, \"unit\": {}, \"reason\": {}}}", jsonString(r.deviation),
                                jsonNumber(r.value), jsonString(r.unit), jsonString(r.note));
         });
-        o += fmt::format("{}\n    {{\"name\": {}, \"files\": {}, \"compensated\": {}, \"not_compensated\": {}, "
-                         "\"before_max_um\": {}, \"before_rms_um\": {}, \"after_max_um\": {}, \"after_rms_um\": {}, \"points\": {}, "
-                         "\"span_before_um\": {}, \"span_after_um\": {}, \"basis\": {},\n     \"remaining\": {}}}",
-                         k ? "," : "", jsonString(c.name), jsonArray(c.files, [](const std::string& s) { return jsonString(s); }),
-                         names(c.compensated), names(c.notCompensated), jsonNumber(c.beforeMax / kUm),
-                         jsonNumber(c.beforeRms / kUm), jsonNumber(c.afterMax / kUm), jsonNumber(c.afterRms / kUm), c.points,
-                         jsonNumber(c.spanBefore / kUm), jsonNumber(c.spanAfter / kUm), jsonString(c.basis), remaining);
-    }
-    o += d.controllers.empty() ? "],\n" : "\n  ],\n";
+        return fmt::format("{{\"name\": {}, \"files\": {}, \"compensated\": {}, \"not_compensated\": {}, "
+                           "\"before_max_um\": {}, \"before_rms_um\": {}, \"after_max_um\": {}, \"after_rms_um\": {}, \"points\": {}, "
+                           "\"span_before_um\": {}, \"span_after_um\": {}, \"basis\": {},\n     \"remaining\": {}}}",
+                           jsonString(c.name), jsonArray(c.files, [](const std::string& s) { return jsonString(s); }),
+                           names(c.compensated), names(c.notCompensated), jsonNumber(c.beforeMax / kUm),
+                           jsonNumber(c.beforeRms / kUm), jsonNumber(c.afterMax / kUm), jsonNumber(c.afterRms / kUm), c.points,
+                           jsonNumber(c.spanBefore / kUm), jsonNumber(c.spanAfter / kUm), jsonString(c.basis), remaining);
+    });
     o += "  \"files\": {\"html\": " + jsonString(fileName(files.html)) + ", \"plots\": " +
          jsonArray(files.plots, [](const std::string& s) { return jsonString(fileName(s)); }) + "}\n}\n";
     return o;
