@@ -26,6 +26,16 @@ CompiledKinematics::CompiledKinematics(const MachineModel& machine, const Deviat
 }
 
 void CompiledKinematics::Trig::at(double angle, double& c, double& s) const {
+    if (angle == asked) {  // the same angle again (a pose and its frame, a chain walked twice)
+        c = askedC, s = askedS;
+        return;
+    }
+    asked = angle;
+    compute(angle, c, s);
+    askedC = c, askedS = s;
+}
+
+void CompiledKinematics::Trig::compute(double angle, double& c, double& s) const {
     const double d = angle - last;
     if (std::fabs(d) <= 0.05) {
         // Near the last angle (consecutive evaluations: Newton steps, neighbouring blocks): angle addition with the
@@ -132,9 +142,17 @@ void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame&
         return;
     }
     const std::vector<Op>& ops = c.ops;
-    f.R.setIdentity();
-    f.t.setZero();
-    for (const Op& op : ops) {
+    auto op0 = ops.begin();
+    if (op0 != ops.end() && op0->kind == OpKind::Constant) {  // a leading constant transform is the frame so far
+        f.R = op0->R;
+        f.t = op0->t;
+        ++op0;
+    } else {
+        f.R.setIdentity();
+        f.t.setZero();
+    }
+    for (auto it = op0; it != ops.end(); ++it) {
+        const Op& op = *it;
         switch (op.kind) {
             case OpKind::Constant:
                 f.t += f.R * op.t;
@@ -208,6 +226,98 @@ void CompiledKinematics::toolPose(const AxisVector& q, double length, Vec3& tip,
     const Vec3 dirB = t.R * machine_->toolDirection;
     tip.noalias() = w.R.transpose() * (t.t + length * dirB - w.t);
     axis.noalias() = w.R.transpose() * dirB;
+}
+
+void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
+    if (workpiece_.affine.ok) {
+        toolPose(q, length, tip, axis);
+        return;
+    }
+    const Frame& t = cached(tool_, toolCache_, q, false).frame;
+    axis = t.R * machine_->toolDirection;  // base frame, then through w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base)
+    tip = t.t + length * axis;
+    for (const Op& op : workpiece_.ops) {
+        switch (op.kind) {
+            case OpKind::Constant:
+                tip -= op.t;
+                if (!op.identityR) {
+                    tip = op.R.transpose() * tip;
+                    axis = op.R.transpose() * axis;
+                }
+                break;
+            case OpKind::Linear:
+                tip -= op.dir * q[op.axis];
+                break;
+            case OpKind::Rotary: {
+                double c, sn;
+                op.trig.at(q[op.axis], c, sn);
+                if (op.unit >= 0) {
+                    // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
+                    const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
+                    for (Vec3* v : {&tip, &axis}) {
+                        const double a = (*v)[i], b = (*v)[j];
+                        (*v)[i] = c * a + sn * b;
+                        (*v)[j] = c * b - sn * a;
+                    }
+                } else {
+                    // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
+                    const Vec3& u = op.dir;
+                    for (Vec3* v : {&tip, &axis}) *v = c * *v - sn * u.cross(*v) + (1 - c) * u.dot(*v) * u;
+                }
+                break;
+            }
+            case OpKind::Component: {
+                Vec6 e = Vec6::Zero();
+                for (int k : op.components) {
+                    const DeviationDef& def = machine_->deviations[k];
+                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
+                }
+                const Pose E = errorTransform(e);
+                tip = E.linear().transpose() * (tip - E.translation());
+                axis = E.linear().transpose() * axis;
+                break;
+            }
+        }
+    }
+}
+
+Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) const {
+    if (workpiece_.affine.ok) return workpiece_.affine.R * v;
+    Vec3 r = v;
+    for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
+        const Op& op = *it;
+        switch (op.kind) {
+            case OpKind::Constant:
+                if (!op.identityR) r = op.R * r;
+                break;
+            case OpKind::Linear:
+                break;
+            case OpKind::Rotary: {
+                double c, sn;
+                op.trig.at(q[op.axis], c, sn);
+                if (op.unit >= 0) {
+                    const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
+                    const double a = r[i], b = r[j];
+                    r[i] = c * a - sn * b;
+                    r[j] = sn * a + c * b;
+                } else {
+                    const Vec3& u = op.dir;
+                    r = c * r + sn * u.cross(r) + (1 - c) * u.dot(r) * u;
+                }
+                break;
+            }
+            case OpKind::Component: {
+                Vec6 e = Vec6::Zero();
+                for (int k : op.components) {
+                    const DeviationDef& def = machine_->deviations[k];
+                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
+                }
+                r = errorTransform(e).linear() * r;
+                break;
+            }
+        }
+    }
+    return r;
 }
 
 Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {

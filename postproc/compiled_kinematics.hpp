@@ -29,6 +29,11 @@ public:
     /// at model commands q (mm, rad).
     void toolPose(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
     Vec3 toolTip(const AxisVector& q, double length) const;
+    /// toolPose without the workpiece chain's cache: its operations inverted and applied to the tool point and
+    /// direction (about half the arithmetic of building its frame), for commands met once (Newton steps, checks).
+    void toolPoseOnce(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
+    /// A direction given in the workpiece frame, in the base (bed) frame at q: baseToWorkpiece(q).R · v.
+    Vec3 workpieceToBase(const AxisVector& q, const Vec3& v) const;
     /// d(tip, axis)/dq (6 × n, workpiece frame, rows as cnccomp::toolPoseJacobian); also the pose at q.
     void jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const;
     /// The tool point at q and its derivatives by the three axes `axes` (linear axes: constant in them).
@@ -40,8 +45,10 @@ private:
     enum class OpKind : uint8_t { Constant, Linear, Rotary, Component };
     /// cos and sin of a rotary op's angle, from the last exactly computed angle when it is close.
     struct Trig {
-        mutable double last = HUGE_VAL, lastC = 1, lastS = 0;
+        mutable double last = HUGE_VAL, lastC = 1, lastS = 0;    ///< the last exactly computed angle
+        mutable double asked = HUGE_VAL, askedC = 1, askedS = 0;  ///< the last angle asked for
         void at(double angle, double& c, double& s) const;
+        void compute(double angle, double& c, double& s) const;  ///< from `last` by angle addition, or exactly
     };
     struct Op {
         OpKind kind = OpKind::Constant;

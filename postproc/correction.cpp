@@ -71,20 +71,31 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
     zero_ = machine.fromController(AxisVector::Zero(machine.axisCount()));
 }
 
-Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) const { return actual_.toolTip(c + zero_, toolLength); }
+Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) const {
+    Vec3 tip, axis;
+    actual_.toolPoseOnce(c + zero_, toolLength, tip, axis);
+    return tip;
+}
 Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) const { return nominal_.toolTip(c + zero_, toolLength); }
 
 Vec3 Corrector::tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const {
     return nominalTip(cNom, toolLength) - actualTip(c, toolLength);
 }
 
-bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c) const {
+bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c,
+                         NominalPose* pose) const {
+    if (pose) pose->known = false;
     switch (s.mode) {
         case ProgramMode::Joints:
             c = p.p;
             return true;
         case ProgramMode::TcpAngles:
-            tcp_.toJoints(p.p, s.controlLength, c);
+            if (pose) {
+                pose->known = tcp_.toJoints(p.p, s.controlLength, c, &pose->tip, &pose->axis);
+                pose->length = s.controlLength;
+            } else {
+                tcp_.toJoints(p.p, s.controlLength, c);
+            }
             return c.allFinite();
         case ProgramMode::TcpVector: {
             // The tool axis depends on the rotary axes only: Gauss–Newton on them (fresh Jacobian, limited steps),
@@ -276,7 +287,7 @@ bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, dou
     if (!cache.valid || cache.toolLength != toolLength || cache.q.size() != q.size()) return false;
     for (int i = 0; i < q.size(); ++i) {
         const double d = std::fabs(q[i] - cache.q[i]);
-        if ((rotary_ & (1u << i)) ? d > 2.0 * kDeg : d > 50.0) return false;
+        if ((rotary_ & (1u << i)) ? d > 4.0 * kDeg : d > 50.0) return false;
     }
     return true;
 }
@@ -293,6 +304,7 @@ void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cach
     cache.toolLength = toolLength;
     cache.valid = true;
     cache.factored = false;
+    cache.slopeValid = false;
     cache.sigmaFree = ~0u;
 }
 
@@ -302,7 +314,7 @@ void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask fr
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
             const bool both = (free & (1u << i)) && (free & (1u << j));
-            A[i][j] = both ? cache.JtJ[i][j] + damping.D[i][j] : (i == j ? 1.0 : 0.0);
+            A[i][j] = both ? cache.JtJ[i][j] + (damping.any ? damping.D[i][j] : 0.0) : (i == j ? 1.0 : 0.0);
         }
     for (int i = 0; i < n; ++i) A[i][i] += 1e-12 * (1.0 + A[i][i]);
     if (!invertSpd(A, n, cache.Ainv)) {
@@ -317,21 +329,59 @@ void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask fr
             cache.gain[i][r] = v;
         }
     for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) cache.D[i][j] = damping.D[i][j];
+        for (int j = 0; j < n; ++j) cache.D[i][j] = damping.any ? damping.D[i][j] : 0.0;
+    cache.damped = damping.any;
     cache.free = free;
     cache.factored = true;
+    cache.slopeValid = false;
+}
+
+void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev, const AxisVector& deltaPrev,
+                             double toolLength, AxisVector& start) const {
+    start = cNom + deltaPrev;
+    JacobianCache& cache = cache_;
+    if (identity_) return;
+    const int n = static_cast<int>(cNom.size());
+    if (!cache.slopeValid && cache.factored && cacheUsable(cache, cNom + zero_, toolLength)) {
+        PoseJacobian Jn;
+        Vec3 tip, axis;
+        // The nominal machine where it was aimed: the kept commands less the correction (its Jacobian differs from
+        // the erroneous one at the same commands by the deviations, and from itself at cNom by the correction's
+        // turn — both of the same order).
+        nominal_.jacobian(cache.q - deltaPrev, toolLength, Jn, tip, axis);
+        Jn.bottomRows<3>() *= options_.axisWeight;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                double v = 0;
+                for (int r = 0; r < 6; ++r) v += cache.gain[i][r] * (Jn(r, j) - cache.J(r, j));
+                cache.slope[i][j] = v;
+            }
+        cache.slopeValid = cache.slopeKnown = true;
+        cache.slopeLength = toolLength;
+    }
+    // A slope from a Jacobian kept further away (before the refresh that is due) is still far better than none.
+    // Not near a singular pose: there the damped solution is not a smooth function of cNom (and the slope of the
+    // undamped one is large), the start stays at the neighbour's correction.
+    if (!cache.slopeKnown || cache.slopeLength != toolLength || lastDamped_) return;
+    for (int i = 0; i < n; ++i) {
+        double v = 0;
+        for (int j = 0; j < n; ++j) v += cache.slope[i][j] * (cNom[j] - cNomPrev[j]);
+        start[i] += v;
+    }
 }
 
 bool Corrector::factorUsable(const JacobianCache& cache, const Damping& damping, AxisMask free) const {
     if (!cache.factored || cache.free != free) return false;
+    if (!damping.any && !cache.damped) return true;
     const int n = static_cast<int>(cache.q.size());
     // The damping enters the fixed point through the gradient exactly; the factorisation only sets the rate, so a
     // close one is kept (a changed damping near a singular pose refactors).
     double size = 0, diff = 0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
-            size = std::max(size, std::fabs(damping.D[i][j]));
-            diff = std::max(diff, std::fabs(damping.D[i][j] - cache.D[i][j]));
+            const double d = damping.any ? damping.D[i][j] : 0.0;
+            size = std::max(size, std::fabs(d));
+            diff = std::max(diff, std::fabs(d - cache.D[i][j]));
         }
     return diff <= 0.1 * size;
 }
@@ -339,9 +389,7 @@ bool Corrector::factorUsable(const JacobianCache& cache, const Damping& damping,
 void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask free, const AxisVector* neighbourDelta,
                            Damping& damping, AxisVector& reference) const {
     const int n = static_cast<int>(cNom.size());
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) damping.D[i][j] = 0.0;
-    damping.any = false;
+    damping.any = false;  // D is read only when `any`; it is zeroed below before the first term is added
     reference = cNom;
     int axes[kMaxAxes], k = 0;
     for (int i = 0; i < n; ++i)
@@ -358,16 +406,18 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
                 G[a][b] = G[b][a] = J.block<3, 1>(3, axes[a]).dot(J.block<3, 1>(3, axes[b])) * scale;
     };
     if (cache_.valid && cache_.toolLength == toolLength) {
-        // The kept Jacobian belongs to the erroneous machine at nearby commands: turning rotary axis j by δⱼ turns each
-        // column (a unit rotary direction × the tool axis) by at most 2|δⱼ|, so the singular values differ from the
-        // nominal ones at cNom by at most 2√k Σ|δⱼ| plus the deviations' share (≪ 0.01 rad).
-        double moved = 0;
-        for (int a = 0; a < k; ++a) moved += std::fabs(cache_.q[axes[a]] - (cNom[axes[a]] + zero_[axes[a]]));
-        if (cache_.sigmaFree != free) {  // once per kept Jacobian
+        // The reference: the kept Jacobian of the erroneous machine (once per kept Jacobian), or the nominal one of
+        // the last exact evaluation below, whichever is newer. Turning rotary axis j by δⱼ turns each column (a unit
+        // rotary direction × the tool axis) by at most 2|δⱼ|, so the singular values at cNom differ from the
+        // reference's by at most 2√k Σ|δⱼ| plus the deviations' share (≪ 0.01 rad).
+        if (cache_.sigmaFree != free) {
             gram(cache_.J, 1.0 / (options_.axisWeight * options_.axisWeight));
             cache_.sigma = std::sqrt(std::max(0.0, smallestEigenvalue(G, k)));
             cache_.sigmaFree = free;
+            cache_.sigmaQ = cache_.q;
         }
+        double moved = 0;
+        for (int a = 0; a < k; ++a) moved += std::fabs(cache_.sigmaQ[axes[a]] - (cNom[axes[a]] + zero_[axes[a]]));
         if (cache_.sigma >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
     }
     // The nominal machine's at the target, exactly: D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ, φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, so
@@ -378,9 +428,15 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
     gram(Jn, 1.0);
     double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
     symmetricEigen(G, k, lambda, V);
+    if (cache_.valid && cache_.toolLength == toolLength && cache_.sigmaFree == free) {  // the newer reference
+        cache_.sigma = std::sqrt(std::max(0.0, lambda[0]));
+        cache_.sigmaQ = cNom + zero_;
+    }
     const double lp2 = options_.rotaryDamping * options_.rotaryDamping;
     const double lc2 = neighbourDelta ? options_.continuity * options_.continuity : 0.0;
     const double lam2 = lp2 + lc2;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) damping.D[i][j] = 0.0;
     for (int e = 0; e < k; ++e) {
         const double sigma = std::sqrt(std::max(0.0, lambda[e]));
         if (sigma >= s0) continue;
@@ -433,7 +489,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
     };
     Vec3 tip, axis;
     for (res.iterations = 0; res.iterations < options_.maxIterations; ++res.iterations) {
-        k.toolPose(q, toolLength, tip, axis);
+        k.toolPoseOnce(q, toolLength, tip, axis);
         const Vec3 et = targetTip - tip, ea = targetAxis - axis;
         for (int j = 0; j < 3; ++j) r[j] = et[j], r[3 + j] = ea[j] * w;
         res.tipError = et.norm();
@@ -449,7 +505,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
         }
         lastStep = size;
         for (int i = 0; i < n; ++i) q[i] += step[i];
-        if (linStep <= options_.solveTolerance && rotStep <= 1e-9) {
+        if (linStep <= options_.solveTolerance && rotStep <= 1e-2 * options_.solveTolerance) {
             // The residual before this last (tiny) step bounds the one after it.
             res.converged = true;
             ++res.iterations;
@@ -460,13 +516,14 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
         res.converged = false;
         cache.valid = false;
         cache.factored = false;
+        cache.slopeKnown = false;
     }
     c = q - zero_;
     return res;
 }
 
 SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
-                             const AxisVector* neighbourDelta, const Vec3& tipShift) const {
+                             const AxisVector* neighbourDelta, const Vec3& tipShift, const NominalPose* target) const {
     const int n = static_cast<int>(cNom.size());
     if (identity_) {
         c = cNom;
@@ -486,8 +543,14 @@ SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const Ax
     Damping damping;
     AxisVector reference;
     dampingFor(cNom, toolLength, free, neighbourDelta, damping, reference);
+    lastDamped_ = damping.any;
     Vec3 tip, axis;
-    nominal_.toolPose(cNom + zero_, toolLength, tip, axis);
+    if (target && target->known) {  // the tool point moves along the axis with the length (toolPose is affine in it)
+        tip = target->tip + (toolLength - target->length) * target->axis;
+        axis = target->axis;
+    } else {
+        nominal_.toolPose(cNom + zero_, toolLength, tip, axis);
+    }
     return solveOn(actual_, cache_, tip + tipShift, axis, toolLength, s, reference, damping, free, c);
 }
 
@@ -516,15 +579,17 @@ Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
     if (s.mode == ProgramMode::Joints) return nominalTip(p.p, s.toolLength);
     // TCP: the programmed point is the controlled point (world frame), the nominal tip lies along the tool axis from
     // it; the axis depends on the rotary angles only (or is the programmed vector). No inverse kinematics needed.
+    const int* lin = tcp_.linearAxes();
+    const Vec3 point = tcp_.pointFromWorld(Vec3(p.p[lin[0]], p.p[lin[1]], p.p[lin[2]]));
+    if (s.toolLength == s.controlLength) return point;
     Vec3 axis;
     if (s.mode == ProgramMode::TcpVector) {
         axis = tcp_.axisFromWorld(p.v.normalized());
     } else {
         Vec3 tip;
-        nominal_.toolPose(p.p + zero_, 0.0, tip, axis);
+        nominal_.toolPoseOnce(p.p + zero_, 0.0, tip, axis);
     }
-    const int* lin = tcp_.linearAxes();
-    return tcp_.pointFromWorld(Vec3(p.p[lin[0]], p.p[lin[1]], p.p[lin[2]])) + (s.toolLength - s.controlLength) * axis;
+    return point + (s.toolLength - s.controlLength) * axis;
 }
 
 double Corrector::deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected,

@@ -29,10 +29,18 @@ struct CorrectorOptions {
                                    ///< (1 − σ/singularSine)²; at or above it (tool axis ≥ 5.7° from every rotary axis
                                    ///< on a 5-axis machine) the solution is exact
     double axisWeight = 100.0;     ///< mm per rad: how much a tool-axis error counts against a tip error
-    double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (and 1e-9 rad)
+    double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (rotary: below this / 100 mm in
+                                   ///< rad); the step is applied, the residual left is a small part of it
     int maxIterations = 30;
     int maxDepth = 14;             ///< subdivision levels per move
     int maxPieces = 16384;         ///< pieces per move
+};
+
+/// The nominal machine's tool point at `length` along the tool and its tool axis (spindle → tip), workpiece frame.
+struct NominalPose {
+    bool known = false;
+    double length = 0;
+    Vec3 tip = Vec3::Zero(), axis = Vec3(0, 0, -1);
 };
 
 struct SolveResult {
@@ -113,8 +121,10 @@ public:
     const CompiledKinematics& actual() const { return actual_; }
     const TcpModel& tcp() const { return tcp_; }
 
-    /// Machine coordinates of a program position (nominal controller). false when the TCP inverse fails.
-    bool toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c) const;
+    /// Machine coordinates of a program position (nominal controller). false when the TCP inverse fails. `pose`
+    /// (optional): the nominal tool point and axis there, when the inverse gives them on the way (TCP angles mode).
+    bool toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c,
+                  NominalPose* pose = nullptr) const;
     /// Program position of machine coordinates c.
     void toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) const;
 
@@ -128,8 +138,19 @@ public:
     /// previous end point, or the interpolation of a move's corrected ends), towards it by options().continuity: there
     /// the rotary axes stay on the branch of their neighbours and of the programmed value instead of swinging.
     /// `tipShift` moves the target tip (a point of a path whose start offset is blended out).
+    /// `target` (optional): the nominal pose at cNom as toJoints gave it (else it is evaluated).
     SolveResult solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
-                      const AxisVector* neighbourDelta = nullptr, const Vec3& tipShift = Vec3::Zero()) const;
+                      const AxisVector* neighbourDelta = nullptr, const Vec3& tipShift = Vec3::Zero(),
+                      const NominalPose* target = nullptr) const;
+
+    /// Start for solve() at cNom from the solution at the previous end point (nominal cNomPrev, correction deltaPrev =
+    /// its c − cNom): cNom + deltaPrev + S (cNom − cNomPrev), S = ∂(c − cNom)/∂cNom = (JᵀJ + D)⁻¹ Jᵀ (Jnom − J) from the
+    /// kept Jacobian J of the erroneous machine and the nominal one at the same commands (first order in the change
+    /// of the correction along the program; S is of the deviations' size, so its staleness over the kept Jacobian's
+    /// range costs little). Only a start: solve() converges from it as from any other; without a kept Jacobian near
+    /// cNom it is cNom + deltaPrev.
+    void predictStart(const AxisVector& cNom, const AxisVector& cNomPrev, const AxisVector& deltaPrev, double toolLength,
+                      AxisVector& start) const;
 
     /// Tip (at `toolLength`) of the nominal machine at cNom minus that of the erroneous machine at c.
     Vec3 tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const;
@@ -178,15 +199,22 @@ private:
         double JtJ[kMaxAxes][kMaxAxes] = {};
         AxisMask free = 0;                       ///< of the factorisation
         double D[kMaxAxes][kMaxAxes] = {};       ///< damping of the factorisation
+        bool damped = false;                     ///< D is not all zero
         double Ainv[kMaxAxes][kMaxAxes] = {};    ///< (JᵀJ + D)⁻¹
         double gain[kMaxAxes][6] = {};           ///< Ainv · Jᵀ (zero rows for fixed axes)
+        bool slopeValid = false;                 ///< `slope` belongs to this Jacobian and factorisation
+        bool slopeKnown = false;                 ///< `slope` was computed (perhaps at an earlier Jacobian)
+        double slopeLength = 0;                  ///< tool length of `slope`
+        double slope[kMaxAxes][kMaxAxes] = {};   ///< ∂(c − cNom)/∂cNom (see predictStart)
         AxisMask sigmaFree = ~0u;                ///< free axes `sigma` was computed for (~0: not computed)
-        double sigma = 0;                        ///< smallest singular value of J's axis rows by the free rotary axes
+        double sigma = 0;                        ///< smallest singular value of the tool axis' derivatives by the free
+                                                 ///< rotary axes at sigmaQ (J's, or the nominal one of dampingFor)
+        AxisVector sigmaQ;                       ///< model commands `sigma` belongs to
     };
     /// Rotary damping of one solve: D (n × n, non-zero in the rotary rows and columns of ill-conditioned directions).
     struct Damping {
         bool any = false;
-        double D[kMaxAxes][kMaxAxes];
+        double D[kMaxAxes][kMaxAxes];  ///< read only when `any` (left unset otherwise)
     };
     SolveResult solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
                         double toolLength, const AxisVector& start, const AxisVector& reference, const Damping& damping,
@@ -213,6 +241,7 @@ private:
     bool affine_ = false;  ///< no component errors: with rotary axes fixed, the error is affine in the linear axes
     AxisMask rotary_ = 0;
     mutable JacobianCache cache_;  ///< not thread-safe: one Corrector per thread
+    mutable bool lastDamped_ = false;  ///< the last solve was damped (near a singular pose)
 };
 
 }  // namespace cnccomp::pp

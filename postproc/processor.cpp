@@ -164,6 +164,11 @@ public:
           reader_(reader) {
         lastDelta_ = AxisVector::Zero(layout_.count);
         all_ = layout_.all();
+        for (int a = 0; a < layout_.count; ++a) {  // travel in the controller's machine coordinates
+            const Link& link = m.axisLink(a);
+            travelMin_[a] = link.min - link.machineZero;
+            travelMax_[a] = link.max - link.machineZero;
+        }
     }
 
     /// The next line into `rec`; false at the end of the input.
@@ -186,7 +191,8 @@ private:
     Line line_;
     OverlongLine long_;
     Where nomAt_;
-    AxisVector lastDelta_;
+    AxisVector lastDelta_, lastCNom_;
+    double travelMin_[kMaxAxes] = {}, travelMax_[kMaxAxes] = {};
     bool haveDelta_ = false;  ///< lastDelta_ is the correction at the previous end point (continuity)
     AxisMask all_ = 0;
 };
@@ -266,9 +272,7 @@ void FrontEnd::refuse(Record& rec, const char* reason) {
 void FrontEnd::checkTravel(Record& rec) {
     const AxisVector &cNom = rec.cNom, &c = rec.cEnd;
     for (int a = 0; a < layout_.count; ++a) {
-        const Link& link = machine_.axisLink(a);
-        const double mz = link.machineZero;
-        const double lo = link.min - mz, hi = link.max - mz;  // in the controller's machine coordinates
+        const double lo = travelMin_[a], hi = travelMax_[a];
         const bool nomOut = cNom[a] < lo - 1e-9 || cNom[a] > hi + 1e-9;
         const bool corOut = c[a] < lo - 1e-9 || c[a] > hi + 1e-9;
         if (!nomOut && !corOut) continue;
@@ -317,9 +321,10 @@ void FrontEnd::move(Record& rec) {
     // Corrected end point: nominal machine coordinates, the erroneous machine's solution, its program position.
     AxisVector& cNom = rec.cNom;
     AxisVector& cEnd = rec.cEnd;
+    NominalPose nomPose;
     if (identity && !vector) {
         cNom = r.end;  // not the machine coordinates in TCP mode: not used for anything but guesses
-    } else if (!corrector_.toJoints(space, nomEnd, guess, cNom)) {
+    } else if (!corrector_.toJoints(space, nomEnd, guess, cNom, &nomPose)) {
         refuse(rec, "the controller's TCP kinematics cannot reach this tool vector (no rotary solution)");
         rec.frontRefused = true;
         return;
@@ -329,8 +334,11 @@ void FrontEnd::move(Record& rec) {
         cEnd = cNom;
     } else {
         // Near the previous end point's correction (warm start and continuity) and the programmed value.
-        const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd,
-                                               haveDelta_ ? &lastDelta_ : nullptr);
+        AxisVector start;
+        if (haveDelta_) corrector_.predictStart(cNom, lastCNom_, lastDelta_, space.toolLength, start);
+        else start = cNom + lastDelta_;
+        const SolveResult s = corrector_.solve(cNom, space.toolLength, start, cEnd, haveDelta_ ? &lastDelta_ : nullptr,
+                                               Vec3::Zero(), &nomPose);
         rec.tipResidual = s.tipError;
         rec.axisResidual = s.axisError;
         if (!s.converged || !(s.tipError < 1e-5)) {
@@ -340,6 +348,7 @@ void FrontEnd::move(Record& rec) {
             cEnd = cNom;
         } else {
             lastDelta_ = cEnd - cNom;
+            lastCNom_ = cNom;
             haveDelta_ = true;
             rec.corrected = true;  // the back end writes cEnd's program position (toProgram)
         }

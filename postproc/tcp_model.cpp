@@ -18,6 +18,30 @@ TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
         }
         lin_[k] = a;
     }
+    if (supported_) {
+        // Slides with a fixed bed direction: no rotary link before them in their chain.
+        Mat3 D;
+        fixedSlides_ = true;
+        for (int k = 0; k < 3; ++k) {
+            bool rotaryBefore = false, found = false;
+            for (const Chain* chain : {&m.workpiece, &m.tool}) {
+                bool rotary = false;
+                for (const Link& l : chain->links) {
+                    if (l.axisIndex == lin_[k]) {
+                        found = true;
+                        rotaryBefore = rotary;
+                        D.col(k) = (chain == &m.workpiece ? -1.0 : 1.0) * m.nominalDirection(lin_[k]);
+                        break;
+                    }
+                    rotary = rotary || l.kind == AxisKind::Rotary;
+                }
+                if (found) break;
+            }
+            fixedSlides_ = fixedSlides_ && found && !rotaryBefore;
+        }
+        fixedSlides_ = fixedSlides_ && std::fabs(D.determinant()) > 1e-6;
+        if (fixedSlides_) slidesInverse_ = D.inverse();
+    }
     const Frame w = nominal.baseToWorkpiece(zero_);
     const Frame t = nominal.baseToTool(zero_);
     R0_ = w.R;
@@ -27,7 +51,7 @@ TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
 void TcpModel::forward(const AxisVector& c, double length, Vec3& point, Vec3& axis) const {
     const AxisVector q = c + zero_;
     Vec3 pw, aw;
-    nominal_.toolPose(q, length, pw, aw);
+    nominal_.toolPoseOnce(q, length, pw, aw);
     point = R0_ * pw + t0_;
     axis = R0_ * aw;
 }
@@ -39,17 +63,29 @@ void TcpModel::toProgram(const AxisVector& c, double length, AxisVector& p) cons
     for (int k = 0; k < 3; ++k) p[lin_[k]] = point[k];
 }
 
-void TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c) const {
+bool TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c, Vec3* tipOut, Vec3* axisOut) const {
     c = p;  // rotary angles as programmed; linear axes start at the world coordinates
     const AxisVector q = c + zero_;
+    const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
+    if (fixedSlides_) {
+        Vec3 tip, axis;
+        nominal_.toolPoseOnce(q, length, tip, axis);
+        // A = R0 · w.Rᵀ · D, A⁻¹ = D⁻¹ · w.R · R0ᵀ
+        const Vec3 d = slidesInverse_ * nominal_.workpieceToBase(q, R0_.transpose() * (want - (R0_ * tip + t0_)));
+        for (int k = 0; k < 3; ++k) c[lin_[k]] += d[k];
+        if (!tipOut || !axisOut) return false;
+        *tipOut = pointFromWorld(want);  // where the slides just put it (the point is affine in them)
+        *axisOut = axis;                 // the slides do not turn the tool
+        return true;
+    }
     Mat3 J;
     Vec3 tip;
     nominal_.pointJacobian(q, length, lin_, J, tip);
     const Mat3 A = R0_ * J;
-    const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
     const Vec3 have = R0_ * tip + t0_;
     const Vec3 d = A.inverse() * (want - have);  // 3 x 3, well conditioned (the slides are orthogonal nominally)
     for (int k = 0; k < 3; ++k) c[lin_[k]] += d[k];
+    return false;
 }
 
 }  // namespace cnccomp::pp

@@ -32,7 +32,9 @@ public:
     void toProgram(const AxisVector& c, double length, AxisVector& p) const;
     /// Machine coordinates of program-space p in angles mode: rotary axes at p's angles, linear axes solved
     /// (exact: with the rotary axes fixed the nominal point is affine in the linear axes). `c` may alias nothing.
-    void toJoints(const AxisVector& p, double length, AxisVector& c) const;
+    /// With `tip` and `axis`: the nominal point at `length` and tool axis there (model workpiece frame) when the solve
+    /// gives them on the way (returns true), else false and they are not set.
+    bool toJoints(const AxisVector& p, double length, AxisVector& c, Vec3* tip = nullptr, Vec3* axis = nullptr) const;
     /// World tool axis (spindle → tip) in the world frame → model workpiece frame, and back.
     Vec3 axisToWorld(const Vec3& axisW) const { return R0_ * axisW; }
     Vec3 axisFromWorld(const Vec3& axisWorld) const { return R0_.transpose() * axisWorld; }
@@ -46,6 +48,10 @@ private:
     Mat3 R0_ = Mat3::Identity();
     Vec3 t0_ = Vec3::Zero();
     int lin_[3] = {-1, -1, -1};
+    /// The X, Y, Z slides move along fixed bed directions (no rotary axis before them in their chains): the point's
+    /// derivatives by them are R0 · wRbᵀ · D with D constant, and the linear solve is D⁻¹ · wRb · R0ᵀ (no Jacobian).
+    bool fixedSlides_ = false;
+    Mat3 slidesInverse_ = Mat3::Identity();  ///< D⁻¹, D's columns ± the slides' bed directions (− workpiece side)
     bool supported_ = false;
     const char* why_ = "";
 };

@@ -1,6 +1,7 @@
 // The post-processor's compiled forward kinematics (postproc/compiled_kinematics.hpp: folded constant transforms,
 // affine chains evaluated without walking them, rotations from the last angle by angle addition, two cached
-// evaluations per chain) against the foundation's cnccomp::Kinematics / toolPoseJacobian, an independent
+// evaluations per chain; toolPoseOnce with the workpiece chain inverted onto the tool point) against the foundation's
+// cnccomp::Kinematics / toolPoseJacobian, an independent
 // implementation of the same model: every sample machine (location and component errors), and an inclined rotary
 // axis (a 45° head, the general rotation path). Sequences of nearby and far poses exercise every cache path.
 #include <gtest/gtest.h>
@@ -77,6 +78,16 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
             toolPoseJacobian(ref, q, ref.toolPoint(L), Jr);
             worstJ = std::max(worstJ, (J - Jr).cwiseAbs().maxCoeff());
             EXPECT_LT((t2 - r.tip).norm(), 1e-9) << name;
+            // The same pose with the workpiece chain inverted onto the tool point (no frame built).
+            Vec3 tipOnce, axisOnce;
+            k.toolPoseOnce(q, L, tipOnce, axisOnce);
+            worstTip = std::max(worstTip, (tipOnce - r.tip).norm());
+            worstAxis = std::max(worstAxis, (axisOnce - r.axis).norm());
+            // A workpiece direction into the bed: the frame's rotation, and back to the tool direction there.
+            const Vec3 v(u(rng), u(rng), u(rng));
+            worstAxis = std::max(worstAxis, (k.workpieceToBase(q, v) - k.baseToWorkpiece(q).R * v).norm());
+            worstAxis = std::max(worstAxis,
+                                 (k.workpieceToBase(q, r.axis) - k.baseToTool(q).R * m.toolDirection).norm());
         }
     }
     std::printf("[ compiled ] %-32s tip %.2g mm, axis %.2g, Jacobian %.2g\n", name.c_str(), worstTip, worstAxis, worstJ);
