@@ -94,6 +94,7 @@ KlartextInterpreter::KlartextInterpreter(const AxisLayout& layout, const Setup& 
         known_ |= 1u << a;
     }
     toolAxis_ = L_.axis('Z');
+    tip_ = setup_.defaultToolLength;
 }
 
 void KlartextInterpreter::fail(const std::string& what) const { throw InputError(inputName_, static_cast<int>(line_), what); }
@@ -113,6 +114,7 @@ void KlartextInterpreter::interpret(std::string_view text, uint64_t line, Klarte
     b.startKnown = b.endKnown = known_;
     b.mode = mode_;
     b.controlLength = tlo_;
+    b.tipLength = tip_;
     tokenizeKlartext(text, b.tokens);
     tok_.clear();
     for (const KlartextToken& t : b.tokens) tok_.push_back(klartextUpper(text.substr(t.begin, t.end - t.begin)));
@@ -264,9 +266,10 @@ void KlartextInterpreter::tool(const std::vector<std::string>& rest) {
         }  // S, F, DR, DR2: no effect on positions
     }
     double length = setup_.defaultToolLength;
+    tip_ = setup_.defaultToolLength + dl;
     if (toolNo == 0) length = 0;
     else if (toolNo > 0)
-        if (const auto l = setup_.toolLength(toolNo)) length = *l;
+        if (const auto l = setup_.toolLength(toolNo)) length = *l, tip_ = *l + dl;
     if (mode_ != ProgramMode::Joints && (length + dl != tlo_ || axis != toolAxis_)) {
         // The manual asks to reset TCPM before a TOOL CALL; the tool tip moves with the new length.
         toolAxis_ = axis;
@@ -484,6 +487,13 @@ void KlartextInterpreter::moveMode(const Words& w, KlartextBlock& b) {
     b.startKnown = known_;
     b.mode = mode_;
     b.controlLength = tlo_;
+    b.tipLength = tip_;
+    b.scale = AxisVector::Ones(L_.count);
+    b.offset = AxisVector::Zero(L_.count);
+    for (int a = 0; a < L_.count; ++a) {
+        b.scale[a] = unit(a);
+        b.offset[a] = w.machine ? 0.0 : shift_[a] + (a == toolAxis_ && mode_ == ProgramMode::Joints ? tlo_ : 0.0);
+    }
 }
 
 void KlartextInterpreter::finishMove(KlartextBlock& b) {
@@ -559,8 +569,7 @@ void KlartextInterpreter::pole(std::string_view text, KlartextBlock& b) {
     }
     AxisVector c = pos_;
     unsigned ck = known_;
-    KlartextBlock scratch;
-    apply(w, scratch, c, ck);
+    apply(w, b, c, ck);  // b.axes: for the number style of the program
     const unsigned need = (1u << poleA0_) | (1u << poleA1_);
     poleKnown_ = (ck & need) == need;
     pc0_ = c[poleA0_];

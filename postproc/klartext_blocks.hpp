@@ -83,6 +83,10 @@ struct KlartextBlock {
     ArcGeometry arc;                    ///< arcs: plane, centre and signed sweep in program space
     ProgramMode mode = ProgramMode::Joints;  ///< how the motion's positions are read
     double controlLength = 0.0;         ///< mm: the called tool's length + DL (TCP: the programmed point is its tip)
+    double tipLength = 0.0;             ///< mm: the physical tool point to correct: the called tool's length + DL from
+                                        ///< the setup, or the setup's default length (+ DL) for TOOL CALL 0, a tool
+                                        ///< the setup does not list, or before any TOOL CALL
+    AxisVector scale, offset;           ///< Move: program space = word · scale + offset for an absolute word
     bool tcpOnAtStart = false;          ///< M128 in this block switched TCP on before its motion
     bool tcpOffAtEnd = false;           ///< M129 in this block switched TCP off after its motion
     bool modeSwitch = false;            ///< a block without motion that switched the mode (FUNCTION TCPM, M128 / M129 alone)
@@ -110,6 +114,12 @@ public:
     const AxisVector& position() const { return pos_; }
     AxisMask known() const { return known_; }
     const AxisLayout& layout() const { return L_; }
+    /// Everything unknown (a line that could not be read).
+    void forgetAll() {
+        known_ = 0;
+        poleKnown_ = tangentKnown_ = false;
+        forgotAny_ = true;
+    }
 
 private:
     struct Words;
@@ -155,6 +165,7 @@ private:
     unsigned known_ = 0;
     int toolAxis_ = -1;
     double tlo_ = 0;
+    double tip_ = 0;
     int poleA0_ = -1, poleA1_ = -1;
     double pc0_ = 0, pc1_ = 0;
     bool poleKnown_ = false;
