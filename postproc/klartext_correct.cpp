@@ -593,6 +593,8 @@ void KlartextCorrector::move() {
             out_.write("L");
             out_.write(pieceWords(pieces_[k].q));
             out_.write(comp);
+            out_.write(" ");
+            out_.write(kKlartextInsertedComment);
         }
         if (numbered) shift_ += static_cast<int64_t>(pieces_.size() - 1);
     }

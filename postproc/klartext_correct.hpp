@@ -16,7 +16,8 @@
 //   the program writes them. Missing axis words are added in X Y Z U V W A B C order.
 // - Moves are split where the path would leave the nominal one by more than the tolerance (raised to what the written
 //   digits can hold, as for ISO programs): the first piece stays on the original block (its F, M and R words), the
-//   others are new blocks "n L … R0|RL|RR" after it. Not split: FMAX moves and blocks with M functions (M129 acts at
+//   others are new blocks "n L … R0|RL|RR ; cnccomp" after it (the comment marks the inserted blocks, for the
+//   operator and for `verify`, which finds the test programs' sample blocks again by it). Not split: FMAX moves and blocks with M functions (M129 acts at
 //   the end of its block, other M functions at its start or end): their midpoint deviation is reported.
 // - Block numbers: the TNC numbers the blocks of a program in ascending order (TNC 620 user's manual for conversational
 //   programming 10/2017, 4.2 "Creating and writing programs"). The inserted blocks take the numbers after their
@@ -37,6 +38,9 @@
 #include "postproc/processor.hpp"
 
 namespace cnccomp::pp {
+
+/// The comment that ends every block `correct` inserts into a Klartext program.
+inline constexpr const char* kKlartextInsertedComment = "; cnccomp";
 
 /// Corrects the Klartext program read by `reader` (its head already looked at) into `out`.
 CorrectSummary correctKlartextProgram(const MachineModel& machine, const DeviationSet& deviations, LineReader& reader,
