@@ -465,8 +465,8 @@ void KlartextCorrector::move() {
     if (b_.machine) return passThrough("M91/M92 (machine coordinates)", false);
     if ((b_.endKnown & all_) != all_) {
         std::string axes;
-        for (int a = 0; a < n; ++a)
-            if (!(b_.endKnown & (1u << a))) axes.push_back(layout_.letter[a]);
+        for (const char* p = kKlartextAxisOrder; *p; ++p)
+            if (const int a = layout_.axis(*p); a >= 0 && !(b_.endKnown & (1u << a))) axes += (axes.empty() ? "" : " ") + std::string(1, *p);
         const std::string why = fmt::format("position of axis {} not known yet", axes);
         return passThrough(why.c_str(), true);
     }

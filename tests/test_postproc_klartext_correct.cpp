@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 #include <sstream>
 #include <vector>
 
@@ -561,6 +562,50 @@ TEST(PostprocKlartextCorrect, UnsupportedBlocksPassThroughAndMalformedOnesNameTh
             EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
         }
     }
+}
+
+TEST(PostprocKlartextCorrect, DamagedProgramsEndInAnInputErrorOrAnOutputNeverInACrash) {
+    // Bytes of a program with every kind of block replaced, inserted or deleted at random: the corrector either writes
+    // a program or throws InputError naming test.h and a line of it; nothing else.
+    const std::string base =
+        "0 BEGIN PGM R MM\n1 TOOL CALL 1 Z S3000 DL+0.02\n2 L X+0 Y+0 Z+50 A-20 C+0 R0 FMAX\n3 CC X+0 Y+25\n"
+        "4 C X+25 Y+25 DR+ R0 F200\n5 CR X+20 Y+5 R+20 DR-\n6 CT X+10 Y+10\n7 LP PR+10 IPA+45\n8 CP IPA+720 IZ-5 DR+\n"
+        "9 M128\n10 L IX+1 Y+2 Z+30 A-25 C+10 F500\n11 L Z+50 M129\n12 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS\n"
+        "13 L X+2 A-30\n14 FUNCTION RESET TCPM\n15 CYCL DEF 7.0 DATUM SHIFT\n16 CYCL DEF 7.1 IX+5\n17 L X+3 R0 ~\n"
+        "   F100 ; continued\n18 END PGM R MM\n";
+    {
+        CorrectSummary s;
+        ASSERT_NO_THROW(ktCorrect(base, s));
+        EXPECT_EQ(s.passedThrough, 0u) << formatSummary(s);
+        EXPECT_EQ(s.moves, 10u);
+    }
+    const std::string alphabet = "0123456789+-. XYZACLRFMIPD~;*\n";
+    std::mt19937 rng(7);
+    int written = 0, refused = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        std::string p = base;
+        for (int k = 0; k < 1 + trial % 3; ++k) {
+            const size_t at = std::uniform_int_distribution<size_t>(0, p.size() - 1)(rng);
+            const char ch = alphabet[std::uniform_int_distribution<size_t>(0, alphabet.size() - 1)(rng)];
+            switch (rng() % 3) {
+                case 0: p[at] = ch; break;
+                case 1: p.insert(p.begin() + long(at), ch); break;
+                default: p.erase(at, 1); break;
+            }
+        }
+        CorrectSummary s;
+        try {
+            ktCorrect(p, s);
+            ++written;
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.file(), "test.h");
+            EXPECT_GE(e.line(), 0) << e.what();
+            ++refused;
+        }
+    }
+    EXPECT_GT(written, 50);
+    EXPECT_GT(refused, 50);
+    std::printf("[ klartext ] damaged programs: %d corrected, %d refused with file:line\n", written, refused);
 }
 
 TEST(PostprocKlartextCorrect, CliStrictExitsThreeAndAMalformedBlockWritesNothing) {
