@@ -119,6 +119,7 @@ struct KtMove {
     long line = 0;
     bool tcp = false;
     bool rapid = false;
+    double tool = kKtTool;  // the called tool's length + DL (the physical tool too)
     Pose5 from, to;  // joints at the start and the end
     Pose5 progFrom, progTo;  // program space of the move's mode
     /// Joints at fraction t: the joints linear, or (TCP) the programmed tip and the angles linear.
@@ -127,7 +128,7 @@ struct KtMove {
         const Pose5& b = tcp ? progTo : to;
         const Pose5 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z), a.a + t * (b.a - a.a),
                       a.c + t * (b.c - a.c)};
-        return tcp ? ktTcpToJoints(p, kKtTool) : p;
+        return tcp ? ktTcpToJoints(p, tool) : p;
     }
 };
 
@@ -161,6 +162,8 @@ std::vector<KtMove> ktScan(const std::string& program) {
         };
         if (tok[k] == "TOOL" && k + 2 < tok.size()) {
             tool = tok[k + 2] == "1" ? kKtTool : 0.0;
+            for (size_t i = k + 3; i < tok.size(); ++i)
+                if (tok[i].rfind("DL", 0) == 0) tool += ktWord(tok[i], 2);
             continue;
         }
         if (tok[k] == "FUNCTION") {
@@ -180,10 +183,23 @@ std::vector<KtMove> ktScan(const std::string& program) {
             mv.line = line;
             mv.tcp = tcp;
             mv.rapid = rapid;
+            mv.tool = tool;
             mv.from = joints;
             mv.progFrom = prog;
             for (size_t i = k + 1; i < tok.size(); ++i) {
                 const std::string& t = tok[i];
+                if (t.size() > 2 && t[0] == 'I') {  // incremental word
+                    const double v = ktWord(t, 2);
+                    switch (t[1]) {
+                        case 'X': prog.x += v, any = true; break;
+                        case 'Y': prog.y += v, any = true; break;
+                        case 'Z': prog.z += v, any = true; break;
+                        case 'A': prog.a += v, any = true; break;
+                        case 'C': prog.c += v, any = true; break;
+                        default: break;
+                    }
+                    continue;
+                }
                 switch (t[0]) {
                     case 'X': prog.x = ktWord(t, 1), any = true; break;
                     case 'Y': prog.y = ktWord(t, 1), any = true; break;
@@ -214,7 +230,7 @@ struct KtCheck {
 double ktDistanceToPath(const KtMove& m, const Vec3& p) {
     const int n = 48;
     double best = HUGE_VAL, bestT = 0;
-    auto dist = [&](double t) { return (ktMachineTip(m.at(t), kKtTool, nullptr).tip - p).norm(); };
+    auto dist = [&](double t) { return (ktMachineTip(m.at(t), m.tool, nullptr).tip - p).norm(); };
     for (int k = 0; k <= n; ++k) {
         const double t = double(k) / n, d = dist(t);
         if (d < best) best = d, bestT = t;
@@ -240,12 +256,12 @@ KtCheck ktCheck(const std::string& original, const std::string& corrected, const
     for (size_t k = 1; k < act.size(); ++k) {
         const KtMove& b = act[k];
         if (b.tcp) ++c.tcpMoves;
-        const KtTip end = ktMachineTip(b.to, kKtTool, &e);
+        const KtTip end = ktMachineTip(b.to, b.tool, &e);
         double bestWorst = HUGE_VAL, bestEnd = 0, bestMid = 0;
         size_t bestIndex = s;
         for (size_t cand = std::max<size_t>(s, 1); cand < std::min(nom.size(), s + 4); ++cand) {
             const double dEnd = ktDistanceToPath(nom[cand], end.tip);
-            const double dMid = b.rapid ? 0.0 : ktDistanceToPath(nom[cand], ktMachineTip(b.at(0.5), kKtTool, &e).tip);
+            const double dMid = b.rapid ? 0.0 : ktDistanceToPath(nom[cand], ktMachineTip(b.at(0.5), b.tool, &e).tip);
             if (std::max(dEnd, dMid) < bestWorst - 1e-12) bestWorst = std::max(dEnd, dMid), bestIndex = cand, bestEnd = dEnd, bestMid = dMid;
             if (bestWorst <= 0.2 * kUm) break;
         }
@@ -256,10 +272,10 @@ KtCheck ktCheck(const std::string& original, const std::string& corrected, const
     // End points of the input moves: the corrected program reaches each with the tool axis of the nominal one.
     size_t j = 0;
     for (size_t k = 1; k < nom.size(); ++k) {
-        const KtTip n = ktMachineTip(nom[k].to, kKtTool, nullptr);
-        c.uncorrected = std::max(c.uncorrected, (n.tip - ktMachineTip(nom[k].to, kKtTool, &e).tip).norm());
+        const KtTip n = ktMachineTip(nom[k].to, nom[k].tool, nullptr);
+        c.uncorrected = std::max(c.uncorrected, (n.tip - ktMachineTip(nom[k].to, nom[k].tool, &e).tip).norm());
         for (; j < act.size(); ++j) {
-            const KtTip a = ktMachineTip(act[j].to, kKtTool, &e);
+            const KtTip a = ktMachineTip(act[j].to, act[j].tool, &e);
             if ((a.tip - n.tip).norm() < 1 * kUm) {
                 if (std::fabs(nom[k].to.a) >= 10)
                     c.maxAxisArcsec = std::max(c.maxAxisArcsec, std::acos(std::clamp(a.axis.dot(n.axis), -1.0, 1.0)) / kArcsec);
@@ -268,7 +284,7 @@ KtCheck ktCheck(const std::string& original, const std::string& corrected, const
         }
     }
     if (!act.empty() && !nom.empty())
-        c.lastEnd = (ktMachineTip(act.back().to, kKtTool, &e).tip - ktMachineTip(nom.back().to, kKtTool, nullptr).tip).norm();
+        c.lastEnd = (ktMachineTip(act.back().to, act.back().tool, &e).tip - ktMachineTip(nom.back().to, nom.back().tool, nullptr).tip).norm();
     return c;
 }
 
@@ -390,9 +406,21 @@ TEST(PostprocKlartextCorrect, JointModeProgramPutsTheTipOnTheNominalPath) {
     // The impeller's numbers read as machine positions (no TCPM): a joint-space path of 1000 moves.
     const auto imp = ktImpellerBlocks(1000);
     if (imp.empty()) GTEST_SKIP() << "no impeller program in ../shared/gcode-corpus";
-    std::vector<std::string> blocks{"BEGIN PGM JOINTS MM", "TOOL CALL 1 Z"};
+    // Tool 1 with DL+0.5 (the tip is 30.5 mm from the spindle); every third block in incremental words.
+    std::vector<std::string> blocks{"BEGIN PGM JOINTS MM", "TOOL CALL 1 Z S600 DL+0.5"};
     blocks.insert(blocks.end(), imp.begin(), imp.end());
     blocks.push_back("END PGM JOINTS MM");
+    {
+        const std::vector<KtMove> abs = ktScan(ktNumbered(blocks));
+        for (size_t k = 3; k < blocks.size() - 1; k += 3) {
+            const KtMove& m = abs[k - 2];  // block k is move k − 2 (BEGIN PGM and TOOL CALL first)
+            const double d[5] = {m.progTo.x - m.progFrom.x, m.progTo.y - m.progFrom.y, m.progTo.z - m.progFrom.z,
+                                 m.progTo.a - m.progFrom.a, m.progTo.c - m.progFrom.c};
+            std::string b = "L";
+            for (int i = 0; i < 5; ++i) b += fmt::format(" I{}{:+.3f}", "XYZAC"[i], d[i]);
+            blocks[k] = b + (m.rapid ? " R0 FMAX" : " R0 F159");
+        }
+    }
     const std::string program = ktNumbered(blocks);
     CorrectSummary s;
     const std::string out = ktCorrect(program, s, false, 6, 0.5);
@@ -409,6 +437,7 @@ TEST(PostprocKlartextCorrect, JointModeProgramPutsTheTipOnTheNominalPath) {
     EXPECT_EQ(s.unconverged, 0u);
     EXPECT_EQ(s.passedThrough, 0u) << formatSummary(s);
     EXPECT_EQ(s.moves, 1000u);
+    EXPECT_NE(out.find(" IX"), std::string::npos);
     // Read back in TCP mode (as if M128 were active) the same words are wrong by far more than the tolerance.
     const KtCheck wrong = ktCheck("0 M128\n" + program, "0 M128\n" + out, KtErrors{});
     EXPECT_GT(wrong.maxEnd, 5 * kUm);
@@ -418,7 +447,10 @@ TEST(PostprocKlartextCorrect, JointModeProgramPutsTheTipOnTheNominalPath) {
 void ktExpectTcp(const char* what, const std::string& on, const std::string& off, size_t count) {
     const auto imp = ktImpellerBlocks(count);
     if (imp.empty()) GTEST_SKIP() << "no impeller program in ../shared/gcode-corpus";
-    std::vector<std::string> blocks{"BEGIN PGM TCP MM", "TOOL CALL 1 Z S600", on};
+    // Tool 1 with DL+0.5: the programmed point is the tip 30.5 mm from the spindle, for the controller's inverse too
+    // (on this table machine the tool stays vertical: a length the corrector and the controller share does not move
+    // the tip; DL itself is checked by the reader's tests, tests/test_testprog_klartext.cpp).
+    std::vector<std::string> blocks{"BEGIN PGM TCP MM", "TOOL CALL 1 Z S600 DL+0.5", on};
     blocks.insert(blocks.end(), imp.begin(), imp.end());
     blocks.push_back(off);
     blocks.push_back("END PGM TCP MM");
@@ -440,7 +472,7 @@ void ktExpectTcp(const char* what, const std::string& on, const std::string& off
     // The programmed point is the nominal tool tip in the workpiece frame (the chain of models agrees with itself).
     const auto nom = ktScan(program);
     for (size_t k = 0; k < nom.size(); k += 97) {
-        const Vec3 tip = ktMachineTip(nom[k].to, kKtTool, nullptr).tip;
+        const Vec3 tip = ktMachineTip(nom[k].to, nom[k].tool, nullptr).tip;
         EXPECT_NEAR(tip.x(), nom[k].progTo.x, 1e-9);
         EXPECT_NEAR(tip.z(), nom[k].progTo.z, 1e-9);
     }
@@ -547,6 +579,17 @@ TEST(PostprocKlartextCorrect, UnsupportedBlocksPassThroughAndMalformedOnesNameTh
         EXPECT_NE(out.find("3 L X+Q1 R0 F100\n"), std::string::npos);
         EXPECT_NE(out.find("5 CYCL CALL\n"), std::string::npos);
         EXPECT_EQ(s.moves, 2u);  // blocks 2 and 7
+    }
+    {
+        // M91 / M92: machine coordinates, not corrected and not counted by --strict (like G53).
+        CorrectSummary s;
+        const std::string out = ktCorrect(head + "3 L Z+100 R0 FMAX M91\n4 L X+5 Y+5 Z+40 R0 F100\n5 END PGM E MM\n", s);
+        EXPECT_NE(out.find("3 L Z+100 R0 FMAX M91\n"), std::string::npos) << out;
+        EXPECT_EQ(s.passedThrough, 1u);
+        EXPECT_EQ(s.notCorrected, 1u);
+        EXPECT_EQ(s.uncorrected(), 0u);
+        EXPECT_EQ(s.moves, 2u);
+        EXPECT_EQ(s.corrected, 2u);
     }
     for (const auto& [block, words] : {std::pair<std::string, std::string>{"3 L X+1e R0\n", "not a number"},
                                        {"3 L X+5 Y R0 FMAX\n", "unexpected"},
