@@ -129,8 +129,7 @@ void KlartextCorrector::run(LineReader& reader) {
     bool pending = false;
     while (reader.next(ln)) {
         if (ln.partial) {
-            if (pending) {
-                finalEol_.clear();
+            if (pending) {  // a block continued with '~' ends before a line too long to read
                 block();
                 pending = false;
             }

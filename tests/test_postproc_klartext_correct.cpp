@@ -651,6 +651,32 @@ TEST(PostprocKlartextCorrect, DamagedProgramsEndInAnInputErrorOrAnOutputNeverInA
     std::printf("[ klartext ] damaged programs: %d corrected, %d refused with file:line\n", written, refused);
 }
 
+TEST(PostprocKlartextCorrect, LinesLongerThanTheBufferPassThroughAndForgetThePosition) {
+    const KtFiles files;
+    const MachineModel m = readMachineXml(files.machine);
+    const DeviationSet d = readDeviationCsv(files.deviations, m);
+    const std::string longLine = "4 L X+5 Y+5 R0 F100 ; " + std::string(300, 'x');
+    const std::string program = "0 BEGIN PGM O MM\n1 TOOL CALL 1 Z\n2 L X+0 Y+0 Z+50 A-20 C+0 R0 FMAX\n3 L X+1 Y+1 Z+40 ~\n"
+                                "  A-21 C+1 R0 F100\n" + longLine + "\n5 L X+2 R0\n6 L X+3 Y+3 Z+45 A-20 C+0\n7 END PGM O MM\n";
+    for (const bool zero : {true, false}) {
+        CorrectOptions o;
+        o.setup.toolLengths.emplace_back(1, kKtTool);
+        o.bufferSize = 128;
+        std::istringstream in(program);
+        std::ostringstream out;
+        const CorrectSummary s = correctProgram(m, zero ? DeviationSet(m) : d, in, out, o);
+        if (zero) {
+            EXPECT_EQ(out.str(), program);
+        }
+        EXPECT_NE(out.str().find(longLine + "\n"), std::string::npos);
+        EXPECT_EQ(s.lines, 9u);
+        EXPECT_EQ(s.passedThrough, 2u) << formatSummary(s);  // the long line, then block 5 (Y Z A C unknown)
+        EXPECT_EQ(s.moves, 3u);                               // blocks 2, 3 (two lines) and 6
+        ASSERT_FALSE(s.passThrough.empty());
+        EXPECT_NE(s.passThrough[0].message.find("longer than 128 bytes"), std::string::npos) << s.passThrough[0].message;
+    }
+}
+
 TEST(PostprocKlartextCorrect, CliStrictExitsThreeAndAMalformedBlockWritesNothing) {
     test::ScratchDir dir("pp-klartext-cli");
     const std::string m = test::sourcePath("samples/machines/table-table-ac.xml");
