@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -122,12 +123,20 @@ struct KtMove {
     double tool = kKtTool;  // the called tool's length + DL (the physical tool too)
     Pose5 from, to;  // joints at the start and the end
     Pose5 progFrom, progTo;  // program space of the move's mode
-    /// Joints at fraction t: the joints linear, or (TCP) the programmed tip and the angles linear.
+    bool arc = false;        // C about the pole (cx, cy) in the XY plane, `sweep` rad (DR+ positive)
+    double cx = 0, cy = 0, sweep = 0;
+    /// Joints at fraction t: the joints linear, or (TCP) the programmed tip and the angles linear; on a C block X and Y
+    /// on the circle.
     Pose5 at(double t) const {
         const Pose5& a = tcp ? progFrom : from;
         const Pose5& b = tcp ? progTo : to;
-        const Pose5 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z), a.a + t * (b.a - a.a),
-                      a.c + t * (b.c - a.c)};
+        Pose5 p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z), a.a + t * (b.a - a.a),
+                a.c + t * (b.c - a.c)};
+        if (arc) {
+            const double r = std::hypot(a.x - cx, a.y - cy), th = std::atan2(a.y - cy, a.x - cx) + t * sweep;
+            p.x = cx + r * std::cos(th);
+            p.y = cy + r * std::sin(th);
+        }
         return tcp ? ktTcpToJoints(p, tool) : p;
     }
 };
@@ -144,7 +153,7 @@ std::vector<KtMove> ktScan(const std::string& program) {
     Pose5 joints;   // where the machine is
     Pose5 prog;     // program space of the current mode
     double tool = 0;
-    std::string pending;
+    double poleX = 0, poleY = 0;
     while (std::getline(in, s)) {
         ++line;
         if (!s.empty() && s.back() == '\r') s.pop_back();
@@ -178,7 +187,14 @@ std::vector<KtMove> ktScan(const std::string& program) {
             if (tok[i] == "FMAX") rapid = true;
         }
         if (m128 && !tcp) tcp = true, toProg(true);
-        if (tok[k] == "L") {
+        if (tok[k] == "CC") {
+            for (size_t i = k + 1; i < tok.size(); ++i) {
+                if (tok[i][0] == 'X') poleX = ktWord(tok[i], 1);
+                if (tok[i][0] == 'Y') poleY = ktWord(tok[i], 1);
+            }
+            continue;
+        }
+        if (tok[k] == "L" || tok[k] == "C") {
             KtMove mv;
             mv.line = line;
             mv.tcp = tcp;
@@ -208,6 +224,18 @@ std::vector<KtMove> ktScan(const std::string& program) {
                     case 'C': prog.c = ktWord(t, 1), any = true; break;
                     default: break;
                 }
+            }
+            if (any && tok[k] == "C") {
+                mv.arc = true;
+                mv.cx = poleX, mv.cy = poleY;
+                const bool ccw = std::find(tok.begin(), tok.end(), "DR+") != tok.end();
+                double sw = std::atan2(prog.y - poleY, prog.x - poleX) - std::atan2(mv.progFrom.y - poleY, mv.progFrom.x - poleX);
+                if (ccw) {
+                    while (sw <= 1e-12) sw += 2 * kPi;
+                } else {
+                    while (sw >= -1e-12) sw -= 2 * kPi;
+                }
+                mv.sweep = sw;
             }
             if (any) {
                 joints = tcp ? ktTcpToJoints(prog, tool) : Pose5{prog.x, prog.y, prog.z + tool, prog.a, prog.c};
@@ -532,6 +560,32 @@ TEST(PostprocKlartextCorrect, ModeSwitchesCorrectEachSectionInItsMode) {
 }
 
 // --- 5. Numbers, line ends, errors ---------------------------------------------------------------------------------
+TEST(PostprocKlartextCorrect, CirclesBecomeChordsOnTheNominalCircleInBothModes) {
+    // A full circle and a quarter under M128 (the tip on the circle in the workpiece frame, the table tilted and
+    // turned), then the same outside TCP mode (the slides on the circle).
+    const std::string program =
+        "0 BEGIN PGM ARC MM\n1 TOOL CALL 1 Z\n2 L X+20 Y+0 Z+10 A-30 C+20 R0 FMAX\n3 M128\n4 L X+20 Y+0 Z+5 A-30 C+20 R0 F300\n"
+        "5 CC X+0 Y+0\n6 C X+20 Y+0 DR+\n7 C X+0 Y-20 DR-\n8 L Z+20 M129\n9 L X+30 Y+10 Z+40 A-30 C+20 R0 F500\n"
+        "10 CC X+10 Y+10\n11 C X+10 Y+30 DR+\n12 END PGM ARC MM\n";
+    CorrectSummary s;
+    const std::string out = ktCorrect(program, s, false, 6, 0.5);
+    const KtCheck c = ktCheck(program, out, KtErrors{});
+    ktPrint("circles as chords", c, s);
+    EXPECT_EQ(s.arcsToLines, 3u);
+    EXPECT_EQ(s.tcpMoves, 4u);
+    EXPECT_EQ(s.passedThrough, 0u) << formatSummary(s);
+    EXPECT_EQ(out.find(" C X"), std::string::npos) << out;
+    EXPECT_GT(c.outputMoves, 100u);
+    EXPECT_GT(c.uncorrected, 10 * kUm);
+    EXPECT_LE(c.maxEnd, 0.15 * kUm);
+    EXPECT_LE(c.lastEnd, 0.15 * kUm);
+    EXPECT_LE(c.maxMid, 0.5 * kUm);
+    EXPECT_NE(out.find("5 CC X+0 Y+0\n"), std::string::npos);
+    // Chords read as the circle they replace would not pass: the check sees the circle.
+    EXPECT_GT(ktCheck(program, std::string(program).replace(program.find("6 C X+20 Y+0 DR+"), 16, "6 L X+20 Y+0"),
+                      KtErrors{}).maxMid, 5 * kUm);
+}
+
 TEST(PostprocKlartextCorrect, InsertedBlocksRenumberTheRestAndCrlfStays) {
     // A long joint move across C and A: split; every later block number moves up by the blocks inserted.
     const std::string program =
