@@ -11,11 +11,11 @@ enum class Dialect {
     Fanuc,      ///< Fanuc (and Haas, Mazak EIA): % O1234, #100 macros, G65/M98, G43.4/G43.5, axis integers in increments
     Sinumerik,  ///< Siemens Sinumerik in ISO mode: ; comments, %_N_ headers, NAME(...) calls, R and $ variables
     Printer,    ///< 3D-printer style (Marlin/RepRap): ; comments, E extruder words, M117 text arguments
-    Heidenhain, ///< HEIDENHAIN conversational (Klartext): numbered blocks, BEGIN PGM, L/CC/C; read by klartext_reader only
+    Heidenhain, ///< HEIDENHAIN conversational (Klartext): numbered blocks, BEGIN PGM, L/CC/C; read by postproc/klartext_blocks.*
 };
 
 /// "rs274ngc" (or "linuxcnc"), "fanuc", "sinumerik", "printer" (or "marlin", "reprap"); nullopt otherwise.
-/// (Heidenhain is detected from BEGIN PGM, not named: `correct` cannot rewrite Klartext.)
+/// (Heidenhain is detected from BEGIN PGM, not named here; `correct --dialect heidenhain` names it.)
 std::optional<Dialect> parseDialect(std::string_view name);
 const char* dialectName(Dialect d);
 

@@ -15,6 +15,7 @@
 
 #include "cnccomp/error.hpp"
 #include "postproc/block_writer.hpp"
+#include "postproc/klartext_correct.hpp"
 #include "postproc/line_reader.hpp"
 #include "postproc/number_format.hpp"
 
@@ -1323,14 +1324,18 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     LineReader reader(in, options.bufferSize);
     const std::string_view head = reader.head();
     checkTextHead(head, options.inputName);
-    // HEIDENHAIN Klartext is not ISO G-code: its L / C / CC blocks would be read as words and passed through one by one.
-    // Refused before anything is written, whatever --dialect says.
+    // HEIDENHAIN Klartext (BEGIN PGM among the first lines, whatever --dialect says): its own corrector.
     const int klartext = klartextHeaderLine(head);
-    if (klartext > 0 || options.dialect == Dialect::Heidenhain)
-        throw InputError(options.inputName, klartext,
-                         "a HEIDENHAIN Klartext program (BEGIN PGM): `correct` rewrites ISO G-code only (RS274NGC/LinuxCNC, "
-                         "Fanuc, Sinumerik ISO mode, printers), nothing was written. For a TNC load the compensation into the "
-                         "control instead (cnccomp emit --controller heidenhain-tnc); `cnccomp poses` reads Klartext");
+    if (klartext > 0 || options.dialect == Dialect::Heidenhain) {
+        if (klartext == 0)
+            throw InputError(options.inputName, 0,
+                             "--dialect heidenhain: no BEGIN PGM among the first lines, not a HEIDENHAIN Klartext program");
+        CorrectSummary k = correctKlartextProgram(machine, deviations, reader, out, options);
+        k.dialectDetected = !options.dialect || *options.dialect != Dialect::Heidenhain;
+        k.dialectCertain = klartext > 0;
+        k.dialectReason = "BEGIN PGM";
+        return k;
+    }
     if (options.dialect) {
         s.dialect = *options.dialect;
     } else {

@@ -76,7 +76,9 @@ struct CorrectSummary {
 };
 
 /// Corrects the program read from `in` into `out`. Throws InputError (naming options.inputName) for an empty or
-/// binary input; everything else it cannot evaluate is passed through and reported in the summary.
+/// binary input; everything else it cannot evaluate is passed through and reported in the summary. A HEIDENHAIN
+/// Klartext program (BEGIN PGM) goes to correctKlartextProgram (postproc/klartext_correct.hpp), which also throws
+/// InputError for a malformed block.
 CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& deviations, std::istream& in,
                               std::ostream& out, const CorrectOptions& options);
 

@@ -242,31 +242,41 @@ TEST(PostprocRobustness, CommandLineErrorsNameTheProblem) {
 }
 
 
-TEST(PostprocRobustness, HeidenhainKlartextProgramIsRefusedUpFront) {
-    // A Klartext program (block numbers, BEGIN PGM, L ... R0 FMAX) looks like ISO words to the G-code lexer: before,
-    // every block was passed through, nothing corrected, exit status 0. Now: refused before anything is written,
-    // naming the file and the BEGIN PGM line, whether the dialect is detected or forced.
+TEST(PostprocRobustness, HeidenhainKlartextProgramGoesToTheKlartextCorrector) {
+    // A Klartext program (block numbers, BEGIN PGM, L ... R0 FMAX) looks like ISO words to the G-code lexer: it is
+    // recognised from BEGIN PGM whatever --dialect says and corrected by the Klartext corrector
+    // (postproc/klartext_correct.hpp; tests/test_postproc_klartext_correct.cpp checks what it writes).
     test::ScratchDir dir("pp-klartext");
     const std::string m = test::sourcePath("samples/machines/table-table-ac.xml");
     const std::string d = test::sourcePath("samples/deviations/table-table-ac-truth.csv");
     const std::string p = dir.file("part.h"), o = dir.file("out.h");
     test::writeText(p, "; probe part\n0 BEGIN PGM PART MM\n1 TOOL CALL 1 Z S3000\n2 L X+10 Y+20 Z+50 A+30 C+0 R0 FMAX\n"
                        "3 L X+15 F500\n4 END PGM PART MM\n");
-    for (const char* extra : {"", " --dialect rs274ngc", " --dialect fanuc"}) {
+    for (const char* extra : {"", " --dialect rs274ngc", " --dialect fanuc", " --dialect heidenhain"}) {
+        std::filesystem::remove(o);
         const auto r = test::runCli("correct --machine " + m + " --deviations " + d + " --in " + p + " --out " + o +
-                                    " --tool-length 100" + extra);
-        EXPECT_EQ(r.exitCode, 2) << extra << r.out;
-        EXPECT_NE(r.out.find("part.h:2: a HEIDENHAIN Klartext program"), std::string::npos) << r.out;
-        EXPECT_FALSE(std::filesystem::exists(o)) << extra;
+                                    " --tool-length 100 --strict" + extra);
+        EXPECT_EQ(r.exitCode, 0) << extra << r.out;
+        EXPECT_NE(r.out.find("dialect: heidenhain"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("moves evaluated: 2;"), std::string::npos) << r.out;
+        const std::string out = test::readText(o);
+        EXPECT_EQ(out.rfind("; probe part\n0 BEGIN PGM PART MM\n1 TOOL CALL 1 Z S3000\n2 L X+", 0), 0u) << out;
+        EXPECT_NE(out, test::readText(p));
     }
-    // The library refuses it too (CorrectOptions::dialect Heidenhain, or detected).
+    // The library too (detected, or CorrectOptions::dialect Heidenhain).
     const MachineModel mm = readMachineXml(m);
     std::istringstream in(test::readText(p));
     std::ostringstream out;
     CorrectOptions co;
     co.inputName = "part.h";
-    EXPECT_THROW(correctProgram(mm, DeviationSet(mm), in, out, co), InputError);
-    EXPECT_TRUE(out.str().empty());
+    EXPECT_EQ(correctProgram(mm, DeviationSet(mm), in, out, co).dialect, Dialect::Heidenhain);
+    EXPECT_EQ(out.str(), test::readText(p));
+    // Forced on a program without BEGIN PGM: refused before anything is written.
+    std::istringstream iso("G0 X1 Y2 Z3\n");
+    std::ostringstream none;
+    co.dialect = Dialect::Heidenhain;
+    EXPECT_THROW(correctProgram(mm, DeviationSet(mm), iso, none, co), InputError);
+    EXPECT_TRUE(none.str().empty());
 }
 
 }  // namespace

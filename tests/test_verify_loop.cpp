@@ -303,34 +303,45 @@ TEST(VerifyLoop, WhatABackendLeavesIsNamedWithItsReason) {
 }
 
 TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
+    // RS274NGC and HEIDENHAIN Klartext test programs (Klartext: inserted blocks are numbered and end with
+    // kKlartextInsertedComment, by which the read-back finds the sample blocks again).
     for (const Case& c : kCases) {
         const Loop l = load(c);
         const DeviationSet identified = c.correctWithTruth ? *l.truth : simulateAndIdentify(l, 0.0);
-        // testprog → cnccomp correct (with the run's tool length, as each program's header says) → verify.
-        const auto motions = testprog::planMotions(l.machine, l.plan);
-        const auto set = testprog::makeTestPrograms(l.machine, l.plan, {});
-        VerifyCompensation comp;
-        comp.kind = VerifyCompensation::Kind::CorrectedPrograms;
-        comp.description = "corrected programs";
-        comp.programDialect = pp::Dialect::Rs274ngc;
-        for (size_t i = 0; i < motions.size(); ++i) {
-            pp::CorrectOptions co;
-            co.dialect = pp::Dialect::Rs274ngc;
-            co.setup.defaultToolLength = motions[i].toolLength;
-            std::istringstream in(set.programs[i].text);
-            std::ostringstream out;
-            const pp::CorrectSummary s = pp::correctProgram(l.machine, identified, in, out, co);
-            EXPECT_EQ(s.unconverged, 0u) << c.machine << " " << motions[i].name;
-            EXPECT_GT(s.corrected, 0u);
-            comp.programs.push_back({motions[i].name, {set.programs[i].file, out.str()}});
+        for (const auto& [dialect, reader] : {std::pair{testprog::ProgramDialect::LinuxCnc, pp::Dialect::Rs274ngc},
+                                              std::pair{testprog::ProgramDialect::Heidenhain, pp::Dialect::Heidenhain}}) {
+            // testprog → cnccomp correct (with the run's tool length, as each program's header says) → verify.
+            const auto motions = testprog::planMotions(l.machine, l.plan);
+            testprog::TestProgramOptions to;
+            to.dialect = dialect;
+            const auto set = testprog::makeTestPrograms(l.machine, l.plan, to);
+            VerifyCompensation comp;
+            comp.kind = VerifyCompensation::Kind::CorrectedPrograms;
+            comp.description = "corrected programs";
+            comp.programDialect = reader;
+            uint64_t split = 0;
+            for (size_t i = 0; i < motions.size(); ++i) {
+                pp::CorrectOptions co;
+                co.dialect = reader;
+                co.setup.defaultToolLength = motions[i].toolLength;
+                std::istringstream in(set.programs[i].text);
+                std::ostringstream out;
+                const pp::CorrectSummary s = pp::correctProgram(l.machine, identified, in, out, co);
+                EXPECT_EQ(s.unconverged, 0u) << c.machine << " " << motions[i].name;
+                EXPECT_GT(s.corrected, 0u);
+                split += s.split;
+                comp.programs.push_back({motions[i].name, {set.programs[i].file, out.str()}});
+            }
+            const VerifyResult r = verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
+            std::cout << "[ corrected ] " << c.machine << " " << pp::dialectName(reader)
+                      << (c.machineZero.empty() ? "" : " (machine-zero)") << (c.correctWithTruth ? " (truth set)" : "")
+                      << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm << " um), " << split
+                      << " moves split\n";
+            EXPECT_LT(r.residual, 0.1 * kUm) << c.machine << " " << pp::dialectName(reader) << ": before "
+                                             << r.residualBefore / kUm << " um";
+            EXPECT_GT(r.residualBefore, 1.0 * kUm) << c.machine;
+            EXPECT_FALSE(r.volumetric.available);
         }
-        const VerifyResult r = verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
-        std::cout << "[ corrected ] " << c.machine << (c.machineZero.empty() ? "" : " (machine-zero)")
-                  << (c.correctWithTruth ? " (truth set)" : "") << ": " << r.residual / kUm << " um (before "
-                  << r.residualBefore / kUm << " um)\n";
-        EXPECT_LT(r.residual, 0.1 * kUm) << c.machine << ": before " << r.residualBefore / kUm << " um";
-        EXPECT_GT(r.residualBefore, 1.0 * kUm) << c.machine;
-        EXPECT_FALSE(r.volumetric.available);
     }
 }
 

@@ -7,6 +7,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
+#include "postproc/klartext_correct.hpp"
 #include "postproc/modal.hpp"
 #include "postproc/poses.hpp"
 
@@ -57,11 +58,15 @@ struct Marker {
     std::string label;
 };
 
-/// A block with a number: ISO "N123 …", Klartext "12 …".
+/// A block with a number: ISO "N123 …", Klartext "12 …" (not one `correct` inserted: those end with its comment).
 bool numberedBlock(std::string_view line, pp::Dialect d) {
     line = trim(line);
     if (line.empty()) return false;
-    if (d == pp::Dialect::Heidenhain) return std::isdigit(static_cast<unsigned char>(line.front()));
+    if (d == pp::Dialect::Heidenhain) {
+        const std::string_view mark = pp::kKlartextInsertedComment;
+        const bool inserted = line.size() >= mark.size() && line.substr(line.size() - mark.size()) == mark;
+        return std::isdigit(static_cast<unsigned char>(line.front())) && !inserted;
+    }
     return (line.front() == 'N' || line.front() == 'n') && line.size() > 1 && std::isdigit(static_cast<unsigned char>(line[1]));
 }
 

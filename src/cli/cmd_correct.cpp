@@ -55,8 +55,11 @@ pp::Setup setupOf(const std::string& file, const std::string& toolTable, const s
 
 std::optional<pp::Dialect> dialectOf(const std::string& name) {
     if (name == "auto") return std::nullopt;
+    if (name == "heidenhain" || name == "klartext") return pp::Dialect::Heidenhain;  // also detected from BEGIN PGM
     const auto d = pp::parseDialect(name);
-    if (!d) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, rs274ngc, fanuc, sinumerik, printer)", name));
+    if (!d)
+        throw InputError("--dialect", 0,
+                         fmt::format("unknown dialect '{}' (auto, rs274ngc, fanuc, sinumerik, printer, heidenhain)", name));
     return d;
 }
 
@@ -137,9 +140,9 @@ const RegisterCommand reg([](CLI::App& app) {
     auto* c = app.add_subcommand("correct", "Rewrite a G-code program so that the erroneous machine cuts the nominal path");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--deviations", o->deviations, "deviation set CSV (identified or known)")->required()->check(CLI::ExistingFile);
-    c->add_option("--in", o->in, "G-code program to correct")->required()->check(CLI::ExistingFile);
+    c->add_option("--in", o->in, "G-code or HEIDENHAIN Klartext program to correct")->required()->check(CLI::ExistingFile);
     c->add_option("--out", o->out, "corrected program to write (never the input)")->required();
-    c->add_option("--dialect", o->dialect, "auto, rs274ngc (linuxcnc), fanuc, sinumerik, printer")->capture_default_str();
+    c->add_option("--dialect", o->dialect, "auto, rs274ngc (linuxcnc), fanuc, sinumerik, printer, heidenhain (Klartext: also detected from BEGIN PGM)")->capture_default_str();
     c->add_option("--tol-um", o->tolUm, "largest tool-tip deviation from the nominal path before a move is split, um")
         ->capture_default_str();
     c->add_option("--decimals", o->decimals, "decimals of changed numbers (default: the program's own, at least 4 in mm and deg, 5 in inch)");
@@ -158,7 +161,7 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--report", o->report, "write every pass-through and warning as CSV line,kind,message");
     c->add_option("--threads", o->threads,
                   "threads: 1 reads, corrects and writes in one; 2 or more read and solve end points on a second "
-                  "(the same output byte for byte); 0 (default): the machine's cores")
+                  "(the same output byte for byte); 0 (default): the machine's cores. HEIDENHAIN Klartext runs on one thread")
         ->capture_default_str();
     c->add_flag("--tip-only", o->tipOnly, "correct the tool tip with the linear axes only; rotary commands stay");
     c->add_flag("--rotary-shortest", o->rotaryShortest,
