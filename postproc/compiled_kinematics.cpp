@@ -254,11 +254,11 @@ void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& 
                 if (op.unit >= 0) {
                     // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
                     const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
-                    for (Vec3* v : {&tip, &axis}) {
-                        const double a = (*v)[i], b = (*v)[j];
-                        (*v)[i] = c * a + sn * b;
-                        (*v)[j] = c * b - sn * a;
-                    }
+                    const double ti = tip[i], tj = tip[j], ai = axis[i], aj = axis[j];
+                    tip[i] = c * ti + sn * tj;
+                    tip[j] = c * tj - sn * ti;
+                    axis[i] = c * ai + sn * aj;
+                    axis[j] = c * aj - sn * ai;
                 } else {
                     // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
                     const Vec3& u = op.dir;
@@ -279,6 +279,48 @@ void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& 
             }
         }
     }
+}
+
+Vec3 CompiledKinematics::toolAxisOnce(const AxisVector& q) const {
+    if (workpiece_.affine.ok) {
+        Vec3 tip, axis;
+        toolPose(q, 0.0, tip, axis);
+        return axis;
+    }
+    Vec3 axis = cached(tool_, toolCache_, q, false).frame.R * machine_->toolDirection;
+    for (const Op& op : workpiece_.ops) {  // as toolPoseOnce, directions only
+        switch (op.kind) {
+            case OpKind::Constant:
+                if (!op.identityR) axis = op.R.transpose() * axis;
+                break;
+            case OpKind::Linear:
+                break;
+            case OpKind::Rotary: {
+                double c, sn;
+                op.trig.at(q[op.axis], c, sn);
+                if (op.unit >= 0) {
+                    const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
+                    const double ai = axis[i], aj = axis[j];
+                    axis[i] = c * ai + sn * aj;
+                    axis[j] = c * aj - sn * ai;
+                } else {
+                    const Vec3& u = op.dir;
+                    axis = c * axis - sn * u.cross(axis) + (1 - c) * u.dot(axis) * u;
+                }
+                break;
+            }
+            case OpKind::Component: {
+                Vec6 e = Vec6::Zero();
+                for (int k : op.components) {
+                    const DeviationDef& def = machine_->deviations[k];
+                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
+                }
+                axis = errorTransform(e).linear().transpose() * axis;
+                break;
+            }
+        }
+    }
+    return axis;
 }
 
 Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) const {

@@ -32,6 +32,8 @@ public:
     /// toolPose without the workpiece chain's cache: its operations inverted and applied to the tool point and
     /// direction (about half the arithmetic of building its frame), for commands met once (Newton steps, checks).
     void toolPoseOnce(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
+    /// The tool axis alone (as toolPoseOnce's, without the tool point's arithmetic).
+    Vec3 toolAxisOnce(const AxisVector& q) const;
     /// A direction given in the workpiece frame, in the base (bed) frame at q: baseToWorkpiece(q).R · v.
     Vec3 workpieceToBase(const AxisVector& q, const Vec3& v) const;
     /// d(tip, axis)/dq (6 × n, workpiece frame, rows as cnccomp::toolPoseJacobian); also the pose at q.

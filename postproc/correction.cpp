@@ -586,8 +586,7 @@ Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
     if (s.mode == ProgramMode::TcpVector) {
         axis = tcp_.axisFromWorld(p.v.normalized());
     } else {
-        Vec3 tip;
-        nominal_.toolPoseOnce(p.p + zero_, 0.0, tip, axis);
+        axis = nominal_.toolAxisOnce(p.p + zero_);
     }
     return point + (s.toolLength - s.controlLength) * axis;
 }

@@ -83,6 +83,7 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
             k.toolPoseOnce(q, L, tipOnce, axisOnce);
             worstTip = std::max(worstTip, (tipOnce - r.tip).norm());
             worstAxis = std::max(worstAxis, (axisOnce - r.axis).norm());
+            worstAxis = std::max(worstAxis, (k.toolAxisOnce(q) - r.axis).norm());
             // A workpiece direction into the bed: the frame's rotation, and back to the tool direction there.
             const Vec3 v(u(rng), u(rng), u(rng));
             worstAxis = std::max(worstAxis, (k.workpieceToBase(q, v) - k.baseToWorkpiece(q).R * v).norm());
