@@ -18,6 +18,29 @@ inline void rotateAboutUnit(Mat3& R, int k, double c, double s) {
 
 }  // namespace
 
+void CompiledKinematics::rotateBack(const Op& op, double c, double s, Vec3& v) {
+    if (op.unit >= 0) {
+        // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
+        const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
+        const double a = v[i], b = v[j];
+        v[i] = c * a + s * b;
+        v[j] = c * b - s * a;
+    } else {
+        // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
+        const Vec3& u = op.dir;
+        v = c * v - s * u.cross(v) + (1 - c) * u.dot(v) * u;
+    }
+}
+
+Pose CompiledKinematics::componentError(const Op& op, const AxisVector& q) const {
+    Vec6 e = Vec6::Zero();
+    for (int k : op.components) {
+        const DeviationDef& def = machine_->deviations[k];
+        e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
+    }
+    return errorTransform(e);
+}
+
 CompiledKinematics::CompiledKinematics(const MachineModel& machine, const DeviationSet* deviations)
     : machine_(&machine),
       values_(deviations ? deviations->values : Eigen::VectorXd::Zero(machine.parameterCount())) {
@@ -180,12 +203,7 @@ void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame&
                 break;
             }
             case OpKind::Component: {
-                Vec6 e = Vec6::Zero();
-                for (int k : op.components) {
-                    const DeviationDef& def = machine_->deviations[k];
-                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
-                }
-                const Pose E = errorTransform(e);
+                const Pose E = componentError(op, q);
                 f.t += f.R * E.translation();
                 f.R = f.R * E.linear();
                 break;
@@ -228,57 +246,47 @@ void CompiledKinematics::toolPose(const AxisVector& q, double length, Vec3& tip,
     axis.noalias() = w.R.transpose() * dirB;
 }
 
+template <bool WithPoint>
+void CompiledKinematics::intoWorkpiece(const AxisVector& q, Vec3& point, Vec3& direction) const {
+    // w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base): op_1⁻¹ first.
+    for (const Op& op : workpiece_.ops) {
+        switch (op.kind) {
+            case OpKind::Constant:
+                if constexpr (WithPoint) point -= op.t;
+                if (!op.identityR) {
+                    if constexpr (WithPoint) point = op.R.transpose() * point;
+                    direction = op.R.transpose() * direction;
+                }
+                break;
+            case OpKind::Linear:
+                if constexpr (WithPoint) point -= op.dir * q[op.axis];
+                break;
+            case OpKind::Rotary: {
+                double c, sn;
+                op.trig.at(q[op.axis], c, sn);
+                if constexpr (WithPoint) rotateBack(op, c, sn, point);
+                rotateBack(op, c, sn, direction);
+                break;
+            }
+            case OpKind::Component: {
+                const Pose E = componentError(op, q);
+                if constexpr (WithPoint) point = E.linear().transpose() * (point - E.translation());
+                direction = E.linear().transpose() * direction;
+                break;
+            }
+        }
+    }
+}
+
 void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
     if (workpiece_.affine.ok) {
         toolPose(q, length, tip, axis);
         return;
     }
     const Frame& t = cached(tool_, toolCache_, q, false).frame;
-    axis = t.R * machine_->toolDirection;  // base frame, then through w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base)
+    axis = t.R * machine_->toolDirection;  // base frame
     tip = t.t + length * axis;
-    for (const Op& op : workpiece_.ops) {
-        switch (op.kind) {
-            case OpKind::Constant:
-                tip -= op.t;
-                if (!op.identityR) {
-                    tip = op.R.transpose() * tip;
-                    axis = op.R.transpose() * axis;
-                }
-                break;
-            case OpKind::Linear:
-                tip -= op.dir * q[op.axis];
-                break;
-            case OpKind::Rotary: {
-                double c, sn;
-                op.trig.at(q[op.axis], c, sn);
-                if (op.unit >= 0) {
-                    // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
-                    const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
-                    const double ti = tip[i], tj = tip[j], ai = axis[i], aj = axis[j];
-                    tip[i] = c * ti + sn * tj;
-                    tip[j] = c * tj - sn * ti;
-                    axis[i] = c * ai + sn * aj;
-                    axis[j] = c * aj - sn * ai;
-                } else {
-                    // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
-                    const Vec3& u = op.dir;
-                    for (Vec3* v : {&tip, &axis}) *v = c * *v - sn * u.cross(*v) + (1 - c) * u.dot(*v) * u;
-                }
-                break;
-            }
-            case OpKind::Component: {
-                Vec6 e = Vec6::Zero();
-                for (int k : op.components) {
-                    const DeviationDef& def = machine_->deviations[k];
-                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
-                }
-                const Pose E = errorTransform(e);
-                tip = E.linear().transpose() * (tip - E.translation());
-                axis = E.linear().transpose() * axis;
-                break;
-            }
-        }
-    }
+    intoWorkpiece<true>(q, tip, axis);
 }
 
 Vec3 CompiledKinematics::toolAxisOnce(const AxisVector& q) const {
@@ -288,38 +296,8 @@ Vec3 CompiledKinematics::toolAxisOnce(const AxisVector& q) const {
         return axis;
     }
     Vec3 axis = cached(tool_, toolCache_, q, false).frame.R * machine_->toolDirection;
-    for (const Op& op : workpiece_.ops) {  // as toolPoseOnce, directions only
-        switch (op.kind) {
-            case OpKind::Constant:
-                if (!op.identityR) axis = op.R.transpose() * axis;
-                break;
-            case OpKind::Linear:
-                break;
-            case OpKind::Rotary: {
-                double c, sn;
-                op.trig.at(q[op.axis], c, sn);
-                if (op.unit >= 0) {
-                    const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
-                    const double ai = axis[i], aj = axis[j];
-                    axis[i] = c * ai + sn * aj;
-                    axis[j] = c * aj - sn * ai;
-                } else {
-                    const Vec3& u = op.dir;
-                    axis = c * axis - sn * u.cross(axis) + (1 - c) * u.dot(axis) * u;
-                }
-                break;
-            }
-            case OpKind::Component: {
-                Vec6 e = Vec6::Zero();
-                for (int k : op.components) {
-                    const DeviationDef& def = machine_->deviations[k];
-                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
-                }
-                axis = errorTransform(e).linear().transpose() * axis;
-                break;
-            }
-        }
-    }
+    Vec3 unused;
+    intoWorkpiece<false>(q, unused, axis);
     return axis;
 }
 
@@ -348,15 +326,9 @@ Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) con
                 }
                 break;
             }
-            case OpKind::Component: {
-                Vec6 e = Vec6::Zero();
-                for (int k : op.components) {
-                    const DeviationDef& def = machine_->deviations[k];
-                    e[def.component] += def.basis.evaluate(q[op.axis], values_.data() + def.offset, op.modulo);
-                }
-                r = errorTransform(e).linear() * r;
+            case OpKind::Component:
+                r = componentError(op, q).linear() * r;
                 break;
-            }
         }
     }
     return r;

@@ -102,6 +102,14 @@ private:
         Affine affine;
     };
     void compile(const Chain& chain, Side side, ChainOps& c);
+    /// v ← Rot(op's direction, θ)ᵀ v, given c = cos θ and s = sin θ.
+    static void rotateBack(const Op& op, double c, double s, Vec3& v);
+    /// A base-frame point (WithPoint) and direction into the workpiece frame at q, the workpiece chain's operations
+    /// inverted one by one (no frame built).
+    template <bool WithPoint>
+    void intoWorkpiece(const AxisVector& q, Vec3& point, Vec3& direction) const;
+    /// The error transform of a Component op at q.
+    Pose componentError(const Op& op, const AxisVector& q) const;
     void evaluate(const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const;
     /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
     const ChainEntry& cached(const ChainOps& c, ChainCache& cache, const AxisVector& q, bool lines) const;

@@ -19,8 +19,6 @@ namespace {
 
 constexpr char kKlartextAxisOrder[] = "XYZUVWABC";
 
-double klartextTenTo(int e) { return std::pow(10.0, e); }
-
 class KlartextCorrector {
 public:
     KlartextCorrector(const MachineModel& m, const DeviationSet& d, const CorrectOptions& o, CorrectSummary& s,
@@ -309,21 +307,14 @@ double KlartextCorrector::toleranceFor(const MoveSpace& space) {
         if (layout_.rotary[a]) rotDecimals = std::min(rotDecimals, decimalsFor(a));
         else linDecimals = std::min(linDecimals, decimalsFor(a));
     }
-    const double linStep = klartextTenTo(-linDecimals) * (interp_.inch() ? 25.4 : 1.0);
-    double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearCount_, 1)));
-    if (space.mode == ProgramMode::Joints && rotaryCount_ > 0) {
-        const double lever = corrector_.nominalTip(b_.end, space.toolLength).norm() + std::fabs(space.toolLength);
-        floor += 0.5 * klartextTenTo(-rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
-    }
+    const double floor = digitsTolerance(corrector_, space, b_.end, linDecimals, rotDecimals, interp_.inch(),
+                                         linearCount_, rotaryCount_);
     if (tol >= floor) return tol;
     ++summary_.clampedTolerance;
     summary_.toleranceFloor = std::max(summary_.toleranceFloor, floor);
     if (!warnedTolerance_) {
         warnedTolerance_ = true;
-        notice(true, line_,
-               fmt::format("--tol-um {:.3g} is below what the written digits can hold here ({:.3g} um with {} decimals): "
-                           "moves are checked against {:.3g} um (--decimals writes more digits)",
-                           tol / kUm, floor / kUm, linDecimals, floor / kUm));
+        notice(true, line_, raisedToleranceNotice(tol, floor, linDecimals));
     }
     return floor;
 }
@@ -334,7 +325,7 @@ size_t KlartextCorrector::number(int a, double pv, char* out, double& readBack, 
     st.fixed = fixed_;
     st.plus = true;  // Klartext's signed style: X+12.5, X-3
     readBack = roundToStyle(pv, st);
-    res = klartextTenTo(-std::clamp(st.decimals, 0, 15));
+    res = tenTo(-std::clamp(st.decimals, 0, 15));
     size_t n = formatNumber(pv, st, out);
     if (n > 0 && out[n - 1] == '.') --n;  // "+12." → "+12"
     return n;

@@ -62,4 +62,9 @@ size_t formatNumber(double value, const NumberStyle& style, char* out) {
     return n;
 }
 
+double tenTo(int e) {
+    static constexpr double kNeg[] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15};
+    return e <= 0 && e >= -15 ? kNeg[-e] : std::pow(10.0, e);
+}
+
 }  // namespace cnccomp::pp

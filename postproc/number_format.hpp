@@ -19,6 +19,9 @@ inline constexpr size_t kMaxNumberChars = 48;
 inline constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+/// 10^e for the decimals of a written number (e in −15 … 0 from a table; beyond: std::pow).
+double tenTo(int e);
+
 /// Writes `value` into `out` (at least kMaxNumberChars bytes) and returns the length. Never writes "-0".
 /// Values too large for the style (|value| · 10^decimals ≥ 9e18) are written with as many digits as needed.
 size_t formatNumber(double value, const NumberStyle& style, char* out);

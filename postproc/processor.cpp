@@ -21,6 +21,24 @@
 
 namespace cnccomp::pp {
 
+double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
+                       int rotDecimals, bool inch, int linearAxes, int rotaryAxes) {
+    const double linStep = tenTo(-linDecimals) * (inch ? 25.4 : 1.0);
+    double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearAxes, 1)));
+    if (space.mode == ProgramMode::Joints && rotaryAxes > 0) {
+        // Lever arm of the rotary axes at this pose: the tip's distance from the workpiece origin plus the tool.
+        const double lever = corrector.nominalTip(end, space.toolLength).norm() + std::fabs(space.toolLength);
+        floor += 0.5 * tenTo(-rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryAxes));
+    }
+    return floor;
+}
+
+std::string raisedToleranceNotice(double tolMm, double floorMm, int linDecimals) {
+    return fmt::format("--tol-um {:.3g} is below what the written digits can hold here ({:.3g} um with {} decimals): "
+                       "moves are checked against {:.3g} um (--decimals writes more digits)",
+                       tolMm / kUm, floorMm / kUm, linDecimals, floorMm / kUm);
+}
+
 void checkTextHead(std::string_view head, const std::string& name) {
     if (head.empty()) throw InputError(name, 0, "the program is empty (no bytes)");
     size_t control = 0;
@@ -59,12 +77,6 @@ const char* warningText(Warning w) {
 }
 
 double circular(double d) { return d - 360.0 * std::round(d / 360.0); }
-
-/// 10^e for the decimals of a written number (e in −15 … 0; beyond: std::pow).
-double tenTo(int e) {
-    static constexpr double kNeg[] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15};
-    return e <= 0 && e >= -15 ? kNeg[-e] : std::pow(10.0, e);
-}
 
 /// How the words of one block are spaced and aligned, so that words added to it (or lines added after it) look like
 /// its own: the white space between words, between a letter and its number, and whether positive numbers take the
@@ -852,22 +864,14 @@ double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
         if (layout_.rotary[a]) rotDecimals = std::min(rotDecimals, dd);
         else linDecimals = std::min(linDecimals, dd);
     }
-    const double linStep = tenTo(-linDecimals) * (r_->inch ? 25.4 : 1.0);
-    double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearCount_, 1)));
-    if (space.mode == ProgramMode::Joints && rotaryCount_ > 0) {
-        // Lever arm of the rotary axes at this pose: the tip's distance from the workpiece origin plus the tool.
-        const double lever = corrector_.nominalTip(r_->end, space.toolLength).norm() + std::fabs(space.toolLength);
-        floor += 0.5 * tenTo(-rotDecimals) * kDeg * lever * std::sqrt(static_cast<double>(rotaryCount_));
-    }
+    const double floor = digitsTolerance(corrector_, space, r_->end, linDecimals, rotDecimals, r_->inch, linearCount_,
+                                         rotaryCount_);
     if (tol >= floor) return tol;
     ++summary_.clampedTolerance;
     summary_.toleranceFloor = std::max(summary_.toleranceFloor, floor);
     if (!warnedTolerance_) {
         warnedTolerance_ = true;
-        notice(true, no,
-               fmt::format("--tol-um {:.3g} is below what the written digits can hold here ({:.3g} um with {} decimals): "
-                           "moves are checked against {:.3g} um (--decimals writes more digits)",
-                           tol / kUm, floor / kUm, linDecimals, floor / kUm));
+        notice(true, no, raisedToleranceNotice(tol, floor, linDecimals));
     }
     return floor;
 }

@@ -85,6 +85,14 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
 /// The summary as text for the terminal (several lines).
 std::string formatSummary(const CorrectSummary& s, size_t maxListed = 20);
 
+/// The finest path tolerance the written digits can hold at a move ending at `end` (program space): each end point is
+/// off by up to half a digit per axis — √(linear axes) half-digits of `linDecimals` (mm, or inch digits), and in joint
+/// mode √(rotary axes) half-digits of `rotDecimals` (degrees) times the rotary axes' lever arm at the pose.
+double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
+                       int rotDecimals, bool inch, int linearAxes, int rotaryAxes);
+/// The notice when --tol-um (tolMm) is raised to that bound.
+std::string raisedToleranceNotice(double tolMm, double floorMm, int linDecimals);
+
 /// Refuses files that are empty or binary (NUL bytes, mostly control bytes) in their first bytes.
 void checkTextHead(std::string_view head, const std::string& name);
 
