@@ -112,14 +112,7 @@ private:
 };
 
 void KlartextCorrector::notice(bool warning, uint64_t line, std::string message) {
-    auto& list = warning ? summary_.warnings : summary_.passThrough;
-    if (warning) ++summary_.warningCount;
-    if (options_.report) {
-        std::string m = message;
-        std::replace(m.begin(), m.end(), ',', ';');
-        *options_.report << line << ',' << (warning ? "warning" : "pass-through") << ',' << m << '\n';
-    }
-    if (list.size() < CorrectSummary::kMaxNotices) list.push_back({line, std::move(message)});
+    addNotice(summary_, options_.report, warning, line, std::move(message));
 }
 
 void KlartextCorrector::run(LineReader& reader) {

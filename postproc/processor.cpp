@@ -21,6 +21,18 @@
 
 namespace cnccomp::pp {
 
+void addNotice(CorrectSummary& summary, std::ostream* report, bool warning, uint64_t line, std::string message) {
+    auto& list = warning ? summary.warnings : summary.passThrough;
+    if (warning) ++summary.warningCount;
+    if (report) {
+        // Plain CSV without quoting (as every CSV of the project): commas in messages become semicolons.
+        std::string m = message;
+        std::replace(m.begin(), m.end(), ',', ';');
+        *report << line << ',' << (warning ? "warning" : "pass-through") << ',' << m << '\n';
+    }
+    if (list.size() < CorrectSummary::kMaxNotices) list.push_back({line, std::move(message)});
+}
+
 double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
                        int rotDecimals, bool inch, int linearAxes, int rotaryAxes) {
     const double linStep = tenTo(-linDecimals) * (inch ? 25.4 : 1.0);
@@ -460,15 +472,7 @@ private:
 };
 
 void ProgramCorrector::notice(bool warning, uint64_t line, std::string message) {
-    auto& list = warning ? summary_.warnings : summary_.passThrough;
-    if (warning) ++summary_.warningCount;
-    if (options_.report) {
-        // Plain CSV without quoting (as every CSV of the project): commas in messages become semicolons.
-        std::string m = message;
-        std::replace(m.begin(), m.end(), ',', ';');
-        *options_.report << line << ',' << (warning ? "warning" : "pass-through") << ',' << m << '\n';
-    }
-    if (list.size() < CorrectSummary::kMaxNotices) list.push_back({line, std::move(message)});
+    addNotice(summary_, options_.report, warning, line, std::move(message));
 }
 
 void ProgramCorrector::updateStyles(const LexedBlock& b, std::string_view text) {

@@ -1,9 +1,10 @@
 // `cnccomp correct` on HEIDENHAIN Klartext programs (postproc/klartext_correct.*), checked with models written here,
 // independently of the corrector:
 //  - the controller's nominal TCP kinematics (M128 / FUNCTION TCPM on the xyzac table of LinuxCNC's trt sim, the
-//    machine of test_postproc_xyzac.hpp): trtfuncs.c's xyzac inverse and forward transcribed again (rot-points 0,
+//    machine of test_postproc_xyzac.hpp): trtfuncs.c's xyzac inverse and forward as transcribed there (rot-points 0,
 //    y-offset 20, z-offset 10; the programmed point is the tool tip at the called tool's length);
-//  - the erroneous machine: its links composed by hand from README's definition (placement · E_location · motion);
+//  - the erroneous machine: its links composed by hand from README's definition (placement · E_location · motion),
+//    also in test_postproc_xyzac.hpp (shared with test_postproc_tcp.cpp);
 //  - the programs: read with a small Klartext scanner of this file (L blocks, absolute words, M128/M129, FUNCTION TCPM,
 //    FUNCTION RESET TCPM, TOOL CALL with the tool's length), which carries the position across a mode switch itself.
 // Outside TCP mode the controller interpolates the joints, in TCP mode the tool tip on a straight line in the workpiece
@@ -33,48 +34,26 @@
 namespace cnccomp::pp {
 namespace {
 
-constexpr double kKtYOffset = 20.0, kKtZOffset = 10.0;  // xyzac-trt.ini
+namespace xyzac = cnccomp::test::xyzac;
+
 constexpr double kKtTool = 30.0;                         // TOOL CALL 1 Z: tool 1 is 30 mm long
 
-const char* kKtDeviations =
-    "name,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\nEC0A,,-6,arcsec\n"
-    "EX0C,,15,um\nEY0C,,-9,um\nEA0C,,7,arcsec\nEB0C,,-5,arcsec\nEC0Y,,4,arcsec\n";
-
-struct KtErrors {
-    double ay = 8, az = -12, aa = 12, ab = 10, ac = -6;  // A: EY0A EZ0A EA0A EB0A EC0A (um, arcsec)
-    double cx = 15, cy = -9, ca = 7, cb = -5;            // C: EX0C EY0C EA0C EB0C
-    double yc = 4;                                       // Y: EC0Y
-};
+const char* kKtDeviations = cnccomp::test::xyzac::kDeviationCsv;
 
 /// x y z (mm) a c (deg): joints, or in TCP mode the programmed tip and the angles.
 struct Pose5 {
     double x = 0, y = 0, z = 0, a = 0, c = 0;
 };
 
-// --- trtfuncs.c, xyzac (conventional-directions 0, rot-points 0, dz = z-offset + tool-offset) -------------------------
+// --- The controller's TCP kinematics and the erroneous machine: test_postproc_xyzac.hpp (trtfuncs.c transcribed, the
+// links composed by hand), on this file's Pose5.
 Pose5 ktTrtInverse(const Pose5& p, double tool) {
-    const double k = -1.0, dy = kKtYOffset, dz = kKtZOffset + tool, a = p.a * kDeg, c = p.c * kDeg;
-    Pose5 j;
-    j.x = std::cos(c) * p.x + k * std::sin(c) * p.y;
-    j.y = -k * std::sin(c) * std::cos(a) * p.x + std::cos(c) * std::cos(a) * p.y + k * std::sin(a) * p.z - std::cos(a) * dy -
-          k * std::sin(a) * dz + dy;
-    j.z = std::sin(c) * std::sin(a) * p.x - k * std::cos(c) * std::sin(a) * p.y + std::cos(a) * p.z + k * std::sin(a) * dy -
-          std::cos(a) * dz + dz;
-    j.a = p.a;
-    j.c = p.c;
-    return j;
+    const xyzac::Joints j = xyzac::trtInverse({p.x, p.y, p.z, p.a, p.c}, tool);
+    return {j.x, j.y, j.z, j.a, j.c};
 }
 Pose5 ktTrtForward(const Pose5& j, double tool) {
-    const double k = -1.0, dy = kKtYOffset, dz = kKtZOffset + tool, a = j.a * kDeg, c = j.c * kDeg;
-    Pose5 p;
-    p.x = std::cos(c) * j.x - k * std::sin(c) * std::cos(a) * (j.y - dy) + std::sin(c) * std::sin(a) * (j.z - dz) -
-          k * std::sin(c) * dy;
-    p.y = k * std::sin(c) * j.x + std::cos(c) * std::cos(a) * (j.y - dy) - k * std::cos(c) * std::sin(a) * (j.z - dz) +
-          std::cos(c) * dy;
-    p.z = k * std::sin(a) * (j.y - dy) + std::cos(a) * (j.z - dz) + dz;
-    p.a = j.a;
-    p.c = j.c;
-    return p;
+    const xyzac::World p = xyzac::trtForward({j.x, j.y, j.z, j.a, j.c}, tool);
+    return {p.x, p.y, p.z, p.a, p.c};
 }
 /// The controller (Klartext TCP): the programmed tip at the tool's length is LinuxCNC's world point minus the length.
 Pose5 ktTcpToJoints(const Pose5& p, double tool) { return ktTrtInverse({p.x, p.y, p.z + tool, p.a, p.c}, tool); }
@@ -84,36 +63,9 @@ Pose5 ktJointsToTcp(const Pose5& j, double tool) {
     return w;
 }
 
-// --- The machine, composed by hand ----------------------------------------------------------------------------------
-struct KtRigid {
-    Mat3 R = Mat3::Identity();
-    Vec3 t = Vec3::Zero();
-    KtRigid operator*(const KtRigid& o) const { return {R * o.R, R * o.t + t}; }
-    Vec3 operator*(const Vec3& p) const { return R * p + t; }
-    KtRigid inverse() const { return {R.transpose(), -(R.transpose() * t)}; }
-};
-KtRigid ktShift(double x, double y, double z) { return {Mat3::Identity(), Vec3(x, y, z)}; }
-KtRigid ktTurn(const Vec3& axis, double rad) { return {Eigen::AngleAxisd(rad, axis).toRotationMatrix(), Vec3::Zero()}; }
-KtRigid ktError(double x, double y, double z, double a, double b, double c) {
-    const Vec3 w = Vec3(a, b, c) * kArcsec;
-    KtRigid e;
-    if (w.norm() > 0) e.R = Eigen::AngleAxisd(w.norm(), w / w.norm()).toRotationMatrix();
-    e.t = Vec3(x, y, z) * kUm;
-    return e;
-}
-struct KtTip {
-    Vec3 tip, axis;  // workpiece (C) frame
-};
-KtTip ktMachineTip(const Pose5& j, double L, const KtErrors* e) {
-    const KtErrors zero{0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const KtErrors& d = e ? *e : zero;
-    const KtRigid bMw = ktShift(0, kKtYOffset, kKtZOffset) * ktError(0, d.ay, d.az, d.aa, d.ab, d.ac) *
-                        ktTurn(Vec3::UnitX(), j.a * kDeg) * ktShift(0, -kKtYOffset, -kKtZOffset) *
-                        ktError(d.cx, d.cy, 0, d.ca, d.cb, 0) * ktTurn(Vec3::UnitZ(), j.c * kDeg);
-    const KtRigid bMt = ktShift(j.x, 0, 0) * ktError(0, 0, 0, 0, 0, d.yc) * ktShift(0, j.y, 0) * ktShift(0, 0, j.z);
-    const KtRigid wMb = bMw.inverse();
-    return {wMb * (bMt * Vec3(0, 0, -L)), wMb.R * (bMt.R * Vec3(0, 0, -1))};
-}
+using KtErrors = xyzac::Errors;
+using KtTip = xyzac::ToolTip;
+KtTip ktMachineTip(const Pose5& j, double L, const KtErrors* e) { return xyzac::machineTip({j.x, j.y, j.z, j.a, j.c}, L, e); }
 
 // --- A Klartext scanner ---------------------------------------------------------------------------------------------
 struct KtMove {

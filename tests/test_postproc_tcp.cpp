@@ -28,89 +28,9 @@
 namespace cnccomp::pp {
 namespace {
 
-constexpr double kYOffset = 20.0, kZOffset = 10.0;  // xyzac-trt.ini: sets :y-offset 20, sets :z-offset 10
+using namespace cnccomp::test::xyzac;  // the independent controller and machine models
 
 const char* kMachineXml = cnccomp::test::kXyzacTrtMachine;
-
-// The deviations (µm, arcsec) as the independent model uses them, and as CSV for the corrector.
-struct Errors {
-    double ay = 8, az = -12, aa = 12, ab = 10, ac = -6;  // A: EY0A EZ0A EA0A EB0A EC0A
-    double cx = 15, cy = -9, ca = 7, cb = -5;            // C: EX0C EY0C EA0C EB0C
-    double yc = 4;                                       // Y: EC0Y
-};
-const char* kDeviationCsv =
-    "name,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\nEC0A,,-6,arcsec\n"
-    "EX0C,,15,um\nEY0C,,-9,um\nEA0C,,7,arcsec\nEB0C,,-5,arcsec\nEC0Y,,4,arcsec\n";
-
-struct World {
-    double x = 0, y = 0, z = 0, a = 0, c = 0;  // mm, deg
-};
-struct Joints {
-    double x = 0, y = 0, z = 0, a = 0, c = 0;
-};
-
-// --- LinuxCNC trtfuncs.c, xyzac, transcribed (x/y/z-rot-point 0; dz = z-offset + tool-offset) ------------------------
-constexpr double kCon = -1.0;  // conventional-directions false
-
-Joints trtInverse(const World& p, double toolOffset) {
-    const double dy = kYOffset, dz = kZOffset + toolOffset, a = p.a * kDeg, c = p.c * kDeg;
-    Joints j;
-    j.x = std::cos(c) * p.x + kCon * std::sin(c) * p.y;
-    j.y = -kCon * std::sin(c) * std::cos(a) * p.x + std::cos(c) * std::cos(a) * p.y + kCon * std::sin(a) * p.z -
-          std::cos(a) * dy - kCon * std::sin(a) * dz + dy;
-    j.z = std::sin(c) * std::sin(a) * p.x - kCon * std::cos(c) * std::sin(a) * p.y + std::cos(a) * p.z +
-          kCon * std::sin(a) * dy - std::cos(a) * dz + dz;
-    j.a = p.a;
-    j.c = p.c;
-    return j;
-}
-
-World trtForward(const Joints& j, double toolOffset) {
-    const double dy = kYOffset, dz = kZOffset + toolOffset, a = j.a * kDeg, c = j.c * kDeg;
-    World p;
-    p.x = std::cos(c) * j.x - kCon * std::sin(c) * std::cos(a) * (j.y - dy) + std::sin(c) * std::sin(a) * (j.z - dz) -
-          kCon * std::sin(c) * dy;
-    p.y = kCon * std::sin(c) * j.x + std::cos(c) * std::cos(a) * (j.y - dy) - kCon * std::cos(c) * std::sin(a) * (j.z - dz) +
-          std::cos(c) * dy;
-    p.z = kCon * std::sin(a) * (j.y - dy) + std::cos(a) * (j.z - dz) + dz;
-    p.a = j.a;
-    p.c = j.c;
-    return p;
-}
-
-// --- The machine, composed by hand --------------------------------------------------------------------------------
-struct Rigid {
-    Mat3 R = Mat3::Identity();
-    Vec3 t = Vec3::Zero();
-    Rigid operator*(const Rigid& o) const { return {R * o.R, R * o.t + t}; }
-    Vec3 operator*(const Vec3& p) const { return R * p + t; }
-    Rigid inverse() const { return {R.transpose(), -(R.transpose() * t)}; }
-};
-Rigid shift(double x, double y, double z) { return {Mat3::Identity(), Vec3(x, y, z)}; }
-Rigid turn(const Vec3& axis, double rad) { return {Eigen::AngleAxisd(rad, axis).toRotationMatrix(), Vec3::Zero()}; }
-/// Location error: translation (µm) then rotation by the rotation vector (arcsec).
-Rigid error(double x, double y, double z, double a, double b, double c) {
-    const Vec3 w = Vec3(a, b, c) * kArcsec;
-    Rigid e;
-    if (w.norm() > 0) e.R = Eigen::AngleAxisd(w.norm(), w / w.norm()).toRotationMatrix();
-    e.t = Vec3(x, y, z) * kUm;
-    return e;
-}
-
-struct ToolTip {
-    Vec3 tip, axis;  // table frame
-};
-
-/// Tool tip (length L below the tool frame origin) and tool axis in the table (C) frame.
-ToolTip machineTip(const Joints& j, double L, const Errors* e) {
-    const Errors zero{0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const Errors& d = e ? *e : zero;
-    const Rigid bMw = shift(0, kYOffset, kZOffset) * error(0, d.ay, d.az, d.aa, d.ab, d.ac) * turn(Vec3::UnitX(), j.a * kDeg) *
-                      shift(0, -kYOffset, -kZOffset) * error(d.cx, d.cy, 0, d.ca, d.cb, 0) * turn(Vec3::UnitZ(), j.c * kDeg);
-    const Rigid bMt = shift(j.x, 0, 0) * error(0, 0, 0, 0, 0, d.yc) * shift(0, j.y, 0) * shift(0, 0, j.z);
-    const Rigid wMb = bMw.inverse();
-    return {wMb * (bMt * Vec3(0, 0, -L)), wMb.R * (bMt.R * Vec3(0, 0, -1))};
-}
 
 // --- A word scanner for the demo programs --------------------------------------------------------------------------
 struct Block {
