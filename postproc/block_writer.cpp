@@ -52,14 +52,17 @@ char* BlockEdits::scratch(size_t need) {
 }
 
 void BlockEdits::apply(std::string_view line, OutputBuffer& out) {
-    std::sort(edits_.begin(), edits_.begin() + count_, [](const Edit& a, const Edit& b) {
+    const auto before = [](const Edit& a, const Edit& b) {
         if (a.begin != b.begin) return a.begin < b.begin;
         // At the same position: a replacement that ends there first? No: replacements start there; insertions
         // (empty spans) go before replacements of the word that starts at the same byte.
         const bool ai = a.begin == a.end, bi = b.begin == b.end;
         if (ai != bi) return ai;
         return a.order < b.order;
-    });
+    };
+    // Usually added in the order of the line already (the words, then what is appended after them).
+    if (!std::is_sorted(edits_.begin(), edits_.begin() + count_, before))
+        std::sort(edits_.begin(), edits_.begin() + count_, before);
     uint32_t pos = 0;
     for (int i = 0; i < count_; ++i) {
         const Edit& e = edits_[i];

@@ -21,7 +21,7 @@ inline void rotateAboutUnit(Mat3& R, int k, double c, double s) {
 void CompiledKinematics::rotateBack(const Op& op, double c, double s, Vec3& v) {
     if (op.unit >= 0) {
         // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
-        const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
+        const int i = op.ui, j = op.uj;
         const double a = v[i], b = v[j];
         v[i] = c * a + s * b;
         v[j] = c * b - s * a;
@@ -120,7 +120,7 @@ void CompiledKinematics::compile(const Chain& chain, Side side, ChainOps& c) {
         op.dir = l.direction;
         op.modulo = l.modulo;
         for (int k = 0; k < 3; ++k)
-            if (l.direction == Vec3::Unit(k)) op.unit = k;
+            if (l.direction == Vec3::Unit(k)) op.unit = k, op.ui = (k + 1) % 3, op.uj = (k + 2) % 3;
         ops.push_back(op);
         if (!components.empty()) {
             Op c;
@@ -316,7 +316,7 @@ Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) con
                 double c, sn;
                 op.trig.at(q[op.axis], c, sn);
                 if (op.unit >= 0) {
-                    const int i = (op.unit + 1) % 3, j = (op.unit + 2) % 3;
+                    const int i = op.ui, j = op.uj;
                     const double a = r[i], b = r[j];
                     r[i] = c * a - sn * b;
                     r[j] = sn * a + c * b;

@@ -321,13 +321,18 @@ void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask fr
         for (int i = 0; i < n; ++i)  // not positive definite (NaN): no step, the solve reports non-convergence
             for (int j = 0; j < n; ++j) cache.Ainv[i][j] = 0.0;
     }
-    for (int i = 0; i < n; ++i)
-        for (int r = 0; r < 6; ++r) {
-            double v = 0;
-            if (free & (1u << i))
-                for (int j = 0; j < n; ++j) v += cache.Ainv[i][j] * cache.J(r, j);
-            cache.gain[i][r] = v;
-        }
+    double Jt[kMaxAxes][6];  // Jᵀ as a plain array
+    for (int j = 0; j < n; ++j)
+        for (int r = 0; r < 6; ++r) Jt[j][r] = cache.J(r, j);
+    for (int i = 0; i < n; ++i) {
+        double v[6] = {0, 0, 0, 0, 0, 0};
+        if (free & (1u << i))
+            for (int j = 0; j < n; ++j) {
+                const double a = cache.Ainv[i][j];
+                for (int r = 0; r < 6; ++r) v[r] += a * Jt[j][r];
+            }
+        for (int r = 0; r < 6; ++r) cache.gain[i][r] = v[r];
+    }
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) cache.D[i][j] = damping.any ? damping.D[i][j] : 0.0;
     cache.damped = damping.any;
@@ -363,9 +368,11 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
     // Not near a singular pose: there the damped solution is not a smooth function of cNom (and the slope of the
     // undamped one is large), the start stays at the neighbour's correction.
     if (!cache.slopeKnown || cache.slopeLength != toolLength || lastDamped_) return;
+    double step[kMaxAxes];
+    for (int j = 0; j < n; ++j) step[j] = cNom[j] - cNomPrev[j];
     for (int i = 0; i < n; ++i) {
         double v = 0;
-        for (int j = 0; j < n; ++j) v += cache.slope[i][j] * (cNom[j] - cNomPrev[j]);
+        for (int j = 0; j < n; ++j) v += cache.slope[i][j] * step[j];
         start[i] += v;
     }
 }
