@@ -29,7 +29,7 @@ struct CorrectorOptions {
                                    ///< (1 − σ/singularSine)²; at or above it (tool axis ≥ 5.7° from every rotary axis
                                    ///< on a 5-axis machine) the solution is exact
     double axisWeight = 100.0;     ///< mm per rad: how much a tool-axis error counts against a tip error
-    double solveTolerance = 1e-7;  ///< mm: Newton stops when its step is below this (rotary: below this / 100 mm in
+    double solveTolerance = 1e-6;  ///< mm: Newton stops when its step is below this (rotary: below this / 100 mm in
                                    ///< rad); the step is applied, the residual left is a small part of it
     int maxIterations = 30;
     int maxDepth = 14;             ///< subdivision levels per move
