@@ -238,6 +238,9 @@ void KlartextInterpreter::begin(const std::vector<std::string>& rest) {
 double KlartextInterpreter::number(std::string_view text, std::string_view what) const {
     if (!text.empty() && (text.front() == 'Q' || ((text.front() == '+' || text.front() == '-') && text.size() > 1 && text[1] == 'Q')))
         unsupported(fmt::format("{}: Q parameters are not evaluated by cnccomp's Klartext reader", what), 1);
+    // Klartext numbers are plain decimals; an exponent ("1e3") is refused, not read as something else.
+    if (text.find_first_of("eE") != std::string_view::npos)
+        fail(fmt::format("{}: '{}' is not a number (exponent notation is not Klartext: write the digits out)", what, text));
     const auto v = parseNumber(text);
     if (!v || !std::isfinite(*v)) fail(fmt::format("{}: '{}' is not a number", what, text));
     return *v;

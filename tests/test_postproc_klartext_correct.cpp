@@ -598,6 +598,7 @@ TEST(PostprocKlartextCorrect, UnsupportedBlocksPassThroughAndMalformedOnesNameTh
         EXPECT_EQ(s.corrected, 2u);
     }
     for (const auto& [block, words] : {std::pair<std::string, std::string>{"3 L X+1e R0\n", "not a number"},
+                                       {"3 L X+1e3 Y+0 R0\n", "exponent notation"},
                                        {"3 L X+5 Y R0 FMAX\n", "unexpected"},
                                        {"3 C X+5 Y+5 DR+\n", "CC first"},
                                        {"3 BEGIN PGM X CM\n", "MM or INCH"}}) {
