@@ -69,14 +69,25 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
     for (int i = 0; i < machine.axisCount(); ++i)
         if (machine.axisLink(i).kind == AxisKind::Rotary) rotary_ |= 1u << i;
     zero_ = machine.fromController(AxisVector::Zero(machine.axisCount()));
+    zeroIsZero_ = (zero_.array() == 0.0).all();
 }
 
 Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) const {
     Vec3 tip, axis;
-    actual_.toolPoseOnce(c + zero_, toolLength, tip, axis);
+    AxisVector scratch;
+    actual_.toolPoseOnce(model(c, scratch), toolLength, tip, axis);
     return tip;
 }
-Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) const { return nominal_.toolTip(c + zero_, toolLength); }
+Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) const {
+    AxisVector scratch;
+    return nominal_.toolTip(model(c, scratch), toolLength);
+}
+
+const AxisVector& Corrector::model(const AxisVector& c, AxisVector& scratch) const {
+    if (zeroIsZero_) return c;
+    scratch = c + zero_;
+    return scratch;
+}
 
 Vec3 Corrector::tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const {
     return nominalTip(cNom, toolLength) - actualTip(c, toolLength);
@@ -464,8 +475,9 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
                                AxisVector& c) const {
     SolveResult res;
     const int n = static_cast<int>(start.size());
-    AxisVector q = start + zero_;
-    const AxisVector ref = reference + zero_;
+    AxisVector q = start, refScratch;
+    if (!zeroIsZero_) q += zero_;
+    const AxisVector& ref = model(reference, refScratch);
     const double w = options_.axisWeight;
     double step[kMaxAxes], g[kMaxAxes], r[6];
     if (!cacheUsable(cache, q, toolLength)) refreshJacobian(k, cache, q, toolLength);
@@ -525,7 +537,8 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
         cache.factored = false;
         cache.slopeKnown = false;
     }
-    c = q - zero_;
+    c = q;
+    if (!zeroIsZero_) c -= zero_;
     return res;
 }
 
@@ -546,7 +559,9 @@ SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const Ax
             if (rotary_ & (1u << i)) s[i] = cNom[i];
     }
     // The kept Jacobian near the start first: it tells whether the pose is well conditioned (no damping at all).
-    if (!cacheUsable(cache_, s + zero_, toolLength)) refreshJacobian(actual_, cache_, s + zero_, toolLength);
+    AxisVector scratch;
+    const AxisVector& sModel = model(s, scratch);
+    if (!cacheUsable(cache_, sModel, toolLength)) refreshJacobian(actual_, cache_, sModel, toolLength);
     Damping damping;
     AxisVector reference;
     dampingFor(cNom, toolLength, free, neighbourDelta, damping, reference);
@@ -593,7 +608,8 @@ Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
     if (s.mode == ProgramMode::TcpVector) {
         axis = tcp_.axisFromWorld(p.v.normalized());
     } else {
-        axis = nominal_.toolAxisOnce(p.p + zero_);
+        AxisVector scratch;
+        axis = nominal_.toolAxisOnce(model(p.p, scratch));
     }
     return point + (s.toolLength - s.controlLength) * axis;
 }

@@ -237,6 +237,9 @@ private:
     TcpModel tcp_;
     CorrectorOptions options_;
     AxisVector zero_;      ///< model commands of the controller's machine zero (machine-zero per axis)
+    bool zeroIsZero_ = true;  ///< zero_ is 0 on every axis: model commands are the machine coordinates
+    /// Model commands of machine coordinates c: c + zero_ (in `scratch`), or c itself when zero_ is 0.
+    const AxisVector& model(const AxisVector& c, AxisVector& scratch) const;
     bool identity_ = false;
     bool affine_ = false;  ///< no component errors: with rotary axes fixed, the error is affine in the linear axes
     AxisMask rotary_ = 0;

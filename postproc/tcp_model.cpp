@@ -8,6 +8,7 @@ TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
     const MachineModel& m = nominal.machine();
     const int n = m.axisCount();
     zero_ = m.fromController(AxisVector::Zero(n));
+    zeroIsZero_ = (zero_.array() == 0.0).all();
     const char names[3] = {'X', 'Y', 'Z'};
     supported_ = true;
     for (int k = 0; k < 3; ++k) {
@@ -49,7 +50,8 @@ TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
 }
 
 void TcpModel::forward(const AxisVector& c, double length, Vec3& point, Vec3& axis) const {
-    const AxisVector q = c + zero_;
+    AxisVector scratch;
+    const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);
     Vec3 pw, aw;
     nominal_.toolPoseOnce(q, length, pw, aw);
     point = R0_ * pw + t0_;
@@ -65,7 +67,8 @@ void TcpModel::toProgram(const AxisVector& c, double length, AxisVector& p) cons
 
 bool TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c, Vec3* tipOut, Vec3* axisOut) const {
     c = p;  // rotary angles as programmed; linear axes start at the world coordinates
-    const AxisVector q = c + zero_;
+    AxisVector scratch;
+    const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);  // (may be c itself: read before c changes below)
     const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
     if (fixedSlides_) {
         Vec3 tip, axis;

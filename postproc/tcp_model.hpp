@@ -45,6 +45,7 @@ public:
 private:
     const CompiledKinematics& nominal_;
     AxisVector zero_;  ///< model commands of the controller's machine zero
+    bool zeroIsZero_ = true;
     Mat3 R0_ = Mat3::Identity();
     Vec3 t0_ = Vec3::Zero();
     int lin_[3] = {-1, -1, -1};
