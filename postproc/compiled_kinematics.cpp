@@ -283,9 +283,17 @@ void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& 
         toolPose(q, length, tip, axis);
         return;
     }
-    const Frame& t = cached(tool_, toolCache_, q, false).frame;
-    axis = t.R * machine_->toolDirection;  // base frame
-    tip = t.t + length * axis;
+    if (tool_.affine.ok) {  // the tool frame directly (no cache entry written)
+        const Affine& a = tool_.affine;
+        tip = a.t0;
+        for (int k = 0; k < a.count; ++k) tip += a.col[k] * q[a.axis[k]];
+        axis = a.R * machine_->toolDirection;  // base frame
+        tip += length * axis;
+    } else {
+        const Frame& t = cached(tool_, toolCache_, q, false).frame;
+        axis = t.R * machine_->toolDirection;
+        tip = t.t + length * axis;
+    }
     intoWorkpiece<true>(q, tip, axis);
 }
 
@@ -295,7 +303,7 @@ Vec3 CompiledKinematics::toolAxisOnce(const AxisVector& q) const {
         toolPose(q, 0.0, tip, axis);
         return axis;
     }
-    Vec3 axis = cached(tool_, toolCache_, q, false).frame.R * machine_->toolDirection;
+    Vec3 axis = (tool_.affine.ok ? tool_.affine.R : cached(tool_, toolCache_, q, false).frame.R) * machine_->toolDirection;
     Vec3 unused;
     intoWorkpiece<false>(q, unused, axis);
     return axis;
