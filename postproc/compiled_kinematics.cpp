@@ -323,15 +323,7 @@ Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) con
             case OpKind::Rotary: {
                 double c, sn;
                 op.trig.at(q[op.axis], c, sn);
-                if (op.unit >= 0) {
-                    const int i = op.ui, j = op.uj;
-                    const double a = r[i], b = r[j];
-                    r[i] = c * a - sn * b;
-                    r[j] = sn * a + c * b;
-                } else {
-                    const Vec3& u = op.dir;
-                    r = c * r + sn * u.cross(r) + (1 - c) * u.dot(r) * u;
-                }
+                rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }
             case OpKind::Component:

@@ -358,7 +358,8 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
     JacobianCache& cache = cache_;
     if (identity_) return;
     const int n = static_cast<int>(cNom.size());
-    if (!cache.slopeValid && cache.factored && cacheUsable(cache, cNom + zero_, toolLength)) {
+    AxisVector scratch;
+    if (!cache.slopeValid && cache.factored && cacheUsable(cache, model(cNom, scratch), toolLength)) {
         PoseJacobian Jn;
         Vec3 tip, axis;
         // The nominal machine where it was aimed: the kept commands less the correction (its Jacobian differs from

@@ -302,14 +302,7 @@ double KlartextCorrector::toleranceFor(const MoveSpace& space) {
     }
     const double floor = digitsTolerance(corrector_, space, b_.end, linDecimals, rotDecimals, interp_.inch(),
                                          linearCount_, rotaryCount_);
-    if (tol >= floor) return tol;
-    ++summary_.clampedTolerance;
-    summary_.toleranceFloor = std::max(summary_.toleranceFloor, floor);
-    if (!warnedTolerance_) {
-        warnedTolerance_ = true;
-        notice(true, line_, raisedToleranceNotice(tol, floor, linDecimals));
-    }
-    return floor;
+    return toleranceWithin(tol, floor, linDecimals, summary_, options_.report, line_, warnedTolerance_);
 }
 
 size_t KlartextCorrector::number(int a, double pv, char* out, double& readBack, double& res) const {

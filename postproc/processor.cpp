@@ -45,10 +45,19 @@ double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const
     return floor;
 }
 
-std::string raisedToleranceNotice(double tolMm, double floorMm, int linDecimals) {
-    return fmt::format("--tol-um {:.3g} is below what the written digits can hold here ({:.3g} um with {} decimals): "
-                       "moves are checked against {:.3g} um (--decimals writes more digits)",
-                       tolMm / kUm, floorMm / kUm, linDecimals, floorMm / kUm);
+double toleranceWithin(double tolMm, double floorMm, int linDecimals, CorrectSummary& summary, std::ostream* report,
+                       uint64_t line, bool& warned) {
+    if (tolMm >= floorMm) return tolMm;
+    ++summary.clampedTolerance;
+    summary.toleranceFloor = std::max(summary.toleranceFloor, floorMm);
+    if (!warned) {
+        warned = true;
+        addNotice(summary, report, true, line,
+                  fmt::format("--tol-um {:.3g} is below what the written digits can hold here ({:.3g} um with {} "
+                              "decimals): moves are checked against {:.3g} um (--decimals writes more digits)",
+                              tolMm / kUm, floorMm / kUm, linDecimals, floorMm / kUm));
+    }
+    return floorMm;
 }
 
 void checkTextHead(std::string_view head, const std::string& name) {
@@ -870,14 +879,7 @@ double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
     }
     const double floor = digitsTolerance(corrector_, space, r_->end, linDecimals, rotDecimals, r_->inch, linearCount_,
                                          rotaryCount_);
-    if (tol >= floor) return tol;
-    ++summary_.clampedTolerance;
-    summary_.toleranceFloor = std::max(summary_.toleranceFloor, floor);
-    if (!warnedTolerance_) {
-        warnedTolerance_ = true;
-        notice(true, no, raisedToleranceNotice(tol, floor, linDecimals));
-    }
-    return floor;
+    return toleranceWithin(tol, floor, linDecimals, summary_, options_.report, no, warnedTolerance_);
 }
 
 void ProgramCorrector::switchMode() {

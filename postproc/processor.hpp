@@ -93,8 +93,10 @@ void addNotice(CorrectSummary& summary, std::ostream* report, bool warning, uint
 /// mode √(rotary axes) half-digits of `rotDecimals` (degrees) times the rotary axes' lever arm at the pose.
 double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
                        int rotDecimals, bool inch, int linearAxes, int rotaryAxes);
-/// The notice when --tol-um (tolMm) is raised to that bound.
-std::string raisedToleranceNotice(double tolMm, double floorMm, int linDecimals);
+/// --tol-um (tolMm), or that bound when the tolerance is finer than the digits hold: then counted in the summary and
+/// said once (a warning at `line`; `warned` remembers it).
+double toleranceWithin(double tolMm, double floorMm, int linDecimals, CorrectSummary& summary, std::ostream* report,
+                       uint64_t line, bool& warned);
 
 /// Refuses files that are empty or binary (NUL bytes, mostly control bytes) in their first bytes.
 void checkTextHead(std::string_view head, const std::string& name);

@@ -208,22 +208,7 @@ struct KtCheck {
 };
 
 double ktDistanceToPath(const KtMove& m, const Vec3& p) {
-    const int n = 48;
-    double best = HUGE_VAL, bestT = 0;
-    auto dist = [&](double t) { return (ktMachineTip(m.at(t), m.tool, nullptr).tip - p).norm(); };
-    for (int k = 0; k <= n; ++k) {
-        const double t = double(k) / n, d = dist(t);
-        if (d < best) best = d, bestT = t;
-    }
-    double lo = std::max(0.0, bestT - 1.0 / n), hi = std::min(1.0, bestT + 1.0 / n);
-    for (int it = 0; it < 50; ++it) {
-        const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
-        const double d1 = dist(m1), d2 = dist(m2);
-        if (d1 < d2) hi = m2;
-        else lo = m1;
-        best = std::min({best, d1, d2});
-    }
-    return best;
+    return xyzac::distanceToPath([&](double t) { return ktMachineTip(m.at(t), m.tool, nullptr).tip; }, p);
 }
 
 /// The corrected program on the erroneous machine against the original on the nominal one.

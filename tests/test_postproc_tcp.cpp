@@ -120,27 +120,9 @@ struct TcpCheck {
     size_t inputMoves = 0, outputMoves = 0;
 };
 
-/// Distance from p to the nominal tool-tip path of one input move (dense samples, then a local refinement); the
-/// parameter of the closest point in `at`.
+/// Distance from p to the nominal tool-tip path of one input move; the parameter of the closest point in `at`.
 double distanceToNominal(const World& from, const Block& b, double L, const Vec3& p, double* at = nullptr) {
-    const int n = 48;
-    double best = HUGE_VAL, bestT = 0;
-    auto dist = [&](double t) { return (machineTip(trtInverse(along(from, b, t), 0), L, nullptr).tip - p).norm(); };
-    for (int k = 0; k <= n; ++k) {
-        const double t = double(k) / n, d = dist(t);
-        if (d < best) best = d, bestT = t;
-    }
-    double lo = std::max(0.0, bestT - 1.0 / n), hi = std::min(1.0, bestT + 1.0 / n);
-    for (int it = 0; it < 40; ++it) {
-        const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
-        const double d1 = dist(m1), d2 = dist(m2);
-        if (d1 < d2) hi = m2;
-        else lo = m1;
-        if (d1 < best) best = d1, bestT = m1;
-        if (d2 < best) best = d2, bestT = m2;
-    }
-    if (at) *at = bestT;
-    return best;
+    return distanceToPath([&](double t) { return machineTip(trtInverse(along(from, b, t), 0), L, nullptr).tip; }, p, at);
 }
 
 TcpCheck checkTcp(const std::string& original, const std::string& corrected, double L, const Errors& e,

@@ -2,6 +2,7 @@
 // The machine of LinuxCNC's switchable xyzac-trt sim (configs/sim/axis/vismach/5axis/table-rotary-tilting/xyzac-trt.ini:
 // y-offset 20, z-offset 10, rot-points 0, conventional-directions 0), with the location errors the TCP tests and the
 // benchmark use: A tilts the table about X through y = 20, z = 10; C turns on it through the machine origin.
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -121,6 +122,30 @@ inline ToolTip machineTip(const Joints& j, double L, const Errors* e) {
     const Rigid bMt = shift(j.x, 0, 0) * error(0, 0, 0, 0, 0, d.yc) * shift(0, j.y, 0) * shift(0, 0, j.z);
     const Rigid wMb = bMw.inverse();
     return {wMb * (bMt * Vec3(0, 0, -L)), wMb.R * (bMt.R * Vec3(0, 0, -1))};
+}
+
+/// Distance from p to a path given by its point at each parameter t ∈ [0, 1]: dense samples, then a ternary
+/// refinement around the closest; the parameter of the closest point in `at`.
+template <class PointAt>
+double distanceToPath(const PointAt& pointAt, const Vec3& p, double* at = nullptr) {
+    const int n = 48;
+    double best = HUGE_VAL, bestT = 0;
+    auto dist = [&](double t) { return (pointAt(t) - p).norm(); };
+    for (int k = 0; k <= n; ++k) {
+        const double t = double(k) / n, d = dist(t);
+        if (d < best) best = d, bestT = t;
+    }
+    double lo = std::max(0.0, bestT - 1.0 / n), hi = std::min(1.0, bestT + 1.0 / n);
+    for (int it = 0; it < 50; ++it) {
+        const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+        const double d1 = dist(m1), d2 = dist(m2);
+        if (d1 < d2) hi = m2;
+        else lo = m1;
+        if (d1 < best) best = d1, bestT = m1;
+        if (d2 < best) best = d2, bestT = m2;
+    }
+    if (at) *at = bestT;
+    return best;
 }
 
 }  // namespace xyzac
