@@ -11,11 +11,19 @@
 
 namespace cnccomp::controllers {
 
+struct FitWorkspace;  // controllers/common/fit.hpp
+
 struct EmitRequest {
     const MachineModel& machine;
     const DeviationSet& deviations;
     std::string deviationSource;  ///< file name of the deviation set, for the header comment
     std::string date;             ///< ISO date for the header comment
+    /// The workspace over which the values written were fitted to this controller (controllers/common/fit.hpp), or
+    /// null. A backend with several routes (e.g. LinuxCNC: generated kinematics, or pins and tables) fits the routes
+    /// that cannot hold every deviation over it itself.
+    const FitWorkspace* fitWorkspace = nullptr;
+    /// Lines every file's header carries besides the coverage lists (what was fitted over which workspace, …).
+    std::vector<std::string> headerNotes{};
 };
 
 struct OutputFile {
