@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 #include <fmt/format.h>
@@ -126,6 +127,7 @@ static double ck_basis(const ck_cmp_t *c, double q, int modulo) {
             s += ck_dev(c->dev + 2 * k - 2) * cos(k * q) + ck_dev(c->dev + 2 * k - 1) * sin(k * q);
         return s;
     }
+#if CK_NNODES > 0
     {
         const double *x = ck_nodes + c->node0;
         const int n = c->order;
@@ -146,6 +148,10 @@ static double ck_basis(const ck_cmp_t *c, double q, int modulo) {
         for (i = 0; i + 1 < n && x[i + 1] <= q; ++i) {}
         return ck_dev(c->dev + i) + (ck_dev(c->dev + i + 1) - ck_dev(c->dev + i)) * (q - x[i]) / (x[i + 1] - x[i]);
     }
+#else
+    (void)modulo;
+    return 0.0; /* no table-type component error on this machine */
+#endif
 }
 
 /* placement · E_location of every link, rebuilt when a location pin changed. */
@@ -718,12 +724,12 @@ std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, co
     s += "author \"cnccomp (generated)\";\n";
     s += ";;\n\n";
     s += "#include \"rtapi_math.h\"\n#include \"kinematics.h\"\n\n";
-    s += fmt::format("/* Machine '{}' from {}. Generated: do not edit, run cnccomp emit again. */\n", m.name,
-                     m.sourceFile.empty() ? "(no file)" : m.sourceFile);
+    s += fmt::format("/* Machine '{}' ({}). Generated: do not edit, run cnccomp emit again. */\n", m.name,
+                     m.sourceFile.empty() ? "no file" : std::filesystem::path(m.sourceFile).filename().string());
     s += fmt::format("#define CK_PREFIX \"{}\"\n", o.name);
     s += fmt::format("#define CK_NAX {}\n#define CK_NW {}\n#define CK_NLINKS {}\n", n, nW, nLinks);
     s += fmt::format("#define CK_NDEV_PINS {}\n#define CK_NDEV {}\n", nDev, std::max(nDev, 1));
-    s += fmt::format("#define CK_NLOC {}\n", nLoc);
+    s += fmt::format("#define CK_NLOC {}\n#define CK_NNODES {}\n", nLoc, nNodes);
     s += fmt::format("#define CK_MAX_ITERATIONS {}\n#define CK_TOLERANCE {}\n", o.maxIterations, num(o.tolerance));
     s += fmt::format("#define CK_AXIS_WEIGHT {}\n#define CK_REG {}\n", num(o.axisWeight),
                      num(o.rotaryRegularization));
@@ -749,8 +755,7 @@ std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, co
          (nLoc ? locs : "    {0, 0},\n") + "};\n";
     s += "static const ck_cmp_t ck_cmp[" + std::to_string(std::max(nCmp, 1)) + "] = {\n" +
          (nCmp ? cmps : "    {0, 0, 0, 0, 0},\n") + "};\n";
-    s += "static const double ck_nodes[" + std::to_string(std::max(nNodes, 1)) + "] = {" + (nNodes ? nodes : "0") +
-         "};\n";
+    if (nNodes > 0) s += "static const double ck_nodes[" + std::to_string(nNodes) + "] = {" + nodes + "};\n";
     s += "/* deviation values identified (link values, mm and rad) = the dev pins' initial values */\n";
     s += "static const double ck_dev_init[CK_NDEV] = {\n";
     for (int i = 0; i < nDev; ++i) s += "    " + num(d.values[i]) + ", /* " + pinNames[i] + " */\n";

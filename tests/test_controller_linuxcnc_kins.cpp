@@ -1,0 +1,404 @@
+// The generated LinuxCNC kinematics component (controllers/linuxcnc/kins_component.hpp), checked as C: the C part of
+// the generated .comp is compiled here with the system gcc against a small shim standing in for LinuxCNC's
+// rtapi_math.h / hal.h / kinematics.h (tests/data/linuxcnc_kins_shim/), loaded with dlopen, and its
+// kinematicsInverse / kinematicsForward are run on random poses of every sample machine in both modes.
+// Oracles: cnccomp's exact forward model (Kinematics) — the erroneous machine at the component's joints must put the
+// tool tip where the nominal machine (joint mode) or the TCP world words (tool-tip mode, world frame of
+// postproc/tcp_model.hpp, an independent implementation of that convention) put it — and cnccomp's inverse
+// (solveToolPose, same objective) for the joints; round trips forward∘inverse. halcompile itself (LinuxCNC 2.9,
+// Debian package linuxcnc-uspace-dev) compiles every generated file (--compile, nothing installed).
+#include <dlfcn.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "controllers/linuxcnc/kins_component.hpp"
+#include "postproc/compiled_kinematics.hpp"
+#include "postproc/tcp_model.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp {
+namespace {
+
+using controllers::linuxcnc::kinematicsComponent;
+using controllers::linuxcnc::KinsComponentOptions;
+
+/// EmcPose as LinuxCNC 2.9's emcpos.h lays it out (the shim's copy).
+struct CPose {
+    double x, y, z, a, b, c, u, v, w;
+};
+
+/// The compiled component, loaded.
+class LoadedKins {
+public:
+    using Inverse = int (*)(const CPose*, double*, const unsigned long*, unsigned long*);
+    using Forward = int (*)(const double*, CPose*, const unsigned long*, unsigned long*);
+    LoadedKins(const std::string& so) {
+        handle_ = dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (!handle_) throw std::runtime_error(dlerror());
+        inverse = reinterpret_cast<Inverse>(dlsym(handle_, "kinematicsInverse"));
+        forward = reinterpret_cast<Forward>(dlsym(handle_, "kinematicsForward"));
+        type = reinterpret_cast<int (*)()>(dlsym(handle_, "kinematicsType"));
+        kinsSwitch = reinterpret_cast<int (*)(int)>(dlsym(handle_, "kinematicsSwitch"));
+        pin = reinterpret_cast<void* (*)(const char*)>(dlsym(handle_, "shim_pin"));
+        if (!inverse || !forward || !type || !kinsSwitch || !pin) throw std::runtime_error("symbol missing");
+        if (type() != 4) throw std::runtime_error("kinematicsType is not KINEMATICS_BOTH");  // also makes the pins
+    }
+    ~LoadedKins() {
+        if (handle_) dlclose(handle_);
+    }
+    LoadedKins(const LoadedKins&) = delete;
+    LoadedKins& operator=(const LoadedKins&) = delete;
+    double& floatPin(const std::string& name) {
+        void* p = pin(name.c_str());
+        if (!p) throw std::runtime_error("no pin " + name);
+        return *static_cast<double*>(p);
+    }
+    bool bitPin(const std::string& name) {
+        void* p = pin(name.c_str());
+        if (!p) throw std::runtime_error("no pin " + name);
+        return *static_cast<bool*>(p);
+    }
+    Inverse inverse = nullptr;
+    Forward forward = nullptr;
+    int (*type)() = nullptr;
+    int (*kinsSwitch)(int) = nullptr;
+    void* (*pin)(const char*) = nullptr;
+
+private:
+    void* handle_ = nullptr;
+};
+
+std::string shimDir() { return test::sourcePath("tests/data/linuxcnc_kins_shim"); }
+
+/// The C part of a .comp (after the line ";;").
+std::string cPart(const std::string& comp) {
+    const auto p = comp.find("\n;;\n");
+    if (p == std::string::npos) throw std::runtime_error("no ;; line");
+    return comp.substr(p + 4);
+}
+
+/// The code-generation flags LinuxCNC 2.9 builds realtime modules with (/usr/share/linuxcnc/Makefile.modinc, uspace:
+/// RTFLAGS and EXTRA_CFLAGS): no fast math, and sin/cos not merged into sincos, which the realtime math lacks.
+const std::string kRtFlags =
+    "-Os -fno-fast-math -fno-unsafe-math-optimizations -fno-builtin-sin -fno-builtin-cos -fno-builtin-sincos "
+    "-Wframe-larger-than=2560";
+
+/// Compiles the generated C (and the shim) into a shared object in `dir`; returns its path.
+std::string compileComponent(const test::ScratchDir& dir, const std::string& comp) {
+    const std::string& opt = kRtFlags;
+    test::writeText(dir.file("kins.c"), cPart(comp));
+    const std::string so = dir.file("kins.so");
+    const auto r = test::runCommand("gcc -std=gnu99 " + opt + " -fPIC -shared -Wall -Wextra -Werror -I" + shimDir() +
+                                    " -o " + so + " " + dir.file("kins.c") + " " + shimDir() + "/shim.c -lm 2>&1");
+    if (r.exitCode != 0) throw std::runtime_error("gcc failed:\n" + r.out);
+    return so;
+}
+
+struct Sample {
+    const char* machine;
+    const char* deviations;
+};
+// Every sample machine with its deviation (truth) file; component errors of every basis among them.
+const Sample kSamples[] = {
+    {"multitasking", "multitasking-truth"},
+    {"table-table-ac", "table-table-ac-truth"},
+    {"controllers-table-table-ac", "controllers-table-table-ac"},
+    {"table-table-bc-offsets", "table-table-bc-offsets-truth"},
+    {"table-table-bc", "dbb5-table-table-bc-truth"},
+    {"tilting-head-b", "tilting-head-b-truth"},
+    {"controllers-tilting-head-b", "controllers-tilting-head-b"},
+    {"controllers-siemens-components", "controllers-siemens-components"},
+    {"controllers-heidenhain-components", "controllers-heidenhain-components"},
+    {"controllers-fanuc-pitch", "controllers-fanuc-pitch"},
+};
+
+DeviationSet sampleDeviations(const MachineModel& m, const std::string& stem) {
+    return readDeviationCsv(test::sourcePath("samples/deviations/" + stem + ".csv"), m);
+}
+
+double unitOf(const MachineModel& m, int i) { return m.axisLink(i).kind == AxisKind::Rotary ? kDeg : 1.0; }
+
+/// Controller units (mm, deg from machine zero) of model commands q.
+std::vector<double> toJoints(const MachineModel& m, const AxisVector& q) {
+    const AxisVector c = m.toController(q);
+    std::vector<double> j(m.axisCount());
+    for (int i = 0; i < m.axisCount(); ++i) j[i] = c[i] / unitOf(m, i);
+    return j;
+}
+AxisVector fromJoints(const MachineModel& m, const double* j) {
+    AxisVector c(m.axisCount());
+    for (int i = 0; i < m.axisCount(); ++i) c[i] = j[i] * unitOf(m, i);
+    return m.fromController(c);
+}
+
+double& slot(CPose& p, const std::string& axis) {
+    switch (axis[0]) {
+        case 'X': return p.x;
+        case 'Y': return p.y;
+        case 'Z': return p.z;
+        case 'A': return p.a;
+        case 'B': return p.b;
+        case 'C': return p.c;
+        case 'U': return p.u;
+        case 'V': return p.v;
+        default: return p.w;
+    }
+}
+
+/// Random model commands inside the travel (rotary axes within ±400° at most, away from the travel ends).
+AxisVector randomCommands(const MachineModel& m, std::mt19937& rng) {
+    AxisVector q(m.axisCount());
+    for (int i = 0; i < m.axisCount(); ++i) {
+        const Link& l = m.axisLink(i);
+        double lo = l.min, hi = l.max;
+        if (l.kind == AxisKind::Rotary) {
+            lo = std::max(lo, -400 * kDeg);
+            hi = std::min(hi, 400 * kDeg);
+        }
+        const double margin = 0.02 * (hi - lo);
+        q[i] = std::uniform_real_distribution<double>(lo + margin, hi - margin)(rng);
+    }
+    return q;
+}
+
+IkOptions referenceOptions(const KinsComponentOptions& o) {
+    IkOptions ik;
+    ik.tolerance = 1e-12;
+    ik.maxIterations = 40;
+    ik.axisWeight = o.axisWeight;
+    ik.rotaryRegularization = o.rotaryRegularization;
+    return ik;
+}
+
+struct Figures {
+    double jointDiff = 0, tipErr = 0, roundTrip = 0;
+};
+
+void checkMachine(const Sample& s, int poses, Figures& fig) {
+    SCOPED_TRACE(s.machine);
+    const MachineModel& m = test::sampleMachine(s.machine);
+    const DeviationSet d = sampleDeviations(m, s.deviations);
+    const KinsComponentOptions o;
+    const std::string comp = kinematicsComponent(m, d, o);
+    test::ScratchDir dir(std::string("kins-") + s.machine);
+    LoadedKins k(compileComponent(dir, comp));
+    const Kinematics nominal(m), real(m, d);
+    const pp::CompiledKinematics compiledNominal(m, nullptr);
+    const pp::TcpModel tcp(compiledNominal);
+    const int n = m.axisCount();
+    std::mt19937 rng(20261126);
+    const IkOptions ik = referenceOptions(o);
+    for (int mode : {0, 1}) {
+        ASSERT_EQ(k.kinsSwitch(mode), 0);
+        EXPECT_EQ(k.bitPin("kinstype.is-1"), mode == 1);
+        for (int pose = 0; pose < poses; ++pose) {
+            SCOPED_TRACE(testing::Message() << "mode " << mode << " pose " << pose);
+            const AxisVector q = randomCommands(m, rng);
+            const double L = std::uniform_real_distribution<double>(0, 150)(rng);
+            k.floatPin("cnccomp_kins.tool-offset") = L;
+            const Vec3 tipInTool = nominal.toolPoint(L);
+            const std::vector<double> c = toJoints(m, q);
+            CPose world{};
+            ToolPose target;
+            if (mode == 0) {
+                // Joint mode: the words are the nominal commands.
+                for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = c[i];
+                target = toolPose(nominal, q, tipInTool);
+            } else {
+                // Tool-tip mode: the TCP words of these nominal joints (postproc's TcpModel: world X Y Z of the tip
+                // at length L, rotary words = the angles).
+                AxisVector cc(n), p;
+                for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
+                tcp.toProgram(cc, L, p);
+                for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
+                target = toolPose(nominal, q, tipInTool);  // the nominal machine at those joints
+            }
+            std::vector<double> joints = c;  // LinuxCNC passes the current joints: here the nominal ones
+            ASSERT_EQ(k.inverse(&world, joints.data(), nullptr, nullptr), 0);
+            EXPECT_FALSE(k.bitPin("cnccomp_kins.fail"));
+            const AxisVector qj = fromJoints(m, joints.data());
+            // The erroneous machine at the component's joints puts the tip where the nominal one is (1 nm).
+            const ToolPose got = toolPose(real, qj, tipInTool);
+            const double tipErr = (got.tip - target.tip).norm();
+            EXPECT_LE(tipErr, 1e-6);
+            fig.tipErr = std::max(fig.tipErr, tipErr);
+            // cnccomp's inverse on the same objective gives the same joints (1e-9 mm / deg).
+            const IkResult ref = solveToolPose(real, target, tipInTool, q, ik);
+            const std::vector<double> refJ = toJoints(m, ref.q);
+            for (int i = 0; i < n; ++i) {
+                EXPECT_NEAR(joints[i], refJ[i], 1e-9) << m.axisNames[i];
+                fig.jointDiff = std::max(fig.jointDiff, std::abs(joints[i] - refJ[i]));
+            }
+            // forward∘inverse = identity.
+            CPose back{};
+            ASSERT_EQ(k.forward(joints.data(), &back, nullptr, nullptr), 0);
+            EXPECT_FALSE(k.bitPin("cnccomp_kins.fail"));
+            for (int i = 0; i < n; ++i) {
+                const double diff = std::abs(slot(back, m.axisNames[i]) - slot(world, m.axisNames[i]));
+                EXPECT_LE(diff, 1e-9) << m.axisNames[i];
+                fig.roundTrip = std::max(fig.roundTrip, diff);
+            }
+            // inverse∘forward from other joints near these (the forward is the inverse's inverse).
+            std::vector<double> j2 = joints;
+            for (int i = 0; i < n; ++i) j2[i] += std::uniform_real_distribution<double>(-0.5, 0.5)(rng);
+            CPose w2{};
+            ASSERT_EQ(k.forward(j2.data(), &w2, nullptr, nullptr), 0);
+            std::vector<double> j3 = joints;
+            ASSERT_EQ(k.inverse(&w2, j3.data(), nullptr, nullptr), 0);
+            for (int i = 0; i < n; ++i) EXPECT_NEAR(j3[i], j2[i], 1e-9) << m.axisNames[i];
+        }
+    }
+}
+
+TEST(LinuxcncKinsComponent, JointAndToolTipModesMatchTheExactModelOnEverySample) {
+    for (const Sample& s : kSamples) {
+        Figures fig;
+        checkMachine(s, 20, fig);
+        std::printf("%-36s joints vs cnccomp %.2e mm|deg, tip %.2e mm, forward(inverse) %.2e\n", s.machine,
+                    fig.jointDiff, fig.tipErr, fig.roundTrip);
+    }
+}
+
+
+// The HAL pins carry the model: with every deviation pin at 0 the component is the nominal machine, whose joint-mode
+// inverse is the identity; a NaN word keeps the joints and sets `fail`; symbols the C needs are math and HAL only.
+TEST(LinuxcncKinsComponent, PinsCarryTheDeviationsAndFailureKeepsTheJoints) {
+    const MachineModel& m = test::sampleMachine("table-table-bc-offsets");
+    const DeviationSet d = sampleDeviations(m, "table-table-bc-offsets-truth");
+    const std::string comp = kinematicsComponent(m, d, {});
+    test::ScratchDir dir("kins-pins");
+    LoadedKins k(compileComponent(dir, comp));
+    const int n = m.axisCount();
+    std::mt19937 rng(7);
+    const AxisVector q = randomCommands(m, rng);
+    const std::vector<double> c = toJoints(m, q);
+    CPose world{};
+    for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = c[i];
+    std::vector<double> j = c;
+    ASSERT_EQ(k.inverse(&world, j.data(), nullptr, nullptr), 0);
+    double moved = 0;
+    for (int i = 0; i < n; ++i) moved = std::max(moved, std::abs(j[i] - c[i]));
+    EXPECT_GT(moved, 1e-3);  // the identified deviations move the joints
+    // Each pin holds its deviation's link value (mm, rad).
+    int pins = 0;
+    for (int di = 0; di < static_cast<int>(m.deviations.size()); ++di)
+        for (int kk = 0; kk < m.deviations[di].size(); ++kk, ++pins) {
+            double& v = k.floatPin("cnccomp_kins." + controllers::linuxcnc::kinsDeviationPin(m, di, kk));
+            EXPECT_EQ(v, d.values[m.deviations[di].offset + kk]);
+            v = 0.0;
+        }
+    EXPECT_EQ(pins, m.parameterCount());
+    j = c;
+    ASSERT_EQ(k.inverse(&world, j.data(), nullptr, nullptr), 0);
+    for (int i = 0; i < n; ++i) EXPECT_NEAR(j[i], c[i], 1e-10) << m.axisNames[i];
+    // Not solvable: the joints stay, fail is set, the call fails (motion stops with "kinematicsInverse failed").
+    world.x = std::nan("");
+    std::vector<double> kept = c;
+    EXPECT_EQ(k.inverse(&world, kept.data(), nullptr, nullptr), -1);
+    EXPECT_TRUE(k.bitPin("cnccomp_kins.fail"));
+    for (int i = 0; i < n; ++i) EXPECT_EQ(kept[i], c[i]);
+    // Realtime: the component's object needs nothing of the C library beyond math, and the HAL / RTAPI calls.
+    const auto nm = test::runCommand("gcc -std=gnu99 " + kRtFlags + " -c -I" + shimDir() + " -o " + dir.file("kins.o") + " " +
+                                     dir.file("kins.c") + " && nm -u " + dir.file("kins.o"));
+    ASSERT_EQ(nm.exitCode, 0) << nm.out;
+    std::istringstream names(nm.out);
+    std::string type, name;
+    const std::set<std::string> allowed = {"cos", "sin", "sqrt", "fmod", "hal_pin_float_newf", "hal_pin_bit_newf",
+                                           "hal_pin_s32_newf", "hal_malloc", "hal_set_unready", "hal_ready",
+                                           "rtapi_print_msg"};
+    while (names >> type >> name) EXPECT_TRUE(allowed.count(name)) << "the component calls " << name;
+}
+
+TEST(LinuxcncKinsComponent, RefusesWhatItCannotDescribe) {
+    const MachineModel& m = test::sampleMachine("multitasking");
+    const DeviationSet d(m);
+    KinsComponentOptions o;
+    o.name = "Bad-Name";
+    EXPECT_THROW(kinematicsComponent(m, d, o), ModelError);
+    MachineModel renamed = m;
+    renamed.axisNames[0] = "Q";
+    EXPECT_THROW(kinematicsComponent(renamed, DeviationSet(renamed), {}), ModelError);
+}
+
+// halcompile (LinuxCNC 2.9, linuxcnc-uspace-dev) compiles the generated file of every sample machine: --compile
+// builds the realtime module in the current folder (a scratch folder here) and installs nothing.
+TEST(LinuxcncKinsComponent, HalcompileCompilesEverySample) {
+    if (!std::filesystem::exists("/usr/bin/halcompile"))
+        GTEST_SKIP() << "halcompile not found (Debian package linuxcnc-uspace-dev, tools/deps.sh)";
+    for (const Sample& s : kSamples) {
+        SCOPED_TRACE(s.machine);
+        const MachineModel& m = test::sampleMachine(s.machine);
+        const std::string comp = kinematicsComponent(m, sampleDeviations(m, s.deviations), {});
+        test::ScratchDir dir(std::string("halcompile-") + s.machine);
+        test::writeText(dir.file("cnccomp_kins.comp"), comp);
+        const auto r = test::runCommand("cd " + dir.path.string() + " && halcompile --compile cnccomp_kins.comp 2>&1");
+        EXPECT_EQ(r.exitCode, 0) << r.out;
+        EXPECT_TRUE(std::filesystem::exists(dir.file("cnccomp_kins.so"))) << r.out;
+        // The module defines the kinematics entry points motion looks up.
+        const auto sym = test::runCommand("nm -D --defined-only " + dir.file("cnccomp_kins.so"));
+        for (const char* f : {"kinematicsForward", "kinematicsInverse", "kinematicsType", "kinematicsSwitchable",
+                              "kinematicsSwitch"})
+            EXPECT_NE(sym.out.find(f), std::string::npos) << f << "\n" << sym.out;
+    }
+}
+
+// Cost per call: 1e5 inverse calls of the C compiled with LinuxCNC 2.9's realtime flags (Makefile.modinc: -Os,
+// -fno-fast-math, no builtin sin/cos), joint mode and tool-tip mode, on the multi-tasking and A/C samples.
+TEST(LinuxcncKinsComponent, InverseCostPerCall) {
+    for (const Sample& s : {kSamples[0], kSamples[2]}) {
+        const MachineModel& m = test::sampleMachine(s.machine);
+        const std::string comp = kinematicsComponent(m, sampleDeviations(m, s.deviations), {});
+        test::ScratchDir dir(std::string("kins-cost-") + s.machine);
+        LoadedKins k(compileComponent(dir, comp));
+        const int n = m.axisCount();
+        std::mt19937 rng(3);
+        // A path: 1e5 servo periods along a line between two random poses (warm start from the previous joints).
+        const AxisVector a = randomCommands(m, rng), b = randomCommands(m, rng);
+        k.floatPin("cnccomp_kins.tool-offset") = 80.0;
+        for (int mode : {0, 1}) {
+            ASSERT_EQ(k.kinsSwitch(mode), 0);
+            const int calls = 100000;
+            std::vector<CPose> words(calls);
+            const pp::CompiledKinematics compiledNominal(m, nullptr);
+            const pp::TcpModel tcp(compiledNominal);
+            for (int t = 0; t < calls; ++t) {
+                const AxisVector q = a + (b - a) * (double(t) / calls);
+                const std::vector<double> c = toJoints(m, q);
+                if (mode == 0) {
+                    for (int i = 0; i < n; ++i) slot(words[t], m.axisNames[i]) = c[i];
+                } else {
+                    AxisVector cc(n), p;
+                    for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
+                    tcp.toProgram(cc, 80.0, p);
+                    for (int i = 0; i < n; ++i) slot(words[t], m.axisNames[i]) = p[i] / unitOf(m, i);
+                }
+            }
+            std::vector<double> j = toJoints(m, a);
+            int failures = 0;
+            const auto t0 = std::chrono::steady_clock::now();
+            for (int t = 0; t < calls; ++t) failures += k.inverse(&words[t], j.data(), nullptr, nullptr) != 0;
+            const double ns =
+                std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / calls;
+            EXPECT_EQ(failures, 0);
+            std::printf("%-28s mode %d: %.0f ns per inverse call (%.2f %% of a 1 ms servo period, %.1f %% of 50 us)\n",
+                        s.machine, mode, ns, ns / 1e4, ns / 500);
+            testing::Test::RecordProperty(std::string(s.machine) + "-mode" + std::to_string(mode) + "-ns",
+                                          std::to_string(ns));
+            EXPECT_LT(ns, 50000.0);  // far below a 1 ms servo period even on a loaded machine
+        }
+    }
+}
+
+}  // namespace
+}  // namespace cnccomp
