@@ -321,6 +321,44 @@ TEST(LinuxcncKinsComponent, PinsCarryTheDeviationsAndFailureKeepsTheJoints) {
     while (names >> type >> name) EXPECT_TRUE(allowed.count(name)) << "the component calls " << name;
 }
 
+// Joint mode on a 5-axis machine matches the tool axis as well as the tip, so the joints do not depend on the tool
+// length (tool-offset); on the 4-axis head (X Y Z B) the axis cannot be matched and the tip at tool-offset is met.
+TEST(LinuxcncKinsComponent, JointModeIndependentOfToolLengthWhereTheAxisIsMatched) {
+    for (const Sample& s : {kSamples[0], kSamples[5]}) {
+        SCOPED_TRACE(s.machine);
+        const MachineModel& m = test::sampleMachine(s.machine);
+        const DeviationSet d = sampleDeviations(m, s.deviations);
+        test::ScratchDir dir(std::string("kins-length-") + s.machine);
+        LoadedKins k(compileComponent(dir, kinematicsComponent(m, d, {})));
+        const Kinematics nominal(m), real(m, d);
+        std::mt19937 rng(11);
+        double spread = 0;
+        for (int pose = 0; pose < 10; ++pose) {
+            const AxisVector q = randomCommands(m, rng);
+            const std::vector<double> c = toJoints(m, q);
+            CPose world{};
+            for (int i = 0; i < m.axisCount(); ++i) slot(world, m.axisNames[i]) = c[i];
+            std::vector<std::vector<double>> byLength;
+            for (double L : {0.0, 150.0}) {
+                k.floatPin("cnccomp_kins.tool-offset") = L;
+                std::vector<double> j = c;
+                ASSERT_EQ(k.inverse(&world, j.data(), nullptr, nullptr), 0);
+                const Vec3 tip = nominal.toolPoint(L);
+                EXPECT_LE((real.toolPointInWorkpiece(fromJoints(m, j.data()), tip) -
+                           nominal.toolPointInWorkpiece(q, tip)).norm(),
+                          1e-6);
+                byLength.push_back(j);
+            }
+            for (int i = 0; i < m.axisCount(); ++i)
+                spread = std::max(spread, std::abs(byLength[0][i] - byLength[1][i]));
+        }
+        if (m.axisCount() == 5)
+            EXPECT_LE(spread, 1e-9);
+        else
+            EXPECT_GT(spread, 1e-6);  // the head's tilt out of the B plane: the tip then depends on the length
+    }
+}
+
 TEST(LinuxcncKinsComponent, RefusesWhatItCannotDescribe) {
     const MachineModel& m = test::sampleMachine("multitasking");
     const DeviationSet d(m);
