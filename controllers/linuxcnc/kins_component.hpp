@@ -63,13 +63,19 @@ struct KinsComponentOptions {
 ///                                           q^(k+1), Fourier cos/sin pairs, table node k), q in mm or rad; mm or rad
 ///                                           (<iso-name> lower-cased, e.g. dev.ex0c, dev.ecc.3)
 ///   out bit   kinstype.is-0 / kinstype.is-1 which mode is active (names as millturn.comp: no prefix)
-///   out bit   fail                          set when an inverse/forward did not converge (joints kept: no NaN)
+///   out bit   fail                          set when the last inverse/forward did not converge; an inverse whose
+///                                           tip residual is still above 1e-6 mm (or not finite) leaves the joints
+///                                           as LinuxCNC passed them and returns -1 (motion then stops with
+///                                           "kinematicsInverse failed"): no NaN reaches the joints
 ///   out s32   iterations                    Newton iterations of the last inverse call
 ///   out float residual                      mm: tip residual of the last inverse call
 /// The compiled-in initial values equal d, so a HAL file that sets nothing gives the identified model; setting the
 /// dev.* pins (setp) changes the model at run time (read back with getp).
 ///
 /// Build: `halcompile --install <name>.comp` (Debian package linuxcnc-uspace-dev; sudo for a package install).
+/// halcompile needs one instance pin: `<name>.0.generated` (out s32, always 1); the kinematics pins above are made by
+/// the component's setup, called from motion's first kinematicsType() call (userkins.comp, note 2).
+/// kinematicsType() = KINEMATICS_BOTH; kinematicsSwitchable() = 1.
 /// Throws ModelError for a machine the component cannot describe (axis names, more than 9 axes).
 std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, const KinsComponentOptions& o = {});
 
