@@ -359,6 +359,55 @@ TEST(LinuxcncKinsComponent, JointModeIndependentOfToolLengthWhereTheAxisIsMatche
     }
 }
 
+// The multi-tasking machine at B = 0 (tool axis parallel to C: C cannot turn the axis) and next to it: the tip is still
+// met, C stays next to its command (the pull), nothing fails, and forward∘inverse is the identity.
+TEST(LinuxcncKinsComponent, SingularPoseOfTheMultitaskingMachine) {
+    const MachineModel& m = test::sampleMachine("multitasking");
+    const DeviationSet d = sampleDeviations(m, "multitasking-truth");
+    test::ScratchDir dir("kins-singular");
+    LoadedKins k(compileComponent(dir, kinematicsComponent(m, d, {})));
+    const Kinematics nominal(m), real(m, d);
+    const int b = m.requireAxis("B"), c = m.requireAxis("C");
+    for (int mode : {0, 1}) {
+        ASSERT_EQ(k.kinsSwitch(mode), 0);
+        for (double bDeg : {0.0, 1e-4, -0.01, 0.5}) {
+            SCOPED_TRACE(testing::Message() << "mode " << mode << " B " << bDeg);
+            AxisVector q = AxisVector::Zero(m.axisCount());
+            q[m.requireAxis("X")] = 120;
+            q[m.requireAxis("Y")] = -15;
+            q[m.requireAxis("Z")] = 300;
+            q[b] = bDeg * kDeg;
+            q[c] = 33 * kDeg;
+            const double L = 60;
+            k.floatPin("cnccomp_kins.tool-offset") = L;
+            const std::vector<double> cj = toJoints(m, q);
+            CPose world{};
+            if (mode == 0) {
+                for (int i = 0; i < m.axisCount(); ++i) slot(world, m.axisNames[i]) = cj[i];
+            } else {
+                const pp::CompiledKinematics compiledNominal(m, nullptr);
+                const pp::TcpModel tcp(compiledNominal);
+                AxisVector cc(m.axisCount()), p;
+                for (int i = 0; i < m.axisCount(); ++i) cc[i] = cj[i] * unitOf(m, i);
+                tcp.toProgram(cc, L, p);
+                for (int i = 0; i < m.axisCount(); ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
+            }
+            std::vector<double> j = cj;
+            ASSERT_EQ(k.inverse(&world, j.data(), nullptr, nullptr), 0);
+            EXPECT_FALSE(k.bitPin("cnccomp_kins.fail"));
+            const Vec3 tip = nominal.toolPoint(L);
+            EXPECT_LE((real.toolPointInWorkpiece(fromJoints(m, j.data()), tip) - nominal.toolPointInWorkpiece(q, tip))
+                          .norm(),
+                      1e-6);
+            EXPECT_NEAR(j[c], cj[c], 0.1);  // C is not swung round to chase a tilt
+            CPose back{};
+            ASSERT_EQ(k.forward(j.data(), &back, nullptr, nullptr), 0);
+            for (int i = 0; i < m.axisCount(); ++i)
+                EXPECT_NEAR(slot(back, m.axisNames[i]), slot(world, m.axisNames[i]), 1e-9) << m.axisNames[i];
+        }
+    }
+}
+
 TEST(LinuxcncKinsComponent, RefusesWhatItCannotDescribe) {
     const MachineModel& m = test::sampleMachine("multitasking");
     const DeviationSet d(m);
