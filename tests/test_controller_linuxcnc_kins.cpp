@@ -408,6 +408,83 @@ TEST(LinuxcncKinsComponent, SingularPoseOfTheMultitaskingMachine) {
     }
 }
 
+// Jumps: each pose starts from the joints of the previous, unrelated one (as after a switch of kinstype or a long
+// rapid): 100 poses per mode on every sample, all solved, tip within 1 nm.
+TEST(LinuxcncKinsComponent, SolvesFromFarAwayJoints) {
+    for (const Sample& s : kSamples) {
+        SCOPED_TRACE(s.machine);
+        const MachineModel& m = test::sampleMachine(s.machine);
+        const DeviationSet d = sampleDeviations(m, s.deviations);
+        test::ScratchDir dir(std::string("kins-jumps-") + s.machine);
+        LoadedKins k(compileComponent(dir, kinematicsComponent(m, d, {})));
+        const Kinematics nominal(m), real(m, d);
+        const pp::CompiledKinematics compiledNominal(m, nullptr);
+        const pp::TcpModel tcp(compiledNominal);
+        const int n = m.axisCount();
+        std::mt19937 rng(99);
+        std::vector<double> joints(n, 0.0);
+        int failures = 0;
+        double worst = 0;
+        for (int mode : {0, 1}) {
+            ASSERT_EQ(k.kinsSwitch(mode), 0);
+            for (int pose = 0; pose < 100; ++pose) {
+                AxisVector q = randomCommands(m, rng);
+                if (pose % 4 == 0)  // tilting axes at 0: singular poses (tool axis parallel to C)
+                    for (int i = 0; i < n; ++i)
+                        if (m.axisLink(i).kind == AxisKind::Rotary && !m.axisLink(i).modulo) q[i] = 0;
+                const double L = 100.0 * (pose % 3);
+                k.floatPin("cnccomp_kins.tool-offset") = L;
+                const std::vector<double> c = toJoints(m, q);
+                CPose world{};
+                AxisVector cc(n), p;
+                for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
+                if (mode == 0)
+                    p = cc;
+                else
+                    tcp.toProgram(cc, L, p);
+                for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
+                if (k.inverse(&world, joints.data(), nullptr, nullptr) != 0) {
+                    ++failures;
+                    continue;
+                }
+                const Vec3 tip = nominal.toolPoint(L);
+                worst = std::max(worst, (real.toolPointInWorkpiece(fromJoints(m, joints.data()), tip) -
+                                         nominal.toolPointInWorkpiece(q, tip))
+                                            .norm());
+            }
+        }
+        EXPECT_EQ(failures, 0);
+        EXPECT_LE(worst, 1e-6);
+    }
+}
+
+// The case that found it: tool-tip mode on the B/C table with offsets, B = 0 and the joints far from the solution.
+TEST(LinuxcncKinsComponent, ScaleFreePivotsAtTheSingularity) {
+    const MachineModel& m = test::sampleMachine("table-table-bc-offsets");
+    const DeviationSet d = sampleDeviations(m, "table-table-bc-offsets-truth");
+    test::ScratchDir dir("kins-pivot");
+    LoadedKins k(compileComponent(dir, kinematicsComponent(m, d, {})));
+    ASSERT_EQ(m.axisNames, (std::vector<std::string>{"B", "C", "X", "Y", "Z"}));
+    ASSERT_EQ(k.kinsSwitch(1), 0);
+    k.floatPin("cnccomp_kins.tool-offset") = 0;
+    CPose world{};
+    world.x = -135;
+    world.y = 60;
+    world.z = 236;
+    world.b = 0;
+    world.c = 198;
+    std::vector<double> joints = {-74.0033, 163.019, -54.0024, 261.007, -32.9954};
+    ASSERT_EQ(k.inverse(&world, joints.data(), nullptr, nullptr), 0);
+    EXPECT_FALSE(k.bitPin("cnccomp_kins.fail"));
+    EXPECT_LE(k.floatPin("cnccomp_kins.residual"), 1e-9);
+    CPose back{};
+    ASSERT_EQ(k.forward(joints.data(), &back, nullptr, nullptr), 0);
+    EXPECT_NEAR(back.x, world.x, 1e-9);
+    EXPECT_NEAR(back.y, world.y, 1e-9);
+    EXPECT_NEAR(back.z, world.z, 1e-9);
+    EXPECT_NEAR(back.c, world.c, 1e-9);
+}
+
 TEST(LinuxcncKinsComponent, RefusesWhatItCannotDescribe) {
     const MachineModel& m = test::sampleMachine("multitasking");
     const DeviationSet d(m);

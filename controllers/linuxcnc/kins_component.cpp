@@ -253,18 +253,17 @@ static void ck_tool(const double *q, double L, int err, double *tip, double *axi
     }
 }
 
-/* Solves N x = g (N symmetric positive definite, n x n) by Cholesky; 0 on success. */
+/* Solves N x = g (N symmetric positive definite, n x n) by Cholesky; 0 on success. A pivot is refused when it is
+ * below 1e-12 of its own diagonal entry (scale-free: joints in mm and rad, long arms): a singular direction. */
 static int ck_cholesky_solve(double N[CK_NAX][CK_NAX], const double *g, double *x) {
-    double Lm[CK_NAX][CK_NAX], y[CK_NAX], dmax = 0.0;
+    double Lm[CK_NAX][CK_NAX], y[CK_NAX];
     int i, j, k;
-    for (i = 0; i < CK_NAX; ++i) if (N[i][i] > dmax) dmax = N[i][i];
-    if (!(dmax > 0.0)) return -1;
     for (i = 0; i < CK_NAX; ++i) {
         for (j = 0; j <= i; ++j) {
             double s = N[i][j];
             for (k = 0; k < j; ++k) s -= Lm[i][k] * Lm[j][k];
             if (i == j) {
-                if (!(s > 1e-13 * dmax)) return -1;
+                if (!(s > 1e-12 * N[i][i])) return -1;
                 Lm[i][i] = sqrt(s);
             } else {
                 Lm[i][j] = s / Lm[j][j];
