@@ -77,6 +77,34 @@ std::optional<TrtPins> parseHal(const std::string& text, const std::string& name
     return p;
 }
 
+std::string wrapCommentLines(const std::string& text, const std::string& prefix, size_t width) {
+    std::string out;
+    for (const TextLine& l : splitLines(text)) {
+        std::string_view rest = l.text;
+        if (rest.size() <= width || !rest.starts_with(prefix)) {
+            out += std::string(rest) + "\n";
+            continue;
+        }
+        rest.remove_prefix(prefix.size());
+        std::string lead = prefix;
+        while (!rest.empty()) {
+            const size_t room = width - lead.size();
+            size_t cut = rest.size();
+            if (cut > room) {
+                cut = rest.rfind(' ', room);
+                if (cut == std::string_view::npos || cut == 0) cut = room;  // one long word: cut it
+            }
+            std::string_view piece = rest.substr(0, cut);
+            while (!piece.empty() && piece.back() == ' ') piece.remove_suffix(1);
+            out += lead + std::string(piece) + "\n";
+            rest.remove_prefix(cut);
+            while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
+            lead = prefix + "  ";
+        }
+    }
+    return out;
+}
+
 std::array<double, 3> parseWorkOffset(const std::string& text, const std::string& name) {
     std::optional<std::array<double, 3>> g54;
     for (const TextLine& l : splitLines(text)) {

@@ -26,6 +26,15 @@ IniFragment parseIni(const std::string& text, const std::string& name);
 /// Unknown pins of the module are errors. Returns nullopt when the fragment sets no pin.
 std::optional<TrtPins> parseHal(const std::string& text, const std::string& name, const std::string& module);
 
+/// The longest program line LinuxCNC 2.9 reads, without its line end: the interpreter reads a line with
+/// fgets(raw_line, LINELEN = 255) and aborts the program with "Command too long" when the line fills the buffer
+/// (strlen == LINELEN − 1 = 254, the '\n' included; src/emc/rs274ngc/interp_read.cc read_text, src/emc/linuxcnc.h).
+inline constexpr size_t kMaxProgramLine = 252;
+
+/// The text with every line longer than `width` characters that starts with `prefix` (a comment) broken at blanks
+/// into several lines, each starting with `prefix` and two more blanks on the continuation lines. Other lines as they are.
+std::string wrapCommentLines(const std::string& text, const std::string& prefix, size_t width = 200);
+
 /// The work offset a program sets with `G10 L2 P1 X… Y… Z…` (G54, mm); ';' and '(…)' comments, blank lines and M2
 /// allowed, anything else an error. InputError when no G10 L2 P1 line is there.
 std::array<double, 3> parseWorkOffset(const std::string& text, const std::string& name);
