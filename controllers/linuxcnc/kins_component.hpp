@@ -1,0 +1,80 @@
+#pragma once
+// A LinuxCNC 2.9 kinematics component generated from the machine model: the exact model of the machine with its
+// identified deviations (every location, squareness and component error; exact rotations), forward and inverse, for
+// any structure a machine XML describes (two serial chains from the bed, src/cnccomp/kinematics.hpp), as the source
+// of a halcompile `.comp` file.
+//
+// Interface followed (LinuxCNC 2.9, tag v2.9.0): src/hal/components/userkins.comp (a kinematics component is a
+// realtime halcompile component whose C section defines kinematicsForward/kinematicsInverse/kinematicsType and whose
+// HAL pins are made in a setup function called from the first kinematicsType() call, because the kinematics
+// functions are called by motion, not by a thread),
+// src/hal/components/millturn.comp (switchable kinematics in a .comp: kinematicsSwitchable() = 1,
+// kinematicsSwitch(type), pins kinstype.is-N), src/emc/kinematics/kinematics.h (the prototypes, KINEMATICS_BOTH),
+// src/emc/motion/control.c (kinematicsInverse gets the joints array preloaded with the joints' current coarse
+// positions: the warm start), src/emc/kinematics/trtfuncs.c (tool-offset pin fed from motion.tooloffset.z).
+#include <string>
+
+#include "cnccomp/deviations.hpp"
+#include "cnccomp/machine.hpp"
+
+namespace cnccomp::controllers::linuxcnc {
+
+/// How the component is generated. Defaults fit a 1 ms servo thread (see README, LinuxCNC kinematics component).
+struct KinsComponentOptions {
+    /// halcompile component name: the file must be `<name>.comp`, the INI says `[KINS] KINEMATICS=<name>`, and every
+    /// HAL pin is `<name>.<pin>`. Lower-case letters, digits and '_', starting with a letter (halcompile takes the
+    /// component name as a C identifier). Throws ModelError otherwise.
+    std::string name = "cnccomp_kins";
+    /// Newton iterations per inverse (and per forward) call at most.
+    int maxIterations = 12;
+    /// Convergence: step size below this (mm, and rad × axisWeight) ends the iteration.
+    double tolerance = 1e-11;
+    /// mm per rad: weight of a tool-axis error against a tip error (as cnccomp::IkOptions::axisWeight).
+    double axisWeight = 100.0;
+    /// mm per rad: pull of the rotary joints towards the nominal (joint mode) or commanded (tool-tip mode) angles,
+    /// as cnccomp::IkOptions::rotaryRegularization: keeps singular poses (tool axis parallel to a rotary axis) tame.
+    double rotaryRegularization = 0.1;
+};
+
+/// Source text of a halcompile `.comp` kinematics component for machine `m` with deviations `d` (LinuxCNC 2.9).
+///
+/// Joints and coordinates: one joint per controlled axis, joint i = machine axis i (m.axisNames order), value = the
+/// controller's machine coordinate of that axis (command − machineZero; mm, degrees). The coordinate letter of joint i
+/// is m.axisNames[i] (each must be one of X Y Z A B C U V W, all different; else ModelError). The INI needs
+///   [KINS] KINEMATICS=<name>   JOINTS=<axisCount>
+///   [TRAJ] COORDINATES=<the axis letters in joint order>   (e.g. "CZYXB" for the multi-tasking sample)
+///
+/// Modes (switchable, as millturn.comp / switchkins: motion.switchkins-type or M-codes calling kinematicsSwitch):
+///   type 0, joint mode (default at start): the world coordinates are the NOMINAL machine's commands, in controller
+///     coordinates; inverse = joints at which the ERRONEOUS machine puts the tool tip and the tool axis where the
+///     nominal machine at those commands puts them (tip exact, axis in the least-squares sense where the axes cannot
+///     match it); forward = nominal commands whose nominal pose is the erroneous pose at the joints.
+///   type 1, tool-tip mode: X Y Z = tool tip in workpiece coordinates (the workpiece frame of the machine model at
+///     machine zero = all commands 0), rotary words = the rotary axes' nominal angles (controller coordinates);
+///     inverse = joints of the erroneous machine putting its tip there with the nominal tool axis of those angles.
+///   The tool length in both modes is the pin `<name>.tool-offset` (mm, along the tool direction from the tool
+///   frame's origin; the HAL file should `net` it from motion.tooloffset.z, as for xyzac-trt-kins).
+///
+/// HAL pins (all made by the component; `<name>.` prefix):
+///   in  float tool-offset                   tool length, mm
+///   in  float dev.<iso-name>                one per location deviation: its LINK value (the error component the
+///                                           kinematic chain uses, DeviationDef; mm or rad); initial value = d's value
+///   in  float dev.<iso-name>.<k>            component deviations: coefficient k (0-based) of the basis (polynomial
+///                                           q^(k+1), Fourier cos/sin pairs, table node k), q in mm or rad; mm or rad
+///                                           (<iso-name> lower-cased, e.g. dev.ex0c, dev.ecc.3)
+///   out bit   kinstype.is-0 / kinstype.is-1 which mode is active (names as millturn.comp: no prefix)
+///   out bit   fail                          set when an inverse/forward did not converge (joints kept: no NaN)
+///   out s32   iterations                    Newton iterations of the last inverse call
+///   out float residual                      mm: tip residual of the last inverse call
+/// The compiled-in initial values equal d, so a HAL file that sets nothing gives the identified model; setting the
+/// dev.* pins (setp) changes the model at run time (read back with getp).
+///
+/// Build: `halcompile --install <name>.comp` (Debian package linuxcnc-uspace-dev; sudo for a package install).
+/// Throws ModelError for a machine the component cannot describe (axis names, more than 9 axes).
+std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, const KinsComponentOptions& o = {});
+
+/// HAL pin name (without the component prefix) of coefficient k of deviation `index` of `m`: "dev.<lower iso name>"
+/// for a location deviation, "dev.<lower iso name>.<k>" for a component deviation.
+std::string kinsDeviationPin(const MachineModel& m, int index, int k = 0);
+
+}  // namespace cnccomp::controllers::linuxcnc
