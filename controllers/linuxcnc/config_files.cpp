@@ -30,7 +30,13 @@ IniFragment parseIni(const std::string& text, const std::string& name) {
             ini.kinematics = std::string(tok[0]);
             for (size_t i = 1; i < tok.size(); ++i)
                 if (tok[i].starts_with("coordinates=")) ini.coordinates = std::string(tok[i].substr(12));
-            if (ini.coordinates.empty()) throw InputError(name, l.number, "KINEMATICS needs coordinates=LETTERS");
+        } else if (section == "KINS" && key == "JOINTS") {
+            const auto n = parseNumber(value);
+            if (!n || *n < 1 || *n > 16 || *n != static_cast<int>(*n)) throw InputError(name, l.number, "JOINTS must be a count 1..16");
+            ini.joints = static_cast<int>(*n);
+        } else if (section == "TRAJ" && key == "COORDINATES") {
+            for (char c : value)
+                if (c != ' ') ini.trajCoordinates += c;
         } else if (section.starts_with("JOINT_")) {
             const auto n = parseNumber(std::string_view(section).substr(6));
             if (!n || *n < 0 || *n != static_cast<int>(*n)) throw InputError(name, l.number, fmt::format("bad section [{}]", section));

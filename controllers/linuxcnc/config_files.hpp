@@ -13,13 +13,15 @@ namespace cnccomp::controllers::linuxcnc {
 /// What the INI fragment says: the kinematics module, its joint letters, and per joint the table file.
 struct IniFragment {
     std::string kinematics;    ///< module name
-    std::string coordinates;   ///< joint letters, e.g. XYZAC
+    std::string coordinates;   ///< joint letters of the KINEMATICS line's coordinates=, e.g. XYZAC (may be empty)
+    std::string trajCoordinates;  ///< [TRAJ] COORDINATES (may be empty)
+    int joints = 0;            ///< [KINS] JOINTS (0 when not given)
     std::map<int, std::string> compFile;  ///< joint number → COMP_FILE
     std::map<int, int> compType;          ///< joint number → COMP_FILE_TYPE (0 when not given, as inijoint.cc)
 };
 
 /// Parses `[SECTION]`, `KEY = value`, '#' / ';' comments. InputError(file:line) on anything else, on a
-/// COMP_FILE_TYPE other than 0 or 1, on a KINEMATICS line without coordinates=.
+/// COMP_FILE_TYPE other than 0 or 1, on a JOINTS that is not a count, when no KINEMATICS line is there.
 IniFragment parseIni(const std::string& text, const std::string& name);
 
 /// The `setp <module>.<pin> <value>` lines of a HAL fragment; `net`/`loadrt`/comments ignored, anything else an error.

@@ -27,6 +27,7 @@ LinuxcncModel::LinuxcncModel(const MachineModel& m, const std::vector<OutputFile
     : machine_(&m), mode_(mode), nominal_(m) {
     const IniFragment ini = parseIni(requireFile(files, kIniFile, "LinuxCNC").content, kIniFile);
     coordinates_ = ini.coordinates;
+    if (coordinates_.empty()) throw InputError(kIniFile, 0, "the KINEMATICS line needs coordinates=LETTERS");
     if (static_cast<int>(coordinates_.size()) != m.axisCount())
         throw InputError(kIniFile, 0, fmt::format("coordinates={} do not match the {} axes of machine '{}'", coordinates_,
                                                   m.axisCount(), m.name));

@@ -35,7 +35,7 @@ namespace cnccomp::controllers::linuxcnc {
 inline constexpr const char* kIniFile = "cnccomp.ini";
 inline constexpr const char* kHalFile = "cnccomp.hal";
 inline constexpr const char* kWorkOffsetFile = "cnccomp-g54.ngc";
-inline constexpr const char* kReadmeFile = "README.txt";
+inline constexpr const char* kReadmeFile = "README-pins.txt";  ///< the pins route's README
 
 /// How LinuxCNC reads a program's axis words (above).
 enum class KinsMode { Joint, ToolTip };

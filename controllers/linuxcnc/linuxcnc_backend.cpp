@@ -5,14 +5,17 @@
 // workspace (controllers/common/fit.hpp) when one is given.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
 #include "controllers/common/controller_model.hpp"
+#include "controllers/common/files.hpp"
 #include "controllers/common/fit.hpp"
 #include "controllers/common/header.hpp"
 #include "controllers/linuxcnc/comp_table.hpp"
+#include "controllers/linuxcnc/component_route.hpp"
 #include "controllers/linuxcnc/config_files.hpp"
 #include "controllers/linuxcnc/linuxcnc_apply.hpp"
 #include "controllers/linuxcnc/linuxcnc_plan.hpp"
@@ -136,7 +139,7 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
                                          fixed(t.table.nominal.back(), 3), unit, t.interpolationError, unit));
         tables.push_back({compFileName(j), formatCompTable(t.table, compFileName(j))});
         iniJoints += fmt::format("\n[JOINT_{}]\n# axis {}: LinuxCNC does not apply BACKLASH to this joint while COMP_FILE is set "
-                                 "(README.txt)\nCOMP_FILE = {}\nCOMP_FILE_TYPE = 1\n",
+                                 "(README-pins.txt)\nCOMP_FILE = {}\nCOMP_FILE_TYPE = 1\n",
                                  n, j.name, compFileName(j));
     }
 
@@ -149,10 +152,10 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
         "tables: COMP_FILE_TYPE 1, nominal = joint position (from machine zero), trims (deltas) added to the joint command"};
     if (plan.trt && *plan.trt == TrtType::BC)
         notes.push_back("NOT for LinuxCNC 2.10/master: its xyzbc-trt-kins inverse differs from 2.9's in the sign of the "
-                        "sin(B) offset terms (README.txt)");
+                        "sin(B) offset terms (README-pins.txt)");
     if (!tables.empty())
         notes.push_back("WARNING: LinuxCNC ignores BACKLASH for a joint with COMP_FILE; forward = reverse here (no reversal "
-                        "error in the deviation set): put the joint's backlash into the columns (README.txt)");
+                        "error in the deviation set): put the joint's backlash into the columns (README-pins.txt)");
     notes.insert(notes.end(), tableNotes.begin(), tableNotes.end());
     if (plan.trt) {
         const TrtPins &p = plan.pins, &n = plan.nominalPins;
@@ -184,7 +187,7 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
     std::string hal = formatHeader(h, "# ");
     if (plan.trt) {
         const TrtPins &p = plan.pins, &n = plan.nominalPins;
-        hal += fmt::format("\n# Absolute values in LinuxCNC's frame; they replace these pins' values (README.txt).\n"
+        hal += fmt::format("\n# Absolute values in LinuxCNC's frame; they replace these pins' values (README-pins.txt).\n"
                            "net tooloffset-z motion.tooloffset.z => {}.tool-offset\n",
                            module);
         hal += pinLine(module, "x-rot-point", n.xRotPoint, p.xRotPoint);
@@ -195,7 +198,7 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
         hal += pinLine(module, "z-offset", n.zOffset, p.zOffset);
         // LinuxCNC aborts a program at a line of 254 characters or more ("Command too long").
         std::string g54 = wrapCommentLines(formatHeader(h, "; "), "; ");
-        g54 += fmt::format("\n; G54 = the workpiece origin of the machine description in LinuxCNC's frame, absolute (README.txt)\n"
+        g54 += fmt::format("\n; G54 = the workpiece origin of the machine description in LinuxCNC's frame, absolute (README-pins.txt)\n"
                            "G10 L2 P1 X{} Y{} Z{}\nM2\n",
                            fixed(plan.workOffset.x(), 6), fixed(plan.workOffset.y(), 6), fixed(plan.workOffset.z(), 6));
         out.files.push_back({kHalFile, hal});
@@ -205,6 +208,16 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
         out.files.push_back({kHalFile, hal});
     }
     out.files.push_back({kReadmeFile, formatHeader(h, "") + readme(plan, module, tables)});
+    return out;
+}
+
+/// The pins route's files of a folder (which may hold the component route too).
+std::vector<OutputFile> pinsFiles(const std::vector<OutputFile>& files) {
+    std::vector<OutputFile> out;
+    for (const OutputFile& f : files)
+        if (f.name == kIniFile || f.name == kHalFile || f.name == kWorkOffsetFile || f.name == kReadmeFile ||
+            (f.name.ends_with(".comp") && f.name != kKinsSourceFile))
+            out.push_back(f);
     return out;
 }
 
@@ -241,21 +254,147 @@ public:
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& m, const std::vector<OutputFile>& files) const override {
         return std::make_unique<LinuxcncModel>(m, files, KinsMode::Joint);
     }
-    /// Never guessed from the files: a folder of LinuxCNC files is "linuxcnc" (which reads the pins route when the
-    /// component route is absent); name this backend to verify the pins route of a folder holding both.
-    bool recognizes(const std::vector<OutputFile>&) const override { return false; }
+    /// A folder of the pins route alone (`emit --controller linuxcnc-pins`); name this backend to verify the pins route
+    /// of a folder holding both routes.
+    bool recognizes(const std::vector<OutputFile>& files) const override {
+        return findFile(files, kIniFile) && !findFile(files, kKinsIniFile);
+    }
+    std::vector<OutputFile> ownFiles(const std::vector<OutputFile>& files) const override { return pinsFiles(files); }
 };
 
+/// README.txt of a folder holding both routes: which files are which route, how to build and load the component.
+std::string componentReadme(const EmitRequest& r, const EmitResult& kins, const EmitResult* pins, const std::string& pinsRefused) {
+    const MachineModel& m = r.machine;
+    std::string coordinates;
+    for (const std::string& a : m.axisNames) coordinates += a;
+    const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC 2.9 (component {}, and the pins-and-tables route)", kKinsName), kins);
+    std::string t = formatHeader(h, "");
+    t += fmt::format(
+        "
+This folder holds two routes. Load ONE of them.
+"
+        "
+"
+        "Route 1, generated kinematics component (the whole model; what cnccomp verify and emit's prediction use):
+"
+        "  {:<20} the component source (C for halcompile)
+"
+        "  {:<20} INI fragment: [KINS] KINEMATICS, JOINTS and [TRAJ] COORDINATES
+"
+        "  {:<20} HAL fragment: the tool-offset net and the deviation values (setp lines)
+",
+        kKinsSourceFile, kKinsIniFile, kKinsHalFile);
+    if (pins) {
+        t += "
+Route 2, pins and tables (for a LinuxCNC where modules cannot be compiled; holds only what joint tables
+"
+             "and the xyzac/xyzbc-trt-kins pins can take, see README-pins.txt and the NOT compensated list there):
+";
+        for (const OutputFile& f : pins->files) t += fmt::format("  {}
+", f.name);
+        t += "  Verify it with cnccomp verify --controller linuxcnc-pins --compensation <this folder>.
+";
+    } else {
+        t += fmt::format("
+Route 2, pins and tables: not written for this machine: {}
+", pinsRefused);
+    }
+    t += fmt::format(
+        "
+Route 1: build and install (once per change of the component; as root for a package install of LinuxCNC)
+"
+        "  apt-get install linuxcnc-uspace-dev      (brings halcompile)
+"
+        "  halcompile --install {}
+"
+        "  It installs {}.so into LinuxCNC's module folder (/usr/lib/linuxcnc/modules for the Debian package).
+"
+        "
+"
+        "Route 1: load
+"
+        "1. INI: put KINEMATICS and JOINTS of {} into [KINS] and COORDINATES into [TRAJ], replacing your keys.
+"
+        "   Joint n is machine axis n = letter n of COORDINATES = {} (controller machine coordinates, mm and deg):
+"
+        "   order your [JOINT_n] sections and the drives' nets to match. Remove the COMP_FILE lines of the pins route if
+"
+        "   you loaded it before: the component already holds the axes' own errors (they would count twice).
+"
+        "2. HAL: add {} as a HALFILE after your own. Remove the setp lines and the tool-offset net of your previous
+"
+        "   kinematics module (a pin takes one net only). Changing a dev.* pin changes the model at once: set them only
+"
+        "   with the machine stopped.
+"
+        "3. Modes: switchkins-type 0 (default at start) is joint mode: the axis words are the nominal machine's
+"
+        "   commands and the component puts the real tool where the nominal one would be (run cnccomp testprog's
+"
+        "   programs this way, G49). switchkins-type 1 is tool-tip mode: X Y Z = tool tip in workpiece coordinates,
+"
+        "   world frame = the workpiece frame as it lies at machine zero, with G43 the tool length. To switch from a
+"
+        "   program: net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type, then M68 E3 Q1 (or Q0)
+"
+        "   followed by M66 E0 L0 (as LinuxCNC's switchkins sample configurations do with M428/M429).
+"
+        "4. Check: {}.fail goes true when an inverse does not converge; {}.residual is the tip residual (mm).
+",
+        kKinsSourceFile, kKinsName, kKinsIniFile, coordinates, kKinsHalFile, kKinsName, kKinsName);
+    return t;
+}
+
+/// Both routes: the component route (default) and, when the machine allows, the fitted pins route.
 class LinuxcncBackend final : public Backend {
 public:
     std::string_view name() const override { return "linuxcnc"; }
     std::string_view description() const override {
-        return "LinuxCNC 2.9: joint COMP_FILE_TYPE 1 tables, INI/HAL fragments for xyzac/xyzbc-trt-kins pins (absolute, "
-               "LinuxCNC's frame), G54 program";
+        return "LinuxCNC 2.9: a generated kinematics component holding the whole model (route 1, default), and the "
+               "pins-and-tables route (route 2: joint COMP_FILE tables, xyzac/xyzbc-trt-kins pins, G54 program)";
     }
-    EmitResult emit(const EmitRequest& r) const override { return emitFittedPinsRoute(r); }
+    EmitResult emit(const EmitRequest& r) const override {
+        EmitResult out = emitComponentRoute(r);
+        std::optional<EmitResult> pins;
+        std::string refused;
+        try {
+            pins = emitFittedPinsRoute(r);
+        } catch (const ModelError& e) {
+            refused = e.what();
+        }
+        const std::vector<OutputFile> kinsFiles = out.files;
+        out.files.push_back({"README.txt", componentReadme(r, out, pins ? &*pins : nullptr, refused)});
+        std::string kinsNames, pinsNames;
+        for (const OutputFile& f : kinsFiles) kinsNames += " " + f.name;
+        out.summary.push_back("route 1, generated kinematics component (the whole model; verify and the prediction use it):" + kinsNames);
+        if (pins) {
+            for (const OutputFile& f : pins->files) {
+                pinsNames += " " + f.name;
+                out.files.push_back(f);
+            }
+            out.summary.push_back("route 2, pins and tables (no module to compile; verify it with --controller linuxcnc-pins):" +
+                                  pinsNames);
+            for (const Coverage& c : pins->notCompensated)
+                out.summary.push_back(fmt::format("  route 2 does not compensate {}: {}", c.deviation, c.note));
+        } else {
+            out.summary.push_back("route 2, pins and tables: not written: " + refused);
+        }
+        out.summary.push_back("README.txt: how to build (halcompile --install) and load each route");
+        return out;
+    }
+    /// The component route when its files are there, else the pins route; joint mode (the test programs' mode).
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& m, const std::vector<OutputFile>& files) const override {
+        if (findFile(files, kKinsIniFile)) return std::make_unique<KinsComponentModel>(m, files, KinsMode::Joint);
         return std::make_unique<LinuxcncModel>(m, files, KinsMode::Joint);
+    }
+    bool recognizes(const std::vector<OutputFile>& files) const override { return findFile(files, kKinsIniFile) != nullptr; }
+    /// The component route's files and README.txt.
+    std::vector<OutputFile> ownFiles(const std::vector<OutputFile>& files) const override {
+        if (!findFile(files, kKinsIniFile)) return pinsFiles(files);
+        std::vector<OutputFile> out;
+        for (const OutputFile& f : files)
+            if (f.name == "README.txt" || f.name == kKinsIniFile || f.name == kKinsHalFile || f.name == kKinsSourceFile) out.push_back(f);
+        return out;
     }
 };
 

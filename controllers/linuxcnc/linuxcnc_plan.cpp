@@ -252,8 +252,16 @@ LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
         }
         // Translation location error.
         if (plan.trt && def.side == Side::Workpiece) {
-            if (def.link <= trtLast) yes(fmt::format("position of the {} axis line: {} HAL pins (rot-point / offset), tool-tip mode only", l.name, module));
-            else yes(fmt::format("position of the workpiece origin on the table ({}): G54 of cnccomp-g54.ngc, tool-tip mode only", l.name));
+            // Listed as NOT compensated: the test programs (and every joint-mode program) run with the identity
+            // kinematics, where the pins and the G54 do nothing (linuxcnc_apply.hpp).
+            if (def.link <= trtLast)
+                no(fmt::format("{} position of the {} axis line: {} HAL pins (rot-point / offset); joint-mode programs (cnccomp "
+                               "testprog's) do not get it",
+                               kToolTipModeOnly, l.name, module));
+            else
+                no(fmt::format("{} position of the workpiece origin on the table ({}): G54 of cnccomp-g54.ngc; joint-mode "
+                               "programs do not get it",
+                               kToolTipModeOnly, l.name));
             continue;
         }
         if (def.link <= firstRotary(c)) {
