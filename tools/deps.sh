@@ -5,8 +5,9 @@ packages=(cmake ninja-build g++ pkg-config libeigen3-dev libnlopt-cxx-dev libtin
           libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
           chromium)  # chromium: the HTML report's browser test (skipped without it)
 # Installed without their recommends: linuxcnc-uspace (the real LinuxCNC 2.9, the oracle of tests/linuxcnc) recommends
-# a real-time kernel, Qt and its documentation; the tests run only its simulator (34 MB download).
-lean=(linuxcnc-uspace)
+# a real-time kernel, Qt and its documentation; the tests run only its simulator (34 MB download). linuxcnc-uspace-dev:
+# halcompile and LinuxCNC's headers, which compile the generated kinematics component in the tests.
+lean=(linuxcnc-uspace linuxcnc-uspace-dev)
 missing=(); missing_lean=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
