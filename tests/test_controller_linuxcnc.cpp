@@ -489,10 +489,16 @@ TEST(ControllerLinuxcnc, ComponentRouteHoldsEveryDeviationAndReadsItsPinsBack) {
         std::vector<OutputFile> edited = r.files;
         for (OutputFile& file : edited)
             if (file.name == linuxcnc::kKinsHalFile) {
-                const size_t at = file.content.find("setp cnccomp_kins.dev.");
-                ASSERT_NE(at, std::string::npos);
-                const size_t value = file.content.find(' ', file.content.find(' ', at) + 1) + 1;
-                file.content.replace(value, file.content.find('\n', value) - value, "0.05");
+                // The first location deviation's pin (no coefficient index after its name): 10 um or 10 mrad more.
+                size_t at = 0;
+                for (;;) {
+                    at = file.content.find("\nsetp cnccomp_kins.dev.", at + 1);
+                    ASSERT_NE(at, std::string::npos);
+                    const size_t pinEnd = file.content.find(' ', at + 6);
+                    if (file.content.substr(at + 23, pinEnd - at - 23).find('.') == std::string::npos) break;
+                }
+                const size_t value = file.content.find(' ', at + 6) + 1, end = file.content.find('\n', value);
+                file.content.replace(value, end - value, fmt::format("{:.17g}", std::stod(file.content.substr(value, end - value)) + 0.01));
             }
         const auto changed = backend("linuxcnc").apply(m, edited);
         double moved = 0;

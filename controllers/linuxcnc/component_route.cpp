@@ -142,11 +142,13 @@ JointValues KinsComponentModel::program(const AxisVector& q, double toolLength) 
     JointValues p(c.size());
     for (int i = 0; i < c.size(); ++i) p[i] = c[i] / (machine_->axisLink(i).kind == AxisKind::Rotary ? kDeg : 1.0);
     if (mode_ == KinsMode::Joint) return p;
-    // World = R0·tip + t0 (the workpiece frame at machine zero, nominal); G43 adds the tool length to Z.
+    // The tool tip in the workpiece frame as it lies at machine zero (nominal): R0·tip + t0. The program states it
+    // as it is (G54 = 0, G43 with the tool length): LinuxCNC adds the tool length to Z (emccanon.cc) and the
+    // component takes it off again (tool-offset pin), as trtfuncs.c does.
     const AxisVector qz = machine_->fromController(AxisVector::Zero(c.size()));
     const Pose w0 = nominal_.baseToWorkpiece(qz), t0 = nominal_.baseToTool(qz);
     const Vec3 world = w0.linear() * nominal_.toolPointInWorkpiece(q, nominal_.toolPoint(toolLength)) + w0.translation() - t0.translation();
-    for (int k = 0; k < 3; ++k) p[machine_->requireAxis(std::string(1, "XYZ"[k]))] = world[k] - (k == 2 ? toolLength : 0.0);
+    for (int k = 0; k < 3; ++k) p[machine_->requireAxis(std::string(1, "XYZ"[k]))] = world[k];
     return p;
 }
 

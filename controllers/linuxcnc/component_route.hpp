@@ -17,9 +17,10 @@
 // - joint mode (switchkins-type 0, the component's default): the words are the nominal machine's commands; the
 //   joints put the erroneous machine's tool tip and tool axis where the nominal one puts them, the tool length being
 //   the tool-offset pin = motion.tooloffset.z (0 under G49, as in `cnccomp testprog`'s programs);
-// - tool-tip mode (switchkins-type 1): program X Y Z = the tool tip in the workpiece frame of the description; the
-//   world words LinuxCNC hands the component are program + G54 + (0, 0, tool length) under G43 (emccanon.cc), and
-//   the component's world frame is the workpiece frame as it lies at machine zero (world = R0·p + t0).
+// - tool-tip mode (switchkins-type 1): program X Y Z = the tool tip in the workpiece frame as it lies at machine zero
+//   (R0·p + t0, p in the description's workpiece frame; G54 = 0 here), rotary words = the angles; LinuxCNC hands the
+//   component program + G54 + (0, 0, tool length) under G43 (emccanon.cc), and the component takes the tool-offset
+//   pin off Z again (as trtfuncs.c does), so that the tip is where the program says.
 // The real LinuxCNC is the oracle of this model (tests/linuxcnc).
 #include <memory>
 #include <string>

@@ -270,77 +270,42 @@ std::string componentReadme(const EmitRequest& r, const EmitResult& kins, const 
     const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC 2.9 (component {}, and the pins-and-tables route)", kKinsName), kins);
     std::string t = formatHeader(h, "");
     t += fmt::format(
-        "
-This folder holds two routes. Load ONE of them.
-"
-        "
-"
-        "Route 1, generated kinematics component (the whole model; what cnccomp verify and emit's prediction use):
-"
-        "  {:<20} the component source (C for halcompile)
-"
-        "  {:<20} INI fragment: [KINS] KINEMATICS, JOINTS and [TRAJ] COORDINATES
-"
-        "  {:<20} HAL fragment: the tool-offset net and the deviation values (setp lines)
-",
+        "\nThis folder holds two routes. Load ONE of them.\n"
+        "\n"
+        "Route 1, generated kinematics component (the whole model; what cnccomp verify and emit's prediction use):\n"
+        "  {:<20} the component source (C for halcompile)\n"
+        "  {:<20} INI fragment: [KINS] KINEMATICS, JOINTS and [TRAJ] COORDINATES\n"
+        "  {:<20} HAL fragment: the tool-offset net and the deviation values (setp lines)\n",
         kKinsSourceFile, kKinsIniFile, kKinsHalFile);
     if (pins) {
-        t += "
-Route 2, pins and tables (for a LinuxCNC where modules cannot be compiled; holds only what joint tables
-"
-             "and the xyzac/xyzbc-trt-kins pins can take, see README-pins.txt and the NOT compensated list there):
-";
-        for (const OutputFile& f : pins->files) t += fmt::format("  {}
-", f.name);
-        t += "  Verify it with cnccomp verify --controller linuxcnc-pins --compensation <this folder>.
-";
+        t += "\nRoute 2, pins and tables (for a LinuxCNC where modules cannot be compiled; holds only what joint tables\n"
+             "and the xyzac/xyzbc-trt-kins pins can take, see README-pins.txt and the NOT compensated list there):\n";
+        for (const OutputFile& f : pins->files) t += fmt::format("  {}\n", f.name);
+        t += "  Verify it with cnccomp verify --controller linuxcnc-pins --compensation <this folder>.\n";
     } else {
-        t += fmt::format("
-Route 2, pins and tables: not written for this machine: {}
-", pinsRefused);
+        t += fmt::format("\nRoute 2, pins and tables: not written for this machine: {}\n", pinsRefused);
     }
     t += fmt::format(
-        "
-Route 1: build and install (once per change of the component; as root for a package install of LinuxCNC)
-"
-        "  apt-get install linuxcnc-uspace-dev      (brings halcompile)
-"
-        "  halcompile --install {}
-"
-        "  It installs {}.so into LinuxCNC's module folder (/usr/lib/linuxcnc/modules for the Debian package).
-"
-        "
-"
-        "Route 1: load
-"
-        "1. INI: put KINEMATICS and JOINTS of {} into [KINS] and COORDINATES into [TRAJ], replacing your keys.
-"
-        "   Joint n is machine axis n = letter n of COORDINATES = {} (controller machine coordinates, mm and deg):
-"
-        "   order your [JOINT_n] sections and the drives' nets to match. Remove the COMP_FILE lines of the pins route if
-"
-        "   you loaded it before: the component already holds the axes' own errors (they would count twice).
-"
-        "2. HAL: add {} as a HALFILE after your own. Remove the setp lines and the tool-offset net of your previous
-"
-        "   kinematics module (a pin takes one net only). Changing a dev.* pin changes the model at once: set them only
-"
-        "   with the machine stopped.
-"
-        "3. Modes: switchkins-type 0 (default at start) is joint mode: the axis words are the nominal machine's
-"
-        "   commands and the component puts the real tool where the nominal one would be (run cnccomp testprog's
-"
-        "   programs this way, G49). switchkins-type 1 is tool-tip mode: X Y Z = tool tip in workpiece coordinates,
-"
-        "   world frame = the workpiece frame as it lies at machine zero, with G43 the tool length. To switch from a
-"
-        "   program: net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type, then M68 E3 Q1 (or Q0)
-"
-        "   followed by M66 E0 L0 (as LinuxCNC's switchkins sample configurations do with M428/M429).
-"
-        "4. Check: {}.fail goes true when an inverse does not converge; {}.residual is the tip residual (mm).
-",
+        "\nRoute 1: build and install (once per change of the component; as root for a package install of LinuxCNC)\n"
+        "  apt-get install linuxcnc-uspace-dev      (brings halcompile)\n"
+        "  halcompile --install {}\n"
+        "  It installs {}.so into LinuxCNC's module folder (/usr/lib/linuxcnc/modules for the Debian package).\n"
+        "\n"
+        "Route 1: load\n"
+        "1. INI: put KINEMATICS and JOINTS of {} into [KINS] and COORDINATES into [TRAJ], replacing your keys.\n"
+        "   Joint n is machine axis n = letter n of COORDINATES = {} (controller machine coordinates, mm and deg):\n"
+        "   order your [JOINT_n] sections and the drives' nets to match. Remove the COMP_FILE lines of the pins route if\n"
+        "   you loaded it before: the component already holds the axes' own errors (they would count twice).\n"
+        "2. HAL: add {} as a HALFILE after your own. Remove the setp lines and the tool-offset net of your previous\n"
+        "   kinematics module (a pin takes one net only). Changing a dev.* pin changes the model at once: set them only\n"
+        "   with the machine stopped.\n"
+        "3. Modes: switchkins-type 0 (default at start) is joint mode: the axis words are the nominal machine's\n"
+        "   commands and the component puts the real tool where the nominal one would be (run cnccomp testprog's\n"
+        "   programs this way, G49). switchkins-type 1 is tool-tip mode: X Y Z = tool tip in the workpiece frame as it\n"
+        "   lies at machine zero, rotary words = the angles, with G43 the active tool's length. To switch from a\n"
+        "   program: net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type, then M68 E3 Q1 (or Q0)\n"
+        "   followed by M66 E0 L0 (as LinuxCNC's switchkins sample configurations do with M428/M429).\n"
+        "4. Check: {}.fail goes true when an inverse does not converge; {}.residual is the tip residual (mm).\n",
         kKinsSourceFile, kKinsName, kKinsIniFile, coordinates, kKinsHalFile, kKinsName, kKinsName);
     return t;
 }
