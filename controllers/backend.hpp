@@ -41,6 +41,8 @@ struct EmitResult {
     std::vector<OutputFile> files;
     std::vector<Coverage> compensated;
     std::vector<Coverage> notCompensated;  ///< never dropped silently: also listed in every file header
+    /// Lines `cnccomp emit` prints after the file list (e.g. which route each file set is). May be empty.
+    std::vector<std::string> summary{};
 };
 
 /// The controller with the files loaded. The program commands axis positions meant for the nominal machine;
@@ -74,6 +76,9 @@ public:
     /// Whether a folder's files are this backend's output, by the file names its emit() writes (registry.cpp keeps
     /// the table; a backend may override).
     virtual bool recognizes(const std::vector<OutputFile>& files) const;
+    /// The files of a folder that are this backend's (a folder may hold several routes of one controller, e.g.
+    /// LinuxCNC's component and pins-and-tables routes): verify reads the coverage lists from these. Default: all.
+    virtual std::vector<OutputFile> ownFiles(const std::vector<OutputFile>& files) const { return files; }
 };
 
 /// All registered backends, sorted by name.

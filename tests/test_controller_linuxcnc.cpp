@@ -18,6 +18,8 @@
 #include "controllers/common/evaluate.hpp"
 #include "controllers/common/files.hpp"
 #include "controllers/linuxcnc/comp_table.hpp"
+#include "controllers/linuxcnc/component_route.hpp"
+#include "controllers/linuxcnc/linuxcnc_apply.hpp"
 #include "controllers/linuxcnc/config_files.hpp"
 #include "controllers/linuxcnc/linuxcnc_plan.hpp"
 #include "test_support.hpp"
@@ -33,7 +35,23 @@ const std::vector<Sample> kSamples = {{"multitasking", "multitasking-truth"},
                                       {"controllers-tilting-head-b", "controllers-tilting-head-b"},
                                       {"table-table-bc-offsets", "table-table-bc-offsets-truth"}};
 
-EmitResult emitSample(const Sample& s, const DeviationSet& d) { return testing::emitSample("linuxcnc", s, d); }
+/// The pins-and-tables route (backend linuxcnc-pins); the component route has its tests further down.
+EmitResult emitSample(const Sample& s, const DeviationSet& d) { return testing::emitSample("linuxcnc-pins", s, d); }
+
+/// What the pins route compensates in tool-tip mode: its compensated list and the NOT-compensated entries that say
+/// "tool-tip mode only" (the trt pins and the G54).
+DeviationSet claimedInToolTipMode(const DeviationSet& d, const EmitResult& r) {
+    EmitResult notInToolTip = r;
+    std::erase_if(notInToolTip.notCompensated,
+                  [](const Coverage& c) { return c.note.starts_with(linuxcnc::kToolTipModeOnly); });
+    return claimedOnly(d, notInToolTip);
+}
+
+/// The pins route's apply model in the mode its pins act in: tool-tip mode on a trt machine, joint mode otherwise.
+std::unique_ptr<AppliedCompensation> pinsInToolTipMode(const MachineModel& m, const std::vector<OutputFile>& files) {
+    using namespace linuxcnc;
+    return std::make_unique<LinuxcncModel>(m, files, matchTrt(m) ? KinsMode::ToolTip : KinsMode::Joint);
+}
 
 /// Workspace samples, and the same again with every modulo axis two turns up and three turns down (LinuxCNC looks
 /// its tables up at the raw joint position: C = 725° is not C = 5°).
@@ -142,8 +160,8 @@ TEST(ControllerLinuxcnc, PinsInTheDescriptionsFrameWouldMissByTensOfMillimetres)
     const DeviationSet d = deviations(s);
     const EmitResult r = emitSample(s, d);
     const auto samples = workspaceSamples(m, 3);
-    const DeviationSet claimed = claimedOnly(d, r);
-    const CompensationFigures good = evaluateCompensation(m, claimed, *backend("linuxcnc").apply(m, r.files), samples, 50.0);
+    const DeviationSet claimed = claimedInToolTipMode(d, r);
+    const CompensationFigures good = evaluateCompensation(m, claimed, *pinsInToolTipMode(m, r.files), samples, 50.0);
     EXPECT_LT(good.maxAfter, 1e-4);
     std::vector<OutputFile> wrong = r.files;
     for (OutputFile& f : wrong)
@@ -153,21 +171,22 @@ TEST(ControllerLinuxcnc, PinsInTheDescriptionsFrameWouldMissByTensOfMillimetres)
                                     "setp xyzbc-trt-kins.z-rot-point {}\nsetp xyzbc-trt-kins.x-offset {}\nsetp xyzbc-trt-kins.z-offset {}\n",
                                     p.xRotPoint + 60, p.yRotPoint + 430, p.zRotPoint + 590, p.xOffset, p.zOffset);
         }
-    const CompensationFigures bad = evaluateCompensation(m, claimed, *backend("linuxcnc").apply(m, wrong), samples, 50.0);
+    const CompensationFigures bad = evaluateCompensation(m, claimed, *pinsInToolTipMode(m, wrong), samples, 50.0);
     EXPECT_GT(bad.maxAfter, 10.0);
 }
 
 TEST(ControllerLinuxcnc, CompensatesWhatItClaimsByAtLeastNinetyPercent) {
-    const Backend& b = backend("linuxcnc");
+    const Backend& b = backend("linuxcnc-pins");
     for (const Sample& s : kSamples) {
         const MachineModel& m = machine(s.machine);
         const DeviationSet all = deviations(s);
         const EmitResult r = emitSample(s, all);
-        ASSERT_FALSE(r.compensated.empty()) << s.machine;
-        const DeviationSet claimed = claimedOnly(all, r);
+        ASSERT_FALSE(r.compensated.empty() && claimedInToolTipMode(all, r).present == DeviationSet(m).present) << s.machine;
+        const DeviationSet claimed = claimedInToolTipMode(all, r);
         const auto samples = samplesWithTurns(m, 5);
-        const CompensationFigures f = emitApplyEvaluate(b, m, claimed, samples, 100.0);
-        const CompensationFigures g = emitApplyEvaluate(b, m, all, samples, 100.0);
+        const CompensationFigures f = evaluateCompensation(m, claimed, *pinsInToolTipMode(m, b.emit({m, claimed, "d.csv", "2024-01-01"}).files),
+                                                           samples, 100.0);
+        const CompensationFigures g = evaluateCompensation(m, all, *pinsInToolTipMode(m, r.files), samples, 100.0);
         std::cout << fmt::format("[linuxcnc] {:<28} claimed: max {:8.3f} -> {:7.3f} um, rms {:7.3f} -> {:6.3f} um | "
                                  "full set: max {:8.3f} -> {:7.3f} um ({} points)\n",
                                  s.machine, f.maxBefore / kUm, f.maxAfter / kUm, f.rmsBefore / kUm, f.rmsAfter / kUm,
@@ -241,7 +260,7 @@ TEST(ControllerLinuxcnc, GoldenFilesAreReproducedAndReadBack) {
         const EmitResult r = emitSample(s, deviations(s));
         const std::vector<OutputFile> golden = compareWithGolden("linuxcnc", s.machine, r);
         // The golden files read back into a working compensation.
-        const auto comp = backend("linuxcnc").apply(machine(s.machine), golden);
+        const auto comp = backend("linuxcnc-pins").apply(machine(s.machine), golden);
         ASSERT_NE(comp, nullptr);
         const AxisVector q = AxisVector::Zero(machine(s.machine).axisCount());
         EXPECT_TRUE(comp->driveCommands(q).allFinite());
@@ -324,7 +343,7 @@ TEST(ControllerLinuxcnc, RotaryTablesCoverTheTravelAtASpacingThatDividesATurn) {
         const DeviationDef& ecc = m.deviations[m.deviationIndex("ECC")];
         d.values.segment(ecc.offset, 4) << 8 * kArcsec, -5 * kArcsec, 3 * kArcsec, 2 * kArcsec;
         d.present[m.deviationIndex("ECC")] = 1;
-        const EmitResult r = backend("linuxcnc").emit({m, d, "d.csv", "2024-01-01"});
+        const EmitResult r = backend("linuxcnc-pins").emit({m, d, "d.csv", "2024-01-01"});
         const linuxcnc::CompTable t = linuxcnc::parseCompTable(requireFile(r.files, "C.comp", "test").content, "C.comp");
         // ±360°: 3° (241 lines); ±3600°: 30° (241 lines); every point a multiple of the spacing, ends at the travel.
         const double h = turns == 1 ? 3.0 : 30.0;
@@ -337,8 +356,8 @@ TEST(ControllerLinuxcnc, RotaryTablesCoverTheTravelAtASpacingThatDividesATurn) {
             for (double c : {-2.5, 17.0, 133.3}) EXPECT_NEAR(t.trim(c + 7 * 360.0), t.trim(c), 1e-7) << c;
         }
         // The interpolation error is stated in every header.
-        EXPECT_NE(requireFile(r.files, "README.txt", "test").content.find("C.comp: 241 points"), std::string::npos);
-        EXPECT_NE(requireFile(r.files, "README.txt", "test").content.find("largest interpolation error"), std::string::npos);
+        EXPECT_NE(requireFile(r.files, "README-pins.txt", "test").content.find("C.comp: 241 points"), std::string::npos);
+        EXPECT_NE(requireFile(r.files, "README-pins.txt", "test").content.find("largest interpolation error"), std::string::npos);
     }
     // No finite travel: refused with the reason.
     std::string xml = test::readText(dir.file("m1.xml"));
@@ -349,7 +368,7 @@ TEST(ControllerLinuxcnc, RotaryTablesCoverTheTravelAtASpacingThatDividesATurn) {
     di.values[inf.deviations[0].offset] = 1e-5;
     di.present[0] = 1;
     try {
-        backend("linuxcnc").emit({inf, di, "d.csv", "2024-01-01"});
+        backend("linuxcnc-pins").emit({inf, di, "d.csv", "2024-01-01"});
         FAIL() << "infinite travel accepted";
     } catch (const ModelError& e) {
         EXPECT_NE(std::string(e.what()).find("travel"), std::string::npos) << e.what();
@@ -360,7 +379,7 @@ TEST(ControllerLinuxcnc, TrtNeedsTheRotaryJointsZeroedWhereTheTableIsLevel) {
     test::ScratchDir dir("linuxcnc-rotary-zero");
     const MachineModel m = fourierMachine(dir, 1, R"(machine-zero="90")");
     try {
-        backend("linuxcnc").emit({m, DeviationSet(m), "d.csv", "2024-01-01"});
+        backend("linuxcnc-pins").emit({m, DeviationSet(m), "d.csv", "2024-01-01"});
         FAIL() << "a tilt axis with machine-zero 90 accepted";
     } catch (const ModelError& e) {
         EXPECT_NE(std::string(e.what()).find("machine-zero"), std::string::npos) << e.what();
@@ -379,7 +398,7 @@ TEST(ControllerLinuxcnc, FilesSayVersionFrameBacklashAndHowToMerge) {
                 EXPECT_NE(f.content.find("pins: ABSOLUTE, LinuxCNC's frame"), std::string::npos) << s.machine << "/" << f.name;
             }
         }
-        const std::string readme = requireFile(r.files, "README.txt", "test").content;
+        const std::string readme = requireFile(r.files, "README-pins.txt", "test").content;
         EXPECT_NE(readme.find("add +b/2 to every forward trim and -b/2 to every reverse trim"), std::string::npos) << s.machine;
         const std::string ini = requireFile(r.files, "cnccomp.ini", "test").content;
         EXPECT_EQ(ini.find("WRAPPED_ROTARY"), std::string::npos) << s.machine;  // tables cover the travel instead
@@ -401,7 +420,7 @@ TEST(ControllerLinuxcnc, ImplausibleValuesAreRefused) {
     const MachineModel& m = machine("multitasking");
     DeviationSet d(m);
     d.set("EX0C", 12.0);  // 12 mm: a unit mistake
-    EXPECT_THROW(backend("linuxcnc").emit({m, d, "x.csv", "2024-01-01"}), ModelError);
+    EXPECT_THROW(backend("linuxcnc-pins").emit({m, d, "x.csv", "2024-01-01"}), ModelError);
 }
 
 TEST(ControllerLinuxcnc, EmitCommandWritesFilesAndNeverAnInput) {
@@ -413,8 +432,13 @@ TEST(ControllerLinuxcnc, EmitCommandWritesFilesAndNeverAnInput) {
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("NOT compensated:"), std::string::npos);
     EXPECT_NE(r.out.find("EB0A"), std::string::npos);
-    for (const char* f : {"X.comp", "C.comp", "cnccomp.ini", "cnccomp.hal", "cnccomp-g54.ngc", "README.txt"})
+    for (const char* f : {"X.comp", "C.comp", "cnccomp.ini", "cnccomp.hal", "cnccomp-g54.ngc", "README-pins.txt", "README.txt",
+                          "cnccomp_kins.comp", "cnccomp-kins.ini", "cnccomp-kins.hal"})
         EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("out/") + f))) << f;
+    // emit says which route each file set is.
+    EXPECT_NE(r.out.find("route 1, generated kinematics component"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("route 2, pins and tables"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("route 2 does not compensate EB0A"), std::string::npos) << r.out;
     // The deviation file sits where README.txt would go: nothing is written.
     std::filesystem::create_directories(dir.file("in"));
     std::filesystem::copy_file(dfile, dir.file("in/README.txt"));
@@ -429,6 +453,196 @@ TEST(ControllerLinuxcnc, EmitCommandWritesFilesAndNeverAnInput) {
     EXPECT_NE(unknown.out.find("linuxcnc"), std::string::npos);
     const auto help = test::runCli("emit --help");
     EXPECT_NE(help.out.find("linuxcnc"), std::string::npos);
+}
+
+
+// ---- the component route (issue 17) -------------------------------------------------------------------------------
+
+TEST(ControllerLinuxcnc, ComponentRouteHoldsEveryDeviationAndReadsItsPinsBack) {
+    // Oracle: the exact kinematics of the erroneous machine (tool tip and axis at the drive commands the files give).
+    // The generated component itself is checked against the real LinuxCNC in tests/linuxcnc.
+    for (const Sample& s : kSamples) {
+        const MachineModel& m = machine(s.machine);
+        const DeviationSet all = deviations(s);
+        const EmitResult r = testing::emitSample("linuxcnc", s, all);
+        EXPECT_TRUE(r.notCompensated.empty()) << s.machine;
+        size_t present = 0;
+        for (char p : all.present) present += p != 0;
+        EXPECT_EQ(r.compensated.size(), present) << s.machine;
+        for (const char* f : {linuxcnc::kKinsSourceFile, linuxcnc::kKinsIniFile, linuxcnc::kKinsHalFile, "README.txt", "cnccomp.ini"})
+            EXPECT_NE(findFile(r.files, f), nullptr) << s.machine << " " << f;
+        const std::string readme = requireFile(r.files, "README.txt", "test").content;
+        EXPECT_NE(readme.find("halcompile --install cnccomp_kins.comp"), std::string::npos);
+        EXPECT_NE(readme.find("Route 2, pins and tables"), std::string::npos);
+        const auto comp = backend("linuxcnc").apply(m, r.files);
+        const auto* kins = dynamic_cast<const linuxcnc::KinsComponentModel*>(comp.get());
+        ASSERT_NE(kins, nullptr) << s.machine;
+        EXPECT_EQ((kins->values().values - all.values).cwiseAbs().maxCoeff(), 0.0) << s.machine;  // %.17g round trip
+        const auto samples = workspaceSamples(m, 4);
+        const CompensationFigures f = evaluateCompensation(m, all, *comp, samples, 0.0);
+        std::cout << fmt::format("[linuxcnc component] {:<28} tip max {:8.3f} -> {:.2e} um, axis {:.2f} -> {:.2e} arcsec ({} points)\n",
+                                 s.machine, f.maxBefore / kUm, f.maxAfter / kUm, f.maxAxisBefore / kArcsec, f.maxAxisAfter / kArcsec,
+                                 f.points);
+        EXPECT_GT(f.maxBefore, 5 * kUm) << s.machine;
+        EXPECT_LT(f.maxAfter, 1e-6 * kUm * 1e3) << s.machine;  // 1 nm: the whole model
+        // The model reads the values from the HAL file: zero one pin there and the drive commands change.
+        std::vector<OutputFile> edited = r.files;
+        for (OutputFile& file : edited)
+            if (file.name == linuxcnc::kKinsHalFile) {
+                // The first location deviation's pin (no coefficient index after its name): 10 um or 10 mrad more.
+                size_t at = 0;
+                for (;;) {
+                    at = file.content.find("\nsetp cnccomp_kins.dev.", at + 1);
+                    ASSERT_NE(at, std::string::npos);
+                    const size_t pinEnd = file.content.find(' ', at + 6);
+                    if (file.content.substr(at + 23, pinEnd - at - 23).find('.') == std::string::npos) break;
+                }
+                const size_t value = file.content.find(' ', at + 6) + 1, end = file.content.find('\n', value);
+                file.content.replace(value, end - value, fmt::format("{:.17g}", std::stod(file.content.substr(value, end - value)) + 0.01));
+            }
+        const auto changed = backend("linuxcnc").apply(m, edited);
+        double moved = 0;
+        for (const AxisVector& q : samples) moved = std::max(moved, (changed->driveCommands(q) - comp->driveCommands(q)).cwiseAbs().maxCoeff());
+        EXPECT_GT(moved, 1e-3) << s.machine;
+        // The pins route of the same folder is verified when named.
+        EXPECT_NE(dynamic_cast<const linuxcnc::LinuxcncModel*>(backend("linuxcnc-pins").apply(m, r.files).get()), nullptr);
+    }
+}
+
+TEST(ControllerLinuxcnc, ComponentRouteReadersNameFileAndLine) {
+    const Sample& s = kSamples[1];
+    const MachineModel& m = machine(s.machine);
+    const EmitResult r = testing::emitSample("linuxcnc", s, deviations(s));
+    const auto withHal = [&](const std::string& extra) {
+        std::vector<OutputFile> f = r.files;
+        for (OutputFile& x : f)
+            if (x.name == linuxcnc::kKinsHalFile) x.content += extra;
+        return f;
+    };
+    DeviationSet v(m);
+    const auto line = [&](const std::vector<OutputFile>& f) { return inputErrorLine([&] { linuxcnc::readKinsFiles(m, f, v); }); };
+    const int n = static_cast<int>(splitLines(requireFile(r.files, linuxcnc::kKinsHalFile, "t").content).size());
+    EXPECT_EQ(line(withHal("setp cnccomp_kins.dev.nosuch 1\n")), n + 1);
+    EXPECT_EQ(line(withHal("setp cnccomp_kins.dev.ex0c 1\n")), n + 1);  // set twice
+    EXPECT_EQ(line(withHal("setp cnccomp_kins.dev.ex0c x\n")), n + 1);
+    EXPECT_EQ(line(withHal("loadusr halui\n")), n + 1);
+}
+
+TEST(ControllerLinuxcnc, TestProgramsRunInJointModeWhereTheTrtPinsDoNothing) {
+    // Issue 17: verify ran cnccomp testprog's machine-coordinate programs through the trt pins (tool-tip mode) and
+    // predicted 18.7 um where the real LinuxCNC, running them with the identity kinematics, gave 60.1 um.
+    // 1. The programs say their mode.
+    test::ScratchDir dir("linuxcnc-joint-mode");
+    const std::string mfile = test::sourcePath("samples/machines/table-table-ac.xml");
+    const std::string plan = test::sourcePath("samples/plans/table-table-ac-kinematic.xml");
+    const std::string truth = test::sourcePath("samples/deviations/table-table-ac-truth.csv");
+    const auto tp = test::runCli("testprog --machine " + mfile + " --plan " + plan + " --dialect linuxcnc --out " + dir.file("tp"));
+    ASSERT_EQ(tp.exitCode, 0) << tp.out;
+    int programs = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("tp")))
+        if (e.path().extension() == ".ngc") {
+            ++programs;
+            EXPECT_NE(test::readText(e.path().string()).find("kinematics mode: joint"), std::string::npos) << e.path();
+        }
+    EXPECT_GT(programs, 0);
+    // 2. Joint mode: the drives get the program words plus the table trims, whatever the pins and G54 say. Oracle:
+    // the files' own tables read independently (parseCompTable), and the folder with the pins set to their nominal
+    // values (the "tables only" run of the review) gives the same prediction.
+    const auto emit = test::runCli("emit --controller linuxcnc-pins --machine " + mfile + " --deviations " + truth + " --out " +
+                                   dir.file("pins") + " --date 2024-01-01");
+    ASSERT_EQ(emit.exitCode, 0) << emit.out;
+    const MachineModel m = readMachineXml(mfile);
+    std::filesystem::copy(dir.file("pins"), dir.file("tables"));
+    {
+        std::string hal = test::readText(dir.file("pins/cnccomp.hal")), nominal;
+        for (const auto& l : splitLines(hal)) {
+            const std::string t(l.text);
+            if (t.starts_with("# x-rot") || t.starts_with("# y-") || t.starts_with("# z-")) {
+                const auto tok = tokens(t);  // "# pin nominal <value> delta ..."
+                nominal += fmt::format("setp xyzac-trt-kins.{} {}\n", tok[1], tok[3]);
+            }
+        }
+        ASSERT_FALSE(nominal.empty()) << hal;
+        test::writeText(dir.file("tables/cnccomp.hal"), nominal);
+        test::writeText(dir.file("tables/cnccomp-g54.ngc"), "G10 L2 P1 X0 Y0 Z0\nM2\n");
+    }
+    const auto verifyResidual = [&](const std::string& folder) {
+        const auto v = test::runCli("verify --controller linuxcnc-pins --machine " + mfile + " --plan " + plan + " --compensation " +
+                                    folder + " --truth " + truth);
+        EXPECT_EQ(v.exitCode, 0) << v.out;
+        const size_t at = v.out.find("residual (largest span after compensation): ");
+        EXPECT_NE(at, std::string::npos) << v.out;
+        return at == std::string::npos ? -1.0 : std::stod(v.out.substr(at + 44));
+    };
+    const double withPins = verifyResidual(dir.file("pins")), tablesOnly = verifyResidual(dir.file("tables"));
+    std::cout << fmt::format("[linuxcnc joint mode] verify residual: emitted pins route {:.3f} um, tables-only folder {:.3f} um\n",
+                             withPins, tablesOnly);
+    EXPECT_EQ(withPins, tablesOnly);
+    std::vector<OutputFile> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("pins")))
+        files.push_back({e.path().filename().string(), test::readText(e.path().string())});
+    const auto joint = backend("linuxcnc-pins").apply(m, files);
+    const linuxcnc::LinuxcncModel tip(m, files, linuxcnc::KinsMode::ToolTip);
+    double differs = 0;
+    for (const AxisVector& q : workspaceSamples(m, 3)) {
+        const AxisVector c = m.toController(q);
+        AxisVector expect = q;
+        for (const char* axis : {"X", "Y", "Z", "A", "C"}) {
+            const int a = m.requireAxis(axis);
+            const OutputFile* table = findFile(files, std::string(axis) + ".comp");
+            if (!table) continue;
+            const double unit = m.axisLink(a).kind == AxisKind::Rotary ? kDeg : 1.0;
+            expect[a] += linuxcnc::parseCompTable(table->content, table->name).trim(c[a] / unit) * unit;
+        }
+        EXPECT_LT((joint->driveCommands(q) - expect).cwiseAbs().maxCoeff(), 1e-12);
+        differs = std::max(differs, (tip.driveCommands(q) - expect).cwiseAbs().maxCoeff());
+    }
+    EXPECT_GT(differs, 1e-3);  // in tool-tip mode the pins act (tens of um on this machine)
+}
+
+TEST(ControllerLinuxcnc, TableTableAxisTurningTheOtherWayIsRefusedByNameInThePinsRoute) {
+    // Issue 17: C about −Z silently got trivkins, and README's "replace the key" swapped out the user's tool-tip
+    // kinematics. The pins route refuses it naming the axis; the component route holds any structure.
+    test::ScratchDir dir("linuxcnc-minus-z");
+    std::string xml = test::readText(test::sourcePath("samples/machines/table-table-ac.xml"));
+    const size_t c = xml.find("name=\"C\"");
+    ASSERT_NE(c, std::string::npos);
+    const size_t d = xml.find("direction=\"0 0 1\"", c);
+    ASSERT_NE(d, std::string::npos) << "the sample's C axis direction";
+    xml.replace(d, 17, "direction=\"0 0 -1\"");
+    test::writeText(dir.file("m.xml"), xml);
+    const MachineModel m = readMachineXml(dir.file("m.xml"));
+    DeviationSet dev(m);
+    dev.set("EX0C", 0.01);
+    try {
+        backend("linuxcnc-pins").emit({m, dev, "d.csv", "2024-01-01"});
+        FAIL() << "C about -Z accepted by the pins route";
+    } catch (const ModelError& e) {
+        EXPECT_NE(std::string(e.what()).find("rotary axis C turns about -Z"), std::string::npos) << e.what();
+    }
+    const EmitResult r = backend("linuxcnc").emit({m, dev, "d.csv", "2024-01-01"});
+    EXPECT_EQ(findFile(r.files, "cnccomp.ini"), nullptr);
+    EXPECT_NE(requireFile(r.files, "README.txt", "t").content.find("not written for this machine: "), std::string::npos);
+    const auto comp = backend("linuxcnc").apply(m, r.files);
+    const CompensationFigures f = evaluateCompensation(m, dev, *comp, workspaceSamples(m, 3), 0.0);
+    EXPECT_LT(f.maxAfter, 1e-6);
+}
+
+TEST(ControllerLinuxcnc, EveryEmittedProgramLineFitsLinuxcncsLineBuffer) {
+    // LinuxCNC 2.9 aborts a program at a line of 254 characters or more, line end included ("Command too long",
+    // interp_read.cc): the review's cnccomp-g54.ngc had comment lines of 258-270 characters and G54 stayed 0.
+    for (const Sample& s : kSamples)
+        for (const char* b : {"linuxcnc", "linuxcnc-pins"}) {
+            const EmitResult r = testing::emitSample(b, s, deviations(s));
+            for (const OutputFile& f : r.files) {
+                if (!f.name.ends_with(".ngc")) continue;
+                for (const auto& l : splitLines(f.content))
+                    EXPECT_LE(l.text.size(), linuxcnc::kMaxProgramLine) << s.machine << "/" << f.name << ":" << l.number;
+            }
+        }
+    EXPECT_EQ(linuxcnc::wrapCommentLines("; " + std::string(300, 'a') + "\nG0 X1\n", "; ", 100).find("G0 X1"), 318u);
+    const std::string w = linuxcnc::wrapCommentLines("; one two three four five six\n", "; ", 14);
+    EXPECT_EQ(w, "; one two\n;   three four\n;   five six\n");
 }
 
 }  // namespace

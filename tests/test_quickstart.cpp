@@ -118,8 +118,12 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     EXPECT_LT(rows.at("ideal").verifiedAfter, 0.2);
     EXPECT_LT(rows.at("corrected-programs").verifiedAfter, 0.2);
     EXPECT_LT(rows.at("isg").verifiedAfter, 0.2);       // ISG's table holds every deviation of this machine
-    EXPECT_EQ(rows.at("linuxcnc").left, 10);             // LinuxCNC's pins and tables hold 3 of the 13
-    EXPECT_GT(rows.at("linuxcnc").verifiedAfter, 10.0);  // and the report says so instead of hiding it
+    // LinuxCNC's default route, the generated kinematics component, holds the whole model (issue 17): nothing is left.
+    // Not yet within 0.1 um of span: the test programs run in joint mode under G49, so the component corrects the tool
+    // at the tool-offset pin's length 0 and, where the tool axis cannot be matched (B near 0 on this machine), the
+    // ball at 360 mm is off (run B-Y: 24.4 um). Known gap of this round (README, LinuxCNC).
+    EXPECT_EQ(rows.at("linuxcnc").left, 0);
+    EXPECT_LT(rows.at("linuxcnc").verifiedAfter, rows.at("linuxcnc").verifiedBefore);
     EXPECT_NE(r.out.find("every output: " + out + "/"), std::string::npos);
 
     if (!test::chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";

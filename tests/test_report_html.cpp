@@ -135,7 +135,7 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
                           " --noise-um 0.2 --seed 5");
     ASSERT_EQ(r.exitCode, 0) << r.out;
     r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
-                     dir.file("d.csv") + " --report " + dir.file("report.html") + " --report-controllers linuxcnc,isg");
+                     dir.file("d.csv") + " --report " + dir.file("report.html") + " --report-controllers linuxcnc-pins,isg");
     ASSERT_EQ(r.exitCode, 0) << r.out;
     // Every file of the report.
     for (const char* f : {"report.html", "report.summary.json", "report-polar-B-X.svg", "report-polar-C-radial-RB2.svg",
@@ -158,8 +158,8 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
     EXPECT_EQ(j["unidentified"].array.size(), 0u);
     EXPECT_EQ(j["maps"].array.size(), 3u);
     ASSERT_EQ(j["controllers"].array.size(), 2u);
-    EXPECT_EQ(j["controllers"][0]["name"].string, "linuxcnc");
-    EXPECT_GT(j["controllers"][0]["not_compensated"].array.size(), 0u);  // LinuxCNC tables cannot hold squareness
+    EXPECT_EQ(j["controllers"][0]["name"].string, "linuxcnc-pins");
+    EXPECT_GT(j["controllers"][0]["not_compensated"].array.size(), 0u);  // LinuxCNC's tables cannot hold squareness
     EXPECT_LT(j["controllers"][1]["after_max_um"].num(), 0.1 * j["controllers"][1]["before_max_um"].num());  // ISG: all
     // Before vs after on every run: the compensation removes almost all of the circular deviation.
     for (const JsonValue& run : j["runs"].array) {

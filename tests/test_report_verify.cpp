@@ -65,10 +65,11 @@ std::vector<std::string> names(const JsonValue& array, const char* key = nullptr
 
 TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     test::ScratchDir dir("verify-report");
-    const auto r = emitAndVerify(dir, "linuxcnc");
+    // LinuxCNC's pins-and-tables route: a controller that leaves deviations (its component route leaves none).
+    const auto r = emitAndVerify(dir, "linuxcnc-pins");
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("report -> "), std::string::npos);
-    const std::string base = dir.file("linuxcnc-report/");
+    const std::string base = dir.file("linuxcnc-pins-report/");
     for (const char* f : {"report.html", "report.summary.json", "report-polar-B-X.svg", "report-polar-C-radial-RB2.svg",
                           "report-map-1.svg", "report-map-2.svg", "verify.json"})
         EXPECT_TRUE(fs::exists(base + f)) << f;
@@ -111,10 +112,10 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     // the residual and the volumetric figures verify reports.
     ASSERT_EQ(s["controllers"].array.size(), 1u);
     const JsonValue& c = s["controllers"][0];
-    EXPECT_EQ(c["name"].string, "linuxcnc");
+    EXPECT_EQ(c["name"].string, "linuxcnc-pins");
     const std::vector<std::string> files = names(c["files"]);
-    EXPECT_NE(std::find(files.begin(), files.end(), (fs::path(dir.file("linuxcnc")) / "cnccomp.ini").string()), files.end());
-    const std::string ini = test::readText(dir.file("linuxcnc/cnccomp.ini"));
+    EXPECT_NE(std::find(files.begin(), files.end(), (fs::path(dir.file("linuxcnc-pins")) / "cnccomp.ini").string()), files.end());
+    const std::string ini = test::readText(dir.file("linuxcnc-pins/cnccomp.ini"));
     EXPECT_EQ(names(c["compensated"]), headerList(ini, "compensated:"));
     EXPECT_EQ(names(c["not_compensated"]), headerList(ini, "NOT compensated:"));
     EXPECT_EQ(c["not_compensated"].array.size(), 10u);
@@ -139,7 +140,7 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     EXPECT_GT(s["maps"][1]["plane_max_um"].num(), 1.0);
     // The page carries the reasons and the values of what is left.
     const std::string html = test::readText(base + "report.html");
-    EXPECT_NE(html.find("Deviations linuxcnc leaves, and why"), std::string::npos);
+    EXPECT_NE(html.find("Deviations linuxcnc-pins leaves, and why"), std::string::npos);
     EXPECT_NE(html.find("LinuxCNC has no cross-axis compensation"), std::string::npos);
     for (const char* bad : {"src=", "href=", "<link", "@import", "<script>"}) EXPECT_EQ(html.find(bad), std::string::npos) << bad;
 }
@@ -248,24 +249,24 @@ TEST(VerifyReport, CorrectedProgramsHaveNoMapAndTheIdealCompensationListsItsSet)
 
 TEST(VerifyReport, AFailedGateStillWritesTheReportAndAFailedCommandWritesNothing) {
     test::ScratchDir dir("verify-report-gate");
-    auto r = emitAndVerify(dir, "linuxcnc", "--max-residual-um 1");
+    auto r = emitAndVerify(dir, "linuxcnc-pins", "--max-residual-um 1");
     EXPECT_EQ(r.exitCode, 1) << r.out;
-    const JsonValue s = readJsonFile(dir.file("linuxcnc-report/report.summary.json"));
+    const JsonValue s = readJsonFile(dir.file("linuxcnc-pins-report/report.summary.json"));
     bool failed = false;
     for (const JsonValue& f : s["facts"].array) failed = failed || (f[0].string == "gate" && f[1].string.find("FAILED") != std::string::npos);
     EXPECT_TRUE(failed);
-    EXPECT_FALSE(readJsonFile(dir.file("linuxcnc-report/verify.json"))["passed"].boolean);
+    EXPECT_FALSE(readJsonFile(dir.file("linuxcnc-pins-report/verify.json"))["passed"].boolean);
     // --json names a folder: nothing at all is written, not even the report's folder.
     fs::create_directories(dir.file("taken"));
-    r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("linuxcnc") + " --truth " +
+    r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("linuxcnc-pins") + " --truth " +
                      kTruth + " --report " + dir.file("new/report.html") + " --json " + dir.file("taken"));
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_FALSE(fs::exists(dir.file("new"))) << r.out;
     // A report never overwrites an input: here the controller's own file.
-    r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("linuxcnc") + " --truth " +
-                     kTruth + " --report " + dir.file("x/r.html") + " --json " + dir.file("linuxcnc/cnccomp.ini"));
+    r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("linuxcnc-pins") + " --truth " +
+                     kTruth + " --report " + dir.file("x/r.html") + " --json " + dir.file("linuxcnc-pins/cnccomp.ini"));
     EXPECT_EQ(r.exitCode, 2) << r.out;
-    EXPECT_NE(test::readText(dir.file("linuxcnc/cnccomp.ini")).find("[KINS]"), std::string::npos);
+    EXPECT_NE(test::readText(dir.file("linuxcnc-pins/cnccomp.ini")).find("[KINS]"), std::string::npos);
     EXPECT_FALSE(fs::exists(dir.file("x")));
 }
 

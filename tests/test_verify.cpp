@@ -211,8 +211,9 @@ TEST(Verify, EveryBackendsDamagedFilesFailTheGate) {
          "NC_CEC.INI", "$AN_CEC[0,5]=", "NC_CEC.INI:32: CEC table 0: (MAX-MIN)/STEP+1 = 201 points expected, 200 given"},
         {"fanuc-30i", true, "CNCCOMP.PRM", "N19702Q1L1P-0.0680", "N19702Q1L1P0.0680", "CNCCOMP.PRM", "N19704Q1L1P",
          "CNCCOMP.PRM:36: parameter 19704 is missing"},
-        {"linuxcnc", true, "cnccomp.hal", "setp xyzac-trt-kins.z-rot-point -0.068000", "setp xyzac-trt-kins.z-rot-point 0.068000",
-         "cnccomp.hal", "setp xyzac-trt-kins.y-offset", ""},
+        // LinuxCNC's component route (its default): the deviation pins of cnccomp-kins.hal.
+        {"linuxcnc", true, "cnccomp-kins.hal", "setp cnccomp_kins.dev.ez0a -0.068", "setp cnccomp_kins.dev.ez0a 0.068",
+         "cnccomp-kins.hal", "setp cnccomp_kins.dev.ey0a", "pin cnccomp_kins.dev.ey0a is not set"},
         {"generic", false, "map.csv", "\n0.000000,-180.000000,-400.000000,-500.000000,-200.000000,-107.159320,91.304743,",
          "\n0.000000,-180.000000,-400.000000,-500.000000,-200.000000,-107.159320,-91.304743,", "map.csv",
          "\n0.000000,-180.000000,-400.000000,-500.000000,-200.000000,", "map.csv:27: 1039 rows do not form a full grid (1040 nodes)"},
@@ -324,13 +325,13 @@ TEST(Verify, NotCompensatedListReadFromAnyCommentSyntax) {
 }
 
 TEST(Verify, EmitWarnsWhenItsFilesLeaveMoreThanNoCompensation) {
-    // On the multi-tasking sample the LinuxCNC files correct the spindle and C offsets but cannot hold the squareness
+    // On the multi-tasking sample LinuxCNC's pins-and-tables route corrects the spindle and C offsets but cannot hold the squareness
     // and tilts, which partly cancelled them: the predicted ball-bar span grows (86.7 against 70.2 um). The ISG files
     // hold every deviation: no warning.
     test::ScratchDir dir("emit-worse");
     const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
                       t = src("samples/deviations/multitasking-truth.csv");
-    auto r = test::runCli("emit --controller linuxcnc --machine " + m + " --deviations " + t + " --plan " + p + " --out " +
+    auto r = test::runCli("emit --controller linuxcnc-pins --machine " + m + " --deviations " + t + " --plan " + p + " --out " +
                           dir.file("l"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("WARNING: on this machine these files leave MORE error than no compensation (ball-bar span)"),

@@ -30,7 +30,13 @@ IniFragment parseIni(const std::string& text, const std::string& name) {
             ini.kinematics = std::string(tok[0]);
             for (size_t i = 1; i < tok.size(); ++i)
                 if (tok[i].starts_with("coordinates=")) ini.coordinates = std::string(tok[i].substr(12));
-            if (ini.coordinates.empty()) throw InputError(name, l.number, "KINEMATICS needs coordinates=LETTERS");
+        } else if (section == "KINS" && key == "JOINTS") {
+            const auto n = parseNumber(value);
+            if (!n || *n < 1 || *n > 16 || *n != static_cast<int>(*n)) throw InputError(name, l.number, "JOINTS must be a count 1..16");
+            ini.joints = static_cast<int>(*n);
+        } else if (section == "TRAJ" && key == "COORDINATES") {
+            for (char c : value)
+                if (c != ' ') ini.trajCoordinates += c;
         } else if (section.starts_with("JOINT_")) {
             const auto n = parseNumber(std::string_view(section).substr(6));
             if (!n || *n < 0 || *n != static_cast<int>(*n)) throw InputError(name, l.number, fmt::format("bad section [{}]", section));
@@ -75,6 +81,34 @@ std::optional<TrtPins> parseHal(const std::string& text, const std::string& name
     }
     if (!any) return std::nullopt;
     return p;
+}
+
+std::string wrapCommentLines(const std::string& text, const std::string& prefix, size_t width) {
+    std::string out;
+    for (const TextLine& l : splitLines(text)) {
+        std::string_view rest = l.text;
+        if (rest.size() <= width || !rest.starts_with(prefix)) {
+            out += std::string(rest) + "\n";
+            continue;
+        }
+        rest.remove_prefix(prefix.size());
+        std::string lead = prefix;
+        while (!rest.empty()) {
+            const size_t room = width - lead.size();
+            size_t cut = rest.size();
+            if (cut > room) {
+                cut = rest.rfind(' ', room);
+                if (cut == std::string_view::npos || cut == 0) cut = room;  // one long word: cut it
+            }
+            std::string_view piece = rest.substr(0, cut);
+            while (!piece.empty() && piece.back() == ' ') piece.remove_suffix(1);
+            out += lead + std::string(piece) + "\n";
+            rest.remove_prefix(cut);
+            while (!rest.empty() && rest.front() == ' ') rest.remove_prefix(1);
+            lead = prefix + "  ";
+        }
+    }
+    return out;
 }
 
 std::array<double, 3> parseWorkOffset(const std::string& text, const std::string& name) {

@@ -423,7 +423,8 @@ static int ck_inverse_model(int type, const double *w, const double *current, do
     } else {
         /* tool-tip mode: X Y Z are the tip in the world frame, the rotary words the angles */
         double p[3], tipn[3], nom[CK_NAX];
-        for (k = 0; k < 3; ++k) p[k] = w[ck_xyz[k]] - ck_t0[k];
+        /* G43: LinuxCNC adds the tool length to the Z word (emccanon.cc); taken off as trtfuncs.c does */
+        for (k = 0; k < 3; ++k) p[k] = w[ck_xyz[k]] - ck_t0[k] - (k == 2 ? L : 0.0);
         for (k = 0; k < 3; ++k) tip_t[k] = ck_R0[0][k] * p[0] + ck_R0[1][k] * p[1] + ck_R0[2][k] * p[2];
         for (i = 0; i < CK_NAX; ++i) nom[i] = anchor[i];
         ck_tool(nom, L, 0, tipn, ax_t, 0); /* the nominal tool axis depends on the rotary axes only */
@@ -491,7 +492,7 @@ int kinematicsForward(const double *joints, EmcPose *pos, const KINEMATICS_FORWA
         int k;
         ck_tool(jm, L, 1, tip, ax, 0);
         for (k = 0; k < 3; ++k)
-            w[ck_xyz[k]] = ck_R0[k][0] * tip[0] + ck_R0[k][1] * tip[1] + ck_R0[k][2] * tip[2] + ck_t0[k];
+            w[ck_xyz[k]] = ck_R0[k][0] * tip[0] + ck_R0[k][1] * tip[1] + ck_R0[k][2] * tip[2] + ck_t0[k] + (k == 2 ? L : 0.0);
     }
     for (pass = 0; pass < CK_FORWARD_PASSES; ++pass) {
         double d = 0.0;

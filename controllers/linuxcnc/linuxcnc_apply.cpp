@@ -23,9 +23,11 @@ std::optional<TrtType> trtOfChains(const MachineModel& m) {
 
 }  // namespace
 
-LinuxcncModel::LinuxcncModel(const MachineModel& m, const std::vector<OutputFile>& files) : machine_(&m), nominal_(m) {
+LinuxcncModel::LinuxcncModel(const MachineModel& m, const std::vector<OutputFile>& files, KinsMode mode)
+    : machine_(&m), mode_(mode), nominal_(m) {
     const IniFragment ini = parseIni(requireFile(files, kIniFile, "LinuxCNC").content, kIniFile);
     coordinates_ = ini.coordinates;
+    if (coordinates_.empty()) throw InputError(kIniFile, 0, "the KINEMATICS line needs coordinates=LETTERS");
     if (static_cast<int>(coordinates_.size()) != m.axisCount())
         throw InputError(kIniFile, 0, fmt::format("coordinates={} do not match the {} axes of machine '{}'", coordinates_,
                                                   m.axisCount(), m.name));
@@ -56,6 +58,8 @@ LinuxcncModel::LinuxcncModel(const MachineModel& m, const std::vector<OutputFile
         throw InputError(kIniFile, 0, fmt::format("kinematics {} is not modelled (trivkins, xyzac-trt-kins, xyzbc-trt-kins)",
                                                   ini.kinematics));
     }
+    if (mode_ == KinsMode::ToolTip && !trt_)
+        throw ModelError(fmt::format("{}: {} has no tool-tip mode (only xyzac/xyzbc-trt-kins switch to it)", kIniFile, ini.kinematics));
     tables_.resize(coordinates_.size());
     for (const auto& [n, file] : ini.compFile) {
         if (n >= static_cast<int>(coordinates_.size()))
@@ -71,7 +75,7 @@ JointValues LinuxcncModel::program(const AxisVector& q, double toolLength) const
     const int n = static_cast<int>(coordinates_.size());
     JointValues p(n);
     for (int i = 0; i < n; ++i) p[i] = c[jointAxis_[i]] / unit_[i];
-    if (trt_) {
+    if (mode_ == KinsMode::ToolTip) {
         // With the module's rotary joints at 0 the workpiece frame's axes are the joint axes (trt chains have no
         // rotated placements), so the G54 frame is the workpiece frame shifted to the G54 origin.
         const Vec3 tip = nominal_.toolPointInWorkpiece(q, nominal_.toolPoint(toolLength));
@@ -84,7 +88,7 @@ JointValues LinuxcncModel::program(const AxisVector& q, double toolLength) const
 
 JointValues LinuxcncModel::jointPositions(const JointValues& program, double toolLength) const {
     JointValues j = program;
-    if (!trt_) return j;
+    if (mode_ == KinsMode::Joint) return j;  // identity kinematics: the trt pins do nothing
     // emccanon.cc: motion gets program + G54 + tool offset (G43: the tool length along Z).
     TrtPose world{{program[jx_] + g54_[0], program[jy_] + g54_[1], program[jz_] + g54_[2] + toolLength}, program[jt_], program[jc_]};
     TrtPins pins = pins_;

@@ -84,6 +84,25 @@ std::optional<TrtType> matchTrt(const MachineModel& m) {
     if (lin != 3 || dirs != 7 || (m.toolDirection - Vec3(0, 0, -1)).norm() > 1e-12) return std::nullopt;
     const auto [tilt, c] = trtLinks(m);
     const Link &lt = m.workpiece.links[tilt], &lc = m.workpiece.links[c];
+    // A table-table machine whose axes turn the other way is not one of LinuxCNC's trt modules, and trivkins would
+    // replace the user's tool-tip kinematics in [KINS] (issue 17): refuse it by name.
+    const auto refuse = [&](const Link& l, const char* axis, const char* want) {
+        throw ModelError(fmt::format("{}: rotary axis {} turns about {}: LinuxCNC's {} turns it about {} (trtfuncs.c), and the "
+                                     "pins route has no other table-table kinematics (trivkins would replace your tool-tip "
+                                     "kinematics); use the component route (cnccomp emit --controller linuxcnc)",
+                                     m.name, l.name, axis, lc.name == "C" && lt.name == "B" ? "xyzbc-trt-kins" : "xyzac-trt-kins",
+                                     want));
+    };
+    const auto axisName = [](const Vec3& d) -> std::string {
+        const int k = alignedComponent(d);
+        return k < 0 ? fmt::format("({:.3f}, {:.3f}, {:.3f})", d.x(), d.y(), d.z()) : fmt::format("{}{}", d[k] < 0 ? "-" : "+", "XYZ"[k]);
+    };
+    if (lc.name == "C" && (lc.direction - Vec3::UnitZ()).norm() > 1e-12 && alignedComponent(lc.direction) == 2)
+        refuse(lc, axisName(lc.direction).c_str(), "+Z");
+    if (lt.name == "A" && (lt.direction - Vec3::UnitX()).norm() > 1e-12 && alignedComponent(lt.direction) == 0)
+        refuse(lt, axisName(lt.direction).c_str(), "+X");
+    if (lt.name == "B" && (lt.direction - Vec3::UnitY()).norm() > 1e-12 && alignedComponent(lt.direction) == 1)
+        refuse(lt, axisName(lt.direction).c_str(), "+Y");
     if ((lc.direction - Vec3::UnitZ()).norm() > 1e-12 || lc.name != "C") return std::nullopt;
     if ((lt.direction - Vec3::UnitX()).norm() < 1e-12 && lt.name == "A") return TrtType::AC;
     if ((lt.direction - Vec3::UnitY()).norm() < 1e-12 && lt.name == "B") return TrtType::BC;
@@ -233,8 +252,16 @@ LinuxcncPlan planLinuxcnc(const MachineModel& m, const DeviationSet& d) {
         }
         // Translation location error.
         if (plan.trt && def.side == Side::Workpiece) {
-            if (def.link <= trtLast) yes(fmt::format("position of the {} axis line: {} HAL pins (rot-point / offset)", l.name, module));
-            else yes(fmt::format("position of the workpiece origin on the table ({}): G54 of cnccomp-g54.ngc", l.name));
+            // Listed as NOT compensated: the test programs (and every joint-mode program) run with the identity
+            // kinematics, where the pins and the G54 do nothing (linuxcnc_apply.hpp).
+            if (def.link <= trtLast)
+                no(fmt::format("{} position of the {} axis line: {} HAL pins (rot-point / offset); joint-mode programs (cnccomp "
+                               "testprog's) do not get it",
+                               kToolTipModeOnly, l.name, module));
+            else
+                no(fmt::format("{} position of the workpiece origin on the table ({}): G54 of cnccomp-g54.ngc; joint-mode "
+                               "programs do not get it",
+                               kToolTipModeOnly, l.name));
             continue;
         }
         if (def.link <= firstRotary(c)) {

@@ -15,7 +15,8 @@
 //   (the tool chain's fixed offsets and the axes' machine-zero included). The world frame of the module coincides
 //   with the joint frame at tilt = C = 0; the work offset (G54) of the workpiece origin is its position there.
 // Everything else (squareness, tilts of rotary axes, offsets behind a rotary axis with no kinematics pin,
-// cross-axis component errors) is listed as not compensated, with the reason.
+// cross-axis component errors) is listed as not compensated, with the reason; so are the deviations the trt pins and
+// the G54 take, which act in tool-tip mode only (note "tool-tip mode only: …"): the test programs run in joint mode.
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,6 +52,9 @@ struct LinuxcncPlan {
     Vec3 workOffset = Vec3::Zero();         ///< the same with the identified errors
     std::vector<Coverage> compensated, notCompensated;
 };
+
+/// How the NOT-compensated note of a deviation the trt pins or the G54 take begins: they act in tool-tip mode only.
+inline constexpr const char* kToolTipModeOnly = "tool-tip mode only:";
 
 /// Joint order of a LinuxCNC configuration: axis letters in XYZABCUVW order, other names after (machine order).
 std::vector<int> linuxcncJointOrder(const MachineModel& m);

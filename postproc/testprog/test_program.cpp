@@ -198,6 +198,8 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
     syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no tool length or "
                                 "work offset active",
                                 programDialectName(o.dialect)));
+    // The mode the controller must run the program in, which verify also runs it in (issue 17).
+    syntax->comment(kKinematicsModeLine);
     for (const std::string& n : r.notes) syntax->comment(n);
     syntax->comment("setup pose: " + describePose(m, C(r.setup)));
     syntax->comment(fmt::format("sweep parameter: {}, {} samples{}", r.parameter, r.sampleCount,

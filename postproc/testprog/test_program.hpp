@@ -21,6 +21,13 @@
 
 namespace cnccomp::testprog {
 
+/// The header line every test program carries (all dialects): the kinematics mode the controller must run it in.
+/// The words are machine coordinates, so the controller's tool-tip transformation must be off; `cnccomp verify` runs
+/// the programs in this mode (controllers' apply models: joint mode, e.g. LinuxCNC's linuxcnc_apply.hpp).
+inline constexpr const char* kKinematicsModeLine =
+    "kinematics mode: joint (machine coordinates; tool-tip transformation OFF: LinuxCNC identity kinematics, "
+    "Sinumerik TRAORI off, Heidenhain M128/FUNCTION TCPM off, Fanuc G43.4/G43.5 off)";
+
 struct TestProgramOptions {
     ProgramDialect dialect = ProgramDialect::LinuxCnc;
     double feed = 1000.0;        ///< mm/min along the sweep and the overshoot arcs

@@ -88,6 +88,7 @@ void run(const Options& o) {
         writeFileAtomically((fs::path(o.out) / f.name).string(), [&](std::ostream& s) { s << f.content; });
     fmt::print("{} compensation for '{}' from {} ({} files in {})\n", b.name(), m.name, o.deviations, r.files.size(), o.out);
     for (const controllers::OutputFile& f : r.files) fmt::print("  {}\n", f.name);
+    for (const std::string& l : r.summary) fmt::print("{}\n", l);
     fmt::print("{}", controllers::formatCoverage(r));
     predict(b, m, d, r, o);
 }

@@ -112,8 +112,9 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
         c.description = fmt::format("{} files in {}", b->name(), path);
         c.model = std::shared_ptr<const controllers::AppliedCompensation>(b->apply(m, files));
         if (!c.model) throw ModelError(fmt::format("backend '{}' returned no compensation model", b->name()));
-        c.notCompensated = readNotCompensated(files);
-        c.compensated = readCompensated(files);
+        const std::vector<controllers::OutputFile> own = b->ownFiles(files);  // the route verified, of a folder holding several
+        c.notCompensated = readNotCompensated(own);
+        c.compensated = readCompensated(own);
         for (const auto& f : files) c.files.push_back((fs::path(path) / f.name).string());
         return out;
     }

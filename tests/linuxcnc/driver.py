@@ -8,13 +8,19 @@ and then works through the job file ($CNCCOMP_JOB), one command per line:
     record <label>   waits until every joint's comp filter has reached its target (backlash-filt == backlash-corr,
                      at most 1 s) and writes one line to $CNCCOMP_OUT:
                      <label> <settled 0|1> <motion.tooloffset.z> then, per joint, joint.N.pos-cmd, then
-                     joint.N.motor-pos-cmd, joint.N.backlash-corr, joint.N.backlash-filt (repr, full precision)
+                     joint.N.motor-pos-cmd, joint.N.backlash-corr, joint.N.backlash-filt (repr, full precision), then
+                     the 9 values of stat.g5x_offset (the active work offset)
+    auto <file>      runs the program in AUTO to its end (then back to MDI)
+    sample <file>    the same with the HAL sampler (sampler.0, enabled only while the program runs) read by halsampler
+                     into $CNCCOMP_OUT.samples: one line per servo cycle, "<cycle> <value> ..." (halsampler -t, %f)
 The output is written to $CNCCOMP_OUT.part and renamed when the whole job is done, so an output file means success.
 Any LinuxCNC error (error channel) or timeout ends the run with exit code 1 and the reason on stderr.
 Needs /usr/bin/python3 (the linuxcnc and hal modules of the Debian package live in the system dist-packages).
 """
 import os
 import re
+import signal
+import subprocess
 import sys
 import time
 
@@ -73,6 +79,43 @@ def mdi(block):
     check_errors(block)
 
 
+def run_program(path, timeout=900):
+    command.mode(linuxcnc.MODE_AUTO)
+    command.wait_complete()
+    command.program_open(path)
+    command.wait_complete()
+    command.auto(linuxcnc.AUTO_RUN, 0)
+    command.wait_complete()
+    time.sleep(0.5)  # the interpreter has picked the program up (a short one may be over already)
+    def over():
+        if stat.interp_state == linuxcnc.INTERP_PAUSED or stat.task_paused:
+            command.auto(linuxcnc.AUTO_RESUME)  # an M0 of the program (the operator's cycle start)
+            return False
+        return (stat.interp_state == linuxcnc.INTERP_IDLE and stat.exec_state == linuxcnc.EXEC_DONE and stat.inpos
+                and stat.queue == 0)
+    wait(over, timeout, "program " + path)
+    check_errors("program " + path)
+    command.mode(linuxcnc.MODE_MDI)
+    command.wait_complete()
+
+
+def sample_program(path):
+    out = OUT + ".samples"
+    sampler = subprocess.Popen(["halsampler", "-c", "0", "-t", out])
+    time.sleep(0.5)  # attached to the stream
+    hal.set_p("sampler.0.enable", "1")
+    try:
+        run_program(path)
+    finally:
+        hal.set_p("sampler.0.enable", "0")
+    wait(lambda: int(hal.get_value("sampler.0.curr-depth")) == 0, 60, "halsampler to drain the sampler")
+    time.sleep(0.5)
+    sampler.send_signal(signal.SIGTERM)
+    sampler.wait(30)
+    with open(out + ".info", "w") as f:
+        f.write("%d %d\n" % (int(hal.get_value("sampler.0.sample-num")), int(hal.get_value("sampler.0.overruns"))))
+
+
 def pins(name):
     return [float(hal.get_value(name % j)) for j in range(JOINTS)]
 
@@ -86,8 +129,9 @@ def record(label):
         time.sleep(0.002)
     values = (pins("joint.%d.pos-cmd") + pins("joint.%d.motor-pos-cmd") + pins("joint.%d.backlash-corr")
               + pins("joint.%d.backlash-filt"))
+    stat.poll()
     return " ".join([label, "1" if settled else "0", repr(float(hal.get_value("motion.tooloffset.z")))]
-                    + [repr(v) for v in values])
+                    + [repr(v) for v in values] + [repr(float(v)) for v in stat.g5x_offset])
 
 
 def main():
@@ -118,6 +162,10 @@ def main():
             mdi(rest)
         elif verb == "record":
             lines.append(record(rest))
+        elif verb == "auto":
+            run_program(rest)
+        elif verb == "sample":
+            sample_program(rest)
         else:
             raise RuntimeError("unknown job line: " + step)
     with open(OUT + ".part", "w") as f:

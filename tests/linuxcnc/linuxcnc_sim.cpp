@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -44,7 +45,7 @@ std::string tail(const std::string& text, size_t lines) {
 /// The machine's own INI before the merge: what a LinuxCNC configuration of this machine holds anyway (travel in
 /// LinuxCNC's coordinates = description travel − machine-zero, homing at joint position 0, BACKLASH), with trivkins
 /// in [KINS] until cnccomp.ini replaces it.
-std::string baseIni(const MachineModel& m, const std::string& coordinates, double backlash) {
+std::string baseIni(const MachineModel& m, const std::string& coordinates, double backlash, const SimOptions& o) {
     std::string s = fmt::format(R"([EMC]
 VERSION = 1.1
 MACHINE = cnccomp-oracle-{}
@@ -64,7 +65,7 @@ JOINTS = {}
 
 [EMCMOT]
 EMCMOT = motmod
-SERVO_PERIOD = 50000
+SERVO_PERIOD = {}
 COMM_TIMEOUT = 30.0
 
 [TASK]
@@ -77,9 +78,9 @@ CYCLE_TIME = 0.010
 TOOL_TABLE = sim.tbl
 
 [HAL]
-# README.txt: cnccomp.hal loaded after the machine's own HAL file (its setp lines win)
+# README.txt: the route's HAL file loaded after the machine's own HAL file (its setp lines win)
 HALFILE = base.hal
-HALFILE = cnccomp.hal
+HALFILE = {}
 
 [TRAJ]
 COORDINATES = {}
@@ -91,7 +92,8 @@ DEFAULT_LINEAR_ACCELERATION = 5000
 MAX_LINEAR_ACCELERATION = 100000
 MAX_ANGULAR_VELOCITY = 50000
 )",
-                                m.name, coordinates, coordinates.size(), coordinates);
+                                m.name, coordinates, coordinates.size(), o.servoPeriodNs,
+                                o.route == Route::Pins ? "cnccomp.hal" : "cnccomp-kins.hal", coordinates);
     for (char c : coordinates)
         s += fmt::format("\n[AXIS_{}]\nMIN_LIMIT = -100000\nMAX_LIMIT = 100000\nMAX_VELOCITY = 50000\nMAX_ACCELERATION = 50000\n", c);
     for (size_t n = 0; n < coordinates.size(); ++n) {
@@ -99,21 +101,31 @@ MAX_ANGULAR_VELOCITY = 50000
         const double unit = l.kind == AxisKind::Rotary ? kDeg : 1.0;
         s += fmt::format("\n[JOINT_{}]\nTYPE = {}\nHOME = 0\nMIN_LIMIT = {}\nMAX_LIMIT = {}\nMAX_VELOCITY = 50000\n"
                          "MAX_ACCELERATION = 50000\nBACKLASH = {}\nHOME_SEARCH_VEL = 0\nHOME_SEQUENCE = 0\n",
-                         n, l.kind == AxisKind::Rotary ? "ANGULAR" : "LINEAR", (l.min - l.machineZero) / unit,
-                         (l.max - l.machineZero) / unit, backlash);
+                         n, l.kind == AxisKind::Rotary ? "ANGULAR" : "LINEAR", o.wideJointLimits ? -1e5 : (l.min - l.machineZero) / unit,
+                         o.wideJointLimits ? 1e5 : (l.max - l.machineZero) / unit, backlash);
     }
     return s;
 }
 
-/// Ideal drives, estop and tool-change loopbacks; no geometry pin (cnccomp.hal sets them).
-std::string baseHal(int joints) {
+/// Ideal drives, estop and tool-change loopbacks, the kinematics-mode switch (M68 E3), the sampler; no geometry pin
+/// (the route's HAL file sets them).
+std::string baseHal(int joints, const std::string& coordinates, bool sampled) {
     std::string s = "loadrt [KINS]KINEMATICS\n"
                     "loadrt [EMCMOT]EMCMOT servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS\n"
                     "addf motion-command-handler servo-thread\naddf motion-controller servo-thread\n";
     for (int j = 0; j < joints; ++j) s += fmt::format("net j{0} joint.{0}.motor-pos-cmd => joint.{0}.motor-pos-fb\n", j);
     s += "net estop-loop iocontrol.0.user-enable-out => iocontrol.0.emc-enable-in\n"
          "net tool-prep-loop iocontrol.0.tool-prepare => iocontrol.0.tool-prepared\n"
-         "net tool-change-loop iocontrol.0.tool-change => iocontrol.0.tool-changed\n";
+         "net tool-change-loop iocontrol.0.tool-change => iocontrol.0.tool-changed\n"
+         "net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type\n";
+    if (sampled) {
+        s += fmt::format("loadrt sampler depth=20000 cfg={}\naddf sampler.0 servo-thread\nsetp sampler.0.enable 0\n",
+                         std::string(2 * coordinates.size(), 'f'));
+        for (int j = 0; j < joints; ++j) s += fmt::format("net j{0} => sampler.0.pin.{0}\n", j);
+        for (size_t k = 0; k < coordinates.size(); ++k)
+            s += fmt::format("net ax{0} axis.{0}.pos-cmd => sampler.0.pin.{1}\n",
+                             static_cast<char>(std::tolower(static_cast<unsigned char>(coordinates[k]))), joints + static_cast<int>(k));
+    }
     return s;
 }
 
@@ -187,19 +199,32 @@ std::string mergeIni(const std::string& base, const std::string& fragment) {
 }
 
 SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const fs::path& dir, const std::vector<Tool>& tools,
-                         double backlash) {
+                         double backlash, const SimOptions& o) {
     SimConfig c;
     c.dir = dir;
     fs::create_directories(dir);
-    const std::string fragment = readText((emitted / "cnccomp.ini").string());
-    const std::string coordinates = controllers::linuxcnc::parseIni(fragment, "cnccomp.ini").coordinates;
-    c.joints = static_cast<int>(coordinates.size());
+    const bool kins = o.route == Route::Component;
+    // The component route's files with the module renamed (installComponent installed it under that name).
+    const auto routeText = [&](const std::string& name) {
+        std::string t = readText((emitted / name).string());
+        if (!kins) return t;
+        for (size_t at = 0; (at = t.find("cnccomp_kins", at)) != std::string::npos; at += o.module.size()) t.replace(at, 12, o.module);
+        return t;
+    };
+    const std::string fragment = routeText(kins ? "cnccomp-kins.ini" : "cnccomp.ini");
+    const auto ini = controllers::linuxcnc::parseIni(fragment, "ini");
+    c.coordinates = kins ? ini.trajCoordinates : ini.coordinates;
+    c.joints = static_cast<int>(c.coordinates.size());
     c.ini = dir / "sim.ini";
-    writeText(c.ini.string(), mergeIni(baseIni(m, coordinates, backlash), fragment));
-    writeText((dir / "base.hal").string(), baseHal(c.joints));
-    for (const auto& e : fs::directory_iterator(emitted))
-        if (e.path().extension() == ".comp" || e.path().filename() == "cnccomp.hal")
-            fs::copy_file(e.path(), dir / e.path().filename(), fs::copy_options::overwrite_existing);
+    writeText(c.ini.string(), mergeIni(baseIni(m, c.coordinates, backlash, o), fragment));
+    writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled));
+    if (kins) {
+        writeText((dir / "cnccomp-kins.hal").string(), routeText("cnccomp-kins.hal"));
+    } else {
+        for (const auto& e : fs::directory_iterator(emitted))
+            if ((e.path().extension() == ".comp" && e.path().filename() != "cnccomp_kins.comp") || e.path().filename() == "cnccomp.hal")
+                fs::copy_file(e.path(), dir / e.path().filename(), fs::copy_options::overwrite_existing);
+    }
     std::string tbl;
     for (const Tool& t : tools) tbl += fmt::format("T{0} P{0} Z{1} D0 ;\n", t.number, t.length);
     writeText((dir / "sim.tbl").string(), tbl);
@@ -209,7 +234,35 @@ SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const f
     return c;
 }
 
-std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& job, double* seconds) {
+std::string componentUnavailableReason() {
+    if (std::system("command -v halcompile > /dev/null 2>&1") != 0)
+        return "halcompile is missing (Debian 12: apt-get install linuxcnc-uspace-dev, see tools/deps.sh)";
+    if (geteuid() != 0) return "halcompile --install writes LinuxCNC's module folder: run as root (as CI does)";
+    return {};
+}
+
+double installComponent(const fs::path& emitted, const std::string& module, const fs::path& work) {
+    fs::create_directories(work);
+    std::string t = readText((emitted / "cnccomp_kins.comp").string());
+    for (size_t at = 0; (at = t.find("cnccomp_kins", at)) != std::string::npos; at += module.size()) t.replace(at, 12, module);
+    const fs::path src = work / (module + ".comp"), log = work / "halcompile.log";
+    writeText(src.string(), t);
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string cmd = "cd " + shellQuote(work.string()) + " && halcompile --install " + shellQuote(src.filename().string()) +
+                            " > " + shellQuote(log.string()) + " 2>&1";
+    const int rc = std::system(cmd.c_str());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (rc != 0) throw std::runtime_error(fmt::format("halcompile --install {} failed (exit {}):\n{}", src.string(), rc, tail(readText(log.string()), 60)));
+    return seconds;
+}
+
+void uninstallComponent(const std::string& module) {
+    std::error_code ec;
+    for (const char* dir : {"/usr/lib/linuxcnc/modules/", "/usr/realtime/modules/"}) fs::remove(fs::path(dir) / (module + ".so"), ec);
+}
+
+RunResult run(const SimConfig& c, const std::vector<std::string>& job) {
+    RunResult result;
     const fs::path jobFile = c.dir / "job.txt", out = c.dir / "records.txt", log = c.dir / "linuxcnc.log";
     std::string jobText;
     for (const std::string& l : job) jobText += l + "\n";
@@ -228,17 +281,16 @@ std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& j
         fs::permissions(fifo, fs::perms::all | fs::perms::sticky_bit);
         env += " RTAPI_UID=65534 RTAPI_FIFO_PATH=" + shellQuote((fifo / "rtapi_fifo").string());
     }
-    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 600 linuxcnc -r " + shellQuote(c.ini.string()) +
+    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 900 linuxcnc -r " + shellQuote(c.ini.string()) +
                             " > " + shellQuote(log.string()) + " 2>&1 < /dev/null";
     const auto t0 = std::chrono::steady_clock::now();
     const int rc = std::system(cmd.c_str());
-    if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // The linuxcnc script exits 0 even when stopped by a signal: the output file is the proof of success.
     if (const char* keep = std::getenv("CNCCOMP_LINUXCNC_KEEP"))  // debugging: a copy of the run's folder
         fs::copy(c.dir, keep, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
     if (rc != 0 || !fs::exists(out))
         throw std::runtime_error(fmt::format("LinuxCNC run failed (exit {}), end of {}:\n{}", rc, log.string(), tail(readText(log.string()), 120)));
-    std::vector<Record> records;
     std::istringstream in(readText(out.string()));
     std::string line;
     while (std::getline(in, line)) {
@@ -252,10 +304,44 @@ std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& j
             v->resize(c.joints);
             for (double& x : *v) ls >> x;
         }
+        for (double& x : r.g5x) ls >> x;
         if (!ls) throw std::runtime_error("unreadable record line: " + line);
-        records.push_back(std::move(r));
+        result.records.push_back(std::move(r));
     }
-    return records;
+    const fs::path samples = out.string() + ".samples";
+    if (fs::exists(samples)) {
+        std::istringstream sin(readText(samples.string()));
+        while (std::getline(sin, line)) {
+            if (trimmed(line).empty()) continue;
+            if (trimmed(line) == "overrun") {
+                ++result.overruns;
+                continue;
+            }
+            std::istringstream ls(line);
+            Sample s;
+            s.motor.resize(c.joints);
+            s.axis.resize(c.coordinates.size());
+            ls >> s.cycle;
+            for (double& x : s.motor) ls >> x;
+            for (double& x : s.axis) ls >> x;
+            if (!ls) throw std::runtime_error("unreadable sample line: " + line);
+            result.samples.push_back(std::move(s));
+        }
+        std::istringstream info(readText(samples.string() + ".info"));  // sampler.0.sample-num, sampler.0.overruns
+        long number = 0, overruns = 0;
+        info >> number >> overruns;
+        result.overruns += overruns;
+        // halsampler -t tags each sample with its number: a gap is a lost sample too.
+        for (size_t i = 1; i < result.samples.size(); ++i)
+            if (result.samples[i].cycle != result.samples[i - 1].cycle + 1) ++result.overruns;
+    }
+    return result;
+}
+
+std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& job, double* seconds) {
+    RunResult r = run(c, job);
+    if (seconds) *seconds = r.seconds;
+    return std::move(r.records);
 }
 
 }  // namespace cnccomp::test::linuxcnc_sim

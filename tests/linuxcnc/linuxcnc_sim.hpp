@@ -12,6 +12,7 @@
 // loaded machine (ctest -j, POSIX non-realtime threads) motion answers task late: [EMCMOT] COMM_TIMEOUT = 30 s, since
 // a timed-out command is sent again and the comp-table loader then refuses the repeated line ("compensation values
 // must increase"); a move is over when the commanded position has reached the block's words (driver.py).
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -34,17 +35,44 @@ struct Tool {
 };
 
 /// A sim configuration folder: the machine's own INI (joint travel in LinuxCNC's coordinates from the machine
-/// description, BACKLASH on every joint, ideal drives) merged with cnccomp.ini; base.hal, then cnccomp.hal as a
-/// second HALFILE (its setp lines set the pins); the .comp files; a tool table; driver.py.
+/// description, BACKLASH on every joint, ideal drives) merged with the route's INI fragment; base.hal, then the route's
+/// HAL fragment as a second HALFILE (its setp lines set the pins); the route's files; a tool table; driver.py.
+/// base.hal also nets motion.analog-out-03 to motion.switchkins-type (README.txt: M68 E3 Qn + M66 E0 L0 switches the
+/// kinematics mode) and, with `sampled`, a `sampler` on the servo thread that records every joint's
+/// joint.N.motor-pos-cmd and then every axis' axis.L.pos-cmd each servo cycle (driver.py runs halsampler).
 struct SimConfig {
     std::filesystem::path dir, ini;
     int joints = 0;
+    std::string coordinates;  ///< joint letters in joint order
+};
+
+enum class Route { Pins, Component };
+
+struct SimOptions {
+    Route route = Route::Pins;
+    int servoPeriodNs = 50000;  ///< 50 us for the joint tables' comp filter (see above); the component route needs none
+    bool sampled = false;
+    /// Joint limits of ±100000 instead of the description's travel: a world-straight move in tool-tip mode that turns
+    /// a rotary axis takes the joints far out of the travel on the way (LinuxCNC would stop it at the limit).
+    bool wideJointLimits = false;
+    /// Component route: the module name the component was installed under (installComponent); the emitted files'
+    /// cnccomp_kins is renamed to it.
+    std::string module;
 };
 
 /// Builds the configuration in `dir` from the folder `emitted` (what `cnccomp emit` wrote, read as it is).
 /// `backlash` is the BACKLASH (mm or deg) the machine's own INI gives every joint.
 SimConfig buildSimConfig(const MachineModel& m, const std::filesystem::path& emitted, const std::filesystem::path& dir,
-                         const std::vector<Tool>& tools, double backlash);
+                         const std::vector<Tool>& tools, double backlash, const SimOptions& options = {});
+
+/// Empty when halcompile can build and install a component here (root, linuxcnc-uspace-dev), otherwise why not.
+std::string componentUnavailableReason();
+/// Compiles and installs the emitted component (`emitted`/cnccomp_kins.comp) under the name `module` (its text with
+/// cnccomp_kins renamed: one installed module per test, never a stale one) with `halcompile --install`, in `work`.
+/// Throws std::runtime_error with halcompile's output on failure. Returns the seconds it took.
+double installComponent(const std::filesystem::path& emitted, const std::string& module, const std::filesystem::path& work);
+/// Removes an installed module (its .so in LinuxCNC's module folder).
+void uninstallComponent(const std::string& module);
 
 /// One `record` of the job: the joint pins after a move.
 struct Record {
@@ -52,11 +80,28 @@ struct Record {
     bool settled = false;  ///< every joint's comp filter had reached its target
     double toolOffset = 0; ///< motion.tooloffset.z
     std::vector<double> posCmd, motorPosCmd, backlashCorr, backlashFilt;
+    std::array<double, 9> g5x{};  ///< stat.g5x_offset (the active work offset, XYZABCUVW)
 };
 
-/// Runs LinuxCNC on the configuration with a job (lines `mdi <G-code>` / `record <label>`, see driver.py) and
-/// returns the records. Throws std::runtime_error with the end of LinuxCNC's log when the run fails. With the
-/// environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder (INI, HAL, job, log) is copied there.
+/// One servo cycle of a `sample` job line: joint.N.motor-pos-cmd per joint, then axis.L.pos-cmd per coordinate letter.
+struct Sample {
+    long cycle = 0;
+    std::vector<double> motor, axis;
+};
+
+struct RunResult {
+    std::vector<Record> records;
+    std::vector<Sample> samples;
+    double seconds = 0;
+    long overruns = 0;  ///< samples lost by the sampler's FIFO (must be 0)
+};
+
+/// Runs LinuxCNC on the configuration with a job (lines `mdi <G-code>` / `record <label>` / `auto <program file>` /
+/// `sample <program file>`, see driver.py) and returns the records. Throws std::runtime_error with the end of
+/// LinuxCNC's log when the run fails. With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
+/// (INI, HAL, job, log) is copied there.
+RunResult run(const SimConfig& c, const std::vector<std::string>& job);
+/// The records of run() (the MDI tests).
 std::vector<Record> runJob(const SimConfig& c, const std::vector<std::string>& job, double* seconds = nullptr);
 
 }  // namespace cnccomp::test::linuxcnc_sim

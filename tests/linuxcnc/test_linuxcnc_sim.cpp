@@ -22,6 +22,7 @@
 #include "cnccomp/kinematics.hpp"
 #include "controllers/common/files.hpp"
 #include "controllers/linuxcnc/linuxcnc_apply.hpp"
+#include "controllers/linuxcnc/linuxcnc_plan.hpp"
 #include "linuxcnc/linuxcnc_sim.hpp"
 #include "test_support.hpp"
 
@@ -93,6 +94,7 @@ std::string move(const std::string& letters, const JointValues& words) {
 
 struct Figures {
     double kinematics = 0, motor = 0, tip = 0, tipBefore = 0, tipFull = 0, seconds = 0;
+    double g54 = 0, jointMode = 0, jointModeMotor = 0;  ///< G54 after the program; joint mode: pos-cmd vs words, motor vs model
     int poses = 0, settled = 0;
 };
 
@@ -105,16 +107,18 @@ Figures runOracle(const std::string& machineName, const std::string& deviationNa
     ScratchDir dir("linuxcnc-oracle-" + machineName);
 
     // 1. The files exactly as the CLI writes them.
-    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc --machine {} --deviations {} --out {} --date 2024-01-01",
+    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc-pins --machine {} --deviations {} --out {} --date 2024-01-01",
                                               machineFile, deviationFile, dir.file("emitted")));
     EXPECT_EQ(emit.exitCode, 0) << emit.out;
     const std::vector<OutputFile> files = readFolder(dir.path / "emitted");
-    const LinuxcncModel model(m, files);
-    EXPECT_NE(dynamic_cast<const LinuxcncModel*>(controllers::backend("linuxcnc").apply(m, files).get()), nullptr);
+    const LinuxcncModel model(m, files, controllers::linuxcnc::KinsMode::ToolTip);
+    EXPECT_NE(dynamic_cast<const LinuxcncModel*>(controllers::backend("linuxcnc-pins").apply(m, files).get()), nullptr);
 
     // The deviations the backend claims (its coverage list).
     DeviationSet claimed = truth;
-    for (const auto& c : controllers::backend("linuxcnc").emit({m, truth, deviationName + ".csv", "2024-01-01"}).notCompensated) {
+    // (In tool-tip mode, where these poses run, the trt pins and the G54 act too: "tool-tip mode only" entries.)
+    for (const auto& c : controllers::backend("linuxcnc-pins").emit({m, truth, deviationName + ".csv", "2024-01-01"}).notCompensated) {
+        if (c.note.starts_with(controllers::linuxcnc::kToolTipModeOnly)) continue;
         const int i = m.deviationIndex(c.deviation);
         claimed.values.segment(m.deviations[i].offset, m.deviations[i].size()).setZero();
         claimed.present[i] = 0;
@@ -126,8 +130,11 @@ Figures runOracle(const std::string& machineName, const std::string& deviationNa
     const sim::SimConfig config = sim::buildSimConfig(m, dir.path / "emitted", dir.path / "sim", kTools, kBacklash);
     const std::string letters = model.coordinates();
     std::vector<std::string> job{"mdi G90 G21 G94 G17 G40 G49 G54"};
-    for (const auto& l : controllers::splitLines(controllers::requireFile(files, "cnccomp-g54.ngc", "test").content))
-        if (std::string(l.text).starts_with("G10")) job.push_back("mdi " + std::string(l.text));
+    // The emitted G54 program itself, whole, in AUTO (issue 17: a comment line over LinuxCNC's 254 characters aborted
+    // it with "Command too long" and G54 stayed 0).
+    fs::copy_file(dir.path / "emitted" / "cnccomp-g54.ngc", config.dir / "cnccomp-g54.ngc");
+    job.push_back("auto " + (config.dir / "cnccomp-g54.ngc").string());
+    job.push_back("record g54");
     const std::vector<Pose> ps = poses(m, tiltAxis);
     // From the home position (far from the table on some machines) to above the table centre before any rotary
     // axis turns: a world-straight move that turns C keeps the joints within reach only near the C axis.
@@ -172,10 +179,43 @@ Figures runOracle(const std::string& machineName, const std::string& deviationNa
         programs.push_back(program);
     }
 
+    // Joint mode (identity kinematics, switchkins-type 1 of the trt module: how LinuxCNC runs cnccomp testprog's
+    // machine-coordinate programs): G54 and the tool offset off, the words are the joints; only the tables act.
+    job.push_back("mdi G49");
+    job.push_back("mdi G10 L2 P1 X0 Y0 Z0");
+    job.push_back("mdi M68 E3 Q1");
+    job.push_back("mdi M66 E0 L0");
+    std::vector<JointValues> jointWords;
+    const LinuxcncModel jointModel(m, files, controllers::linuxcnc::KinsMode::Joint);
+    for (size_t k = 0; k < ps.size(); ++k) {
+        const JointValues w = jointModel.program(ps[k].q, 0.0), before = w - JointValues::Constant(w.size(), ps[k].dir * 1.0);
+        job.push_back("mdi " + move(letters, before));
+        job.push_back("mdi " + move(letters, w));
+        job.push_back(fmt::format("record j{}", k));
+        jointWords.push_back(w);
+    }
+
     // 3. The real LinuxCNC.
-    const std::vector<sim::Record> rec = sim::runJob(config, job, &f.seconds);
-    EXPECT_EQ(rec.size(), 3 * ps.size());
-    if (rec.size() != 3 * ps.size()) return f;
+    std::vector<sim::Record> rec = sim::runJob(config, job, &f.seconds);
+    EXPECT_EQ(rec.size(), 1 + 4 * ps.size());
+    if (rec.size() != 1 + 4 * ps.size()) return f;
+    // G54 after the whole emitted program.
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(rec[0].g5x[k], model.workOffset()[k], 1e-9) << "G54 " << "XYZ"[k] << " after cnccomp-g54.ngc";
+    f.g54 = std::max({std::abs(rec[0].g5x[0] - model.workOffset()[0]), std::abs(rec[0].g5x[1] - model.workOffset()[1]),
+                      std::abs(rec[0].g5x[2] - model.workOffset()[2])});
+    EXPECT_GT(std::hypot(model.workOffset()[0], model.workOffset()[1], model.workOffset()[2]), 1e-3);  // not 0: the program ran
+    for (size_t k = 0; k < ps.size(); ++k) {
+        const sim::Record& r = rec[1 + 3 * ps.size() + k];
+        EXPECT_EQ(r.label, fmt::format("j{}", k));
+        const JointValues dirs = JointValues::Constant(config.joints, ps[k].dir);
+        const JointValues predicted = jointModel.motorPositions(jointModel.jointPositions(jointWords[k], 0.0), dirs);
+        JointValues motor(config.joints), pos(config.joints);
+        for (int i = 0; i < config.joints; ++i) motor[i] = r.motorPosCmd[i], pos[i] = r.posCmd[i];
+        f.jointMode = std::max(f.jointMode, (pos - jointWords[k]).cwiseAbs().maxCoeff());
+        f.jointModeMotor = std::max(f.jointModeMotor, (motor - predicted).cwiseAbs().maxCoeff());
+    }
+    rec.erase(rec.begin() + 1 + 3 * ps.size(), rec.end());
+    rec.erase(rec.begin());
     for (size_t k = 0; k < ps.size(); ++k) {
         const Pose& p = ps[k];
         const sim::Record &a = rec[3 * k], &b = rec[3 * k + 1], &r = rec[3 * k + 2];
@@ -207,9 +247,11 @@ Figures runOracle(const std::string& machineName, const std::string& deviationNa
     }
     std::cout << fmt::format("[linuxcnc oracle] {:<22} {} poses, LinuxCNC run {:.1f} s; LinuxCNC vs model: pos-cmd {:.1e}, "
                              "motor-pos-cmd {:.1e} (mm/deg); tool tip at LinuxCNC's motor positions: claimed {:.4f} um "
-                             "(before {:.2f} um), full set {:.2f} um; comp filters settled {}/{}\n",
+                             "(before {:.2f} um), full set {:.2f} um; comp filters settled {}/{}; G54 after cnccomp-g54.ngc "
+                             "in AUTO off by {:.1e} mm; joint mode (identity kinematics): pos-cmd = words to {:.1e}, "
+                             "motor-pos-cmd vs model {:.1e}\n",
                              machineName, f.poses, f.seconds, f.kinematics, f.motor, f.tip / kUm, f.tipBefore / kUm,
-                             f.tipFull / kUm, f.settled, f.poses);
+                             f.tipFull / kUm, f.settled, f.poses, f.g54, f.jointMode, f.jointModeMotor);
     return f;
 }
 
@@ -221,6 +263,9 @@ void oracle(const std::string& machine, const std::string& deviations, const std
     EXPECT_LE(f.motor, 1e-4);
     EXPECT_LE(f.tip, 1e-4);
     EXPECT_GT(f.tipBefore, 10 * kUm);  // the deviations matter
+    EXPECT_LE(f.g54, 1e-9);
+    EXPECT_LE(f.jointMode, 1e-9);
+    EXPECT_LE(f.jointModeMotor, 1e-4);
 }
 
 TEST(LinuxcncOracle, TableTableACMatchesTheRealLinuxcnc) { oracle("controllers-table-table-ac", "controllers-table-table-ac", "A"); }
