@@ -2,6 +2,7 @@
 // `cnccomp emit`, or programs corrected by `cnccomp correct`) to the true or the identified machine, before and after.
 // --json and --report (HTML page, its SVGs and summary) are staged together and written only when both are complete.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -169,6 +170,7 @@ void run(const Options& o) {
                        *o.maxVolumetricUm);
     }
     if (!failed.empty()) {
+        std::fflush(stdout);  // the report (banner first) before main's error lines on stderr, also through a pipe
         std::string all;
         for (const std::string& f : failed) all += (all.empty() ? "" : "\n") + f;
         throw std::runtime_error(all);
