@@ -131,7 +131,9 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     for (const std::string& c : controllers) {
         std::istringstream emitted(test::readText(file("5-emit/" + c + ".txt")));
         for (std::string line; std::getline(emitted, line);)
-            if (line.find("WARNING") != std::string::npos) EXPECT_NE(r.out.find(c + ": " + line), std::string::npos) << line;
+            if (line.find("WARNING") != std::string::npos) {
+                EXPECT_NE(r.out.find(c + ": " + line), std::string::npos) << line;
+            }
     }
 
     if (!test::chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
