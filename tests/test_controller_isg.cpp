@@ -157,6 +157,53 @@ TEST(ControllerIsg, ReadersNameFileAndLine) {
     EXPECT_THROW(backend("isg").apply(machine(s.machine), other.files), InputError);
 }
 
+TEST(ControllerIsg, ANegateEntryFlipsTheCompensationAndVerifyFailsIt) {
+    // P-VOLC-00009 `negate` (TF5280 "Modification of compensation values (optional)"): the control negates the computed
+    // compensation of the Cartesian axes named; `set_to_zero` drops it. The files set neither and their header says
+    // so; the apply model reads both. Oracle: the evaluation on the erroneous machine (the tool-tip error before and
+    // after): with `negate XYZ` the correction points the wrong way and the error roughly doubles.
+    const Sample& s = kSamples[1];
+    const MachineModel& m = machine(s.machine);
+    const DeviationSet d = deviations(s);
+    const EmitResult r = emitSample(s, d);
+    const DeviationSet claimed = claimedOnly(d, r);  // what the files claim to hold, as in CompensatesWhatItClaims…
+    std::vector<OutputFile> files = r.files;
+    OutputFile* lis = nullptr;
+    for (OutputFile& f : files)
+        if (f.name == "volcomp.lis") lis = &f;
+    ASSERT_NE(lis, nullptr);
+    EXPECT_NE(lis->content.find("sets neither 'negate' nor 'set_to_zero' (P-VOLC-00009"), std::string::npos) << lis->content;
+    for (const isg::IsgConfig c = isg::parseIsgConfig(lis->content, "volcomp.lis"); const std::string* v : {&c.negate, &c.setToZero})
+        EXPECT_TRUE(v->empty());
+    const auto samples = workspaceSamples(m, 4);
+    const auto figures = [&](const std::string& extra) {
+        std::vector<OutputFile> changed = files;
+        for (OutputFile& f : changed)
+            if (f.name == "volcomp.lis") f.content += extra;
+        return evaluateCompensation(m, claimed, *backend("isg").apply(m, changed), samples, 0.0);
+    };
+    const CompensationFigures plain = figures(""), negated = figures("negate XYZ\n");
+    EXPECT_LT(plain.maxAfter, 0.1 * plain.maxBefore);
+    EXPECT_GT(negated.maxAfter, 1.8 * plain.maxBefore);
+    // Per axis: the correction of X alone flipped, of Z alone dropped.
+    const AxisVector q = AxisVector::Zero(m.axisCount());
+    const auto correction = [&](const std::string& extra) {
+        std::vector<OutputFile> changed = files;
+        for (OutputFile& f : changed)
+            if (f.name == "volcomp.lis") f.content += extra;
+        return AxisVector(backend("isg").apply(m, changed)->driveCommands(q) - q);
+    };
+    const AxisVector c0 = correction(""), cx = correction("negate X\n"), cz = correction("set_to_zero Z\n");
+    const int X = m.requireAxis("X"), Y = m.requireAxis("Y"), Z = m.requireAxis("Z");
+    ASSERT_GT(std::abs(c0[X]) + std::abs(c0[Z]), 1e-4);
+    EXPECT_NEAR(cx[X], -c0[X], 1e-9);
+    EXPECT_NEAR(cx[Y], c0[Y], 1e-9);
+    EXPECT_NEAR(cz[Z], 0.0, 1e-9);
+    EXPECT_NEAR(cz[X], c0[X], 1e-9);
+    // Only the Cartesian axes, with file and line.
+    EXPECT_EQ(inputErrorLine([] { isg::parseIsgConfig("X 1\nnegate XA\nchain XYZ\n", "v.lis"); }), 2);
+}
+
 TEST(ControllerIsg, ImplausibleValuesAreRefused) {
     const Sample& s = kSamples[1];
     DeviationSet d = deviations(s);

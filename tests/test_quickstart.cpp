@@ -1,5 +1,6 @@
 // The main job (README command 1, tools/quickstart.sh) without its apt/build part, end to end in a scratch folder:
-// every step's outputs are there, the identified set is the truth within the noise, every verify passes, what emit
+// every step's outputs are there, the identified set is the truth within the noise, the gated verifies pass, a
+// compensation worse than none has its banner line in the summary and emit's warnings are printed, what emit
 // predicts on the identified machine is what verify finds on the real (simulated) one, the ideal compensation and the
 // corrected programs leave less than the noise, the reports load in headless Chromium. And the stand-in for the ball
 // bar: `simulate --instrument` writes files in the instrument layout that identify imports like measured ones.
@@ -125,6 +126,19 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     EXPECT_EQ(rows.at("linuxcnc").left, 0);
     EXPECT_LT(rows.at("linuxcnc").verifiedAfter, rows.at("linuxcnc").verifiedBefore);
     EXPECT_NE(r.out.find("every output: " + out + "/"), std::string::npos);
+    // Every compensation that verify finds worse than none has its banner line in the summary, the others none; every
+    // WARNING of emit is printed, not only kept in 5-emit/<c>.txt.
+    for (const std::string& n : names) {
+        const bool worse = readJsonFile(file("7-verify/" + n + "/verify.json"))["makes_machine_worse"].boolean;
+        EXPECT_EQ(summary.find("!!! " + n + ": COMPENSATION MAKES THE MACHINE WORSE") != std::string::npos, worse) << n << "\n" << summary;
+    }
+    for (const std::string& c : controllers) {
+        std::istringstream emitted(test::readText(file("5-emit/" + c + ".txt")));
+        for (std::string line; std::getline(emitted, line);)
+            if (line.find("WARNING") != std::string::npos) {
+                EXPECT_NE(r.out.find(c + ": " + line), std::string::npos) << line;
+            }
+    }
 
     if (!test::chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
     for (const std::string page : {"3-identify/report.html", "7-verify/linuxcnc/report.html"}) {

@@ -15,6 +15,7 @@
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/report/polar_plot.hpp"
 #include "test_browser.hpp"
+#include "test_deviation_text.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
@@ -67,9 +68,11 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     test::ScratchDir dir("verify-report");
     // LinuxCNC's pins-and-tables route: a controller that leaves deviations (its component route leaves none).
     const auto r = emitAndVerify(dir, "linuxcnc-pins");
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(r.out.find("report -> "), std::string::npos);
     const std::string base = dir.file("linuxcnc-pins-report/");
+    ASSERT_TRUE(fs::exists(base + "verify.json")) << r.out;
+    // No gate given: exit status 1 only where the files make the machine worse than none (verify.hpp VerifyWorse).
+    EXPECT_EQ(r.exitCode, readJsonFile(base + "verify.json")["makes_machine_worse"].boolean ? 1 : 0) << r.out;
+    EXPECT_NE(r.out.find("report -> "), std::string::npos);
     for (const char* f : {"report.html", "report.summary.json", "report-polar-B-X.svg", "report-polar-C-radial-RB2.svg",
                           "report-map-1.svg", "report-map-2.svg", "verify.json"})
         EXPECT_TRUE(fs::exists(base + f)) << f;
@@ -119,14 +122,17 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     EXPECT_EQ(names(c["compensated"]), headerList(ini, "compensated:"));
     EXPECT_EQ(names(c["not_compensated"]), headerList(ini, "NOT compensated:"));
     EXPECT_EQ(c["not_compensated"].array.size(), 10u);
-    const MachineModel& m = test::multitasking();
-    const DeviationSet truth = readDeviationCsv(kTruth, m);
+    // The values left as the truth file writes them (its text, not the deviation vector): the ISO value under the ISO
+    // name, the paper's value under the alias.
+    const auto truthRows = test::deviationRowsAsWritten(kTruth);
     for (const JsonValue& left : c["remaining"].array) {
-        const int d = m.deviationIndex(left["deviation"].string);
-        ASSERT_GE(d, 0) << left["deviation"].string;
-        const DeviationDef& def = m.deviations[static_cast<size_t>(d)];
-        EXPECT_EQ(left["unit"].string, def.isAngle() ? "arcsec" : "um");
-        EXPECT_NEAR(left["value"].num(), truth.values[def.offset] / (def.isAngle() ? kArcsec : kUm), 1e-9) << def.name;
+        const std::string name = left["deviation"].string;
+        ASSERT_TRUE(truthRows.count(name)) << name;
+        const test::DeviationRowText& row = truthRows.at(name);
+        EXPECT_EQ(left["unit"].string, row.unit) << name;
+        EXPECT_NEAR(left["value"].num(), row.value, 1e-9) << name;
+        EXPECT_EQ(left["alias"].string, row.alias) << name;
+        EXPECT_NEAR(left["alias_value"].num(), row.aliasValue, 1e-9) << name;
         EXPECT_FALSE(left["reason"].string.empty());
     }
     EXPECT_NEAR(c["span_after_um"].num(), v["residual_um"].num(), 1e-6);  // the summary's 9 significant digits
@@ -268,6 +274,41 @@ TEST(VerifyReport, AFailedGateStillWritesTheReportAndAFailedCommandWritesNothing
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_NE(test::readText(dir.file("linuxcnc-pins/cnccomp.ini")).find("[KINS]"), std::string::npos);
     EXPECT_FALSE(fs::exists(dir.file("x")));
+}
+
+TEST(VerifyReport, AWorseCompensationShowsARedBannerAtTheTopOfThePage) {
+    // Every value of the truth with the wrong sign: the compensation doubles the errors. The page opens with the red
+    // banner (its text in the summary's alarms), whatever the gates; headless Chromium shows it at the top.
+    test::ScratchDir dir("verify-report-worse");
+    std::string flipped = "name,alias,value,unit\n";
+    for (const auto& [name, row] : test::deviationRowsAsWritten(kTruth))
+        flipped += name + ",," + std::to_string(-row.value) + "," + row.unit + "\n";
+    test::writeText(dir.file("flipped.csv"), flipped);
+    const auto r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("flipped.csv") +
+                                " --truth " + kTruth + " --report " + dir.file("w/report.html"));
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    const JsonValue s = readJsonFile(dir.file("w/report.summary.json"));
+    ASSERT_EQ(s["alarms"].array.size(), 1u);
+    EXPECT_EQ(s["alarms"][0].string.rfind("COMPENSATION MAKES THE MACHINE WORSE", 0), 0u);
+    const std::string html = test::readText(dir.file("w/report.html"));
+    EXPECT_LT(html.find("class=\"alarm\""), html.find("<h1>"));
+    if (!test::chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
+    const std::string log = test::screenshot(dir.file("w/report.html"), dir.file("top.png"), 1400, 300, dir);
+    EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
+    std::string why;
+    const auto pic = test::readPng(dir.file("top.png"), why);
+    if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
+    // The banner: #c00000 across the page's width (1352 px inside the margins, less its white text) and over 40 px high.
+    EXPECT_GT(test::countColour(*pic, "#c00000"), 1000 * 40);
+    // And an ideal compensation's page has none.
+    const auto ok = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + kTruth + " --truth " +
+                                 kTruth + " --report " + dir.file("ok/report.html"));
+    ASSERT_EQ(ok.exitCode, 0) << ok.out;
+    EXPECT_EQ(test::readText(dir.file("ok/report.html")).find("class=\"alarm\""), std::string::npos);
+    test::screenshot(dir.file("ok/report.html"), dir.file("ok.png"), 1400, 300, dir);
+    const auto okPic = test::readPng(dir.file("ok.png"), why);
+    if (!okPic) GTEST_SKIP() << "cannot read the screenshot: " << why;
+    EXPECT_LT(test::countColour(*okPic, "#c00000"), 100);
 }
 
 TEST(VerifyReport, OptionsAreChecked) {

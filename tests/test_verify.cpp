@@ -3,7 +3,11 @@
 // JSON report, and `cnccomp emit --plan`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <set>
+
+#include <fmt/format.h>
 
 #include "cnccomp/identification/rtest_run.hpp"
 #include "cnccomp/identification/tilting_head_errors.hpp"
@@ -12,6 +16,7 @@
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/verify.hpp"
 #include "cnccomp/verify_sources.hpp"
+#include "test_deviation_text.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
@@ -129,7 +134,8 @@ TEST(Verify, BackendRecognisedFromTheFilesAndUnknownFoldersRefused) {
     auto r = test::runCli("emit --controller fanuc-30i --machine " + mf + " --deviations " + t + " --out " + dir.file("f"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     r = test::runCli("verify --machine " + mf + " --plan " + p + " --truth " + t + " --compensation " + dir.file("f"));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
+    // No gate given: 1 only where the files make the machine worse than none, which the first line then says.
+    ASSERT_EQ(r.exitCode, r.out.rfind("COMPENSATION MAKES THE MACHINE WORSE", 0) == 0 ? 1 : 0) << r.out;
     EXPECT_NE(r.out.find("fanuc-30i files in"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("EA0C1"), std::string::npos) << "the NOT-compensated list of the files is printed";
     std::filesystem::create_directories(dir.file("other"));
@@ -146,7 +152,7 @@ TEST(Verify, BackendRecognisedFromTheFilesAndUnknownFoldersRefused) {
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_NE(r.out.find("--identified"), std::string::npos) << r.out;
     r = test::runCli("verify --machine " + mf + " --plan " + p + " --compensation " + dir.file("f") + " --identified " + t);
-    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_EQ(r.exitCode, r.out.rfind("COMPENSATION MAKES THE MACHINE WORSE", 0) == 0 ? 1 : 0) << r.out;  // as above
     EXPECT_NE(r.out.find("identified machine"), std::string::npos) << r.out;
 }
 
@@ -340,6 +346,121 @@ TEST(Verify, EmitWarnsWhenItsFilesLeaveMoreThanNoCompensation) {
     r = test::runCli("emit --controller isg --machine " + m + " --deviations " + t + " --plan " + p + " --out " + dir.file("i"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_EQ(r.out.find("WARNING"), std::string::npos) << r.out;
+}
+
+TEST(Verify, TheDeviationsLeftCarryTheirIsoValueAndAliasValueAsTheDeviationFileWritesThem) {
+    // Oracle: the truth CSV's text (test::deviationRowsAsWritten), not the deviation vector. The Fanuc files of the
+    // multi-tasking machine cannot hold its squareness errors; verify must name them as an engineer adjusts them: the
+    // ISO value under the ISO name (EC0Y −3″, EB0Z +6″, EA0C 3″), the paper's value under the alias (gXY +3″, bYZ −6″,
+    // aCZ 8″), in the text, the JSON and the HTML report.
+    test::ScratchDir dir("verify-left-names");
+    const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
+                      t = src("samples/deviations/multitasking-truth.csv");
+    auto r = test::runCli("emit --controller fanuc-30i --machine " + m + " --deviations " + t + " --out " + dir.file("f"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli("verify --machine " + m + " --plan " + p + " --compensation " + dir.file("f") + " --truth " + t + " --json " +
+                     dir.file("v.json") + " --report " + dir.file("r/report.html"));
+    const JsonValue v = readJsonFile(dir.file("v.json"));
+    EXPECT_EQ(r.exitCode, v["passed"].boolean ? 0 : 1) << r.out;
+    const auto rows = test::deviationRowsAsWritten(t);
+    std::set<std::string> listed;
+    for (const JsonValue& left : v["remaining"].array) {
+        if (left["iso_name"].type == JsonValue::Type::Null) continue;
+        const std::string name = left["iso_name"].string;
+        listed.insert(name);
+        ASSERT_TRUE(rows.count(name)) << name;
+        const test::DeviationRowText& row = rows.at(name);
+        EXPECT_EQ(left["unit"].string, row.unit) << name;
+        EXPECT_NEAR(left["value"].num(), row.value, 1e-9) << name;
+        EXPECT_EQ(left["alias"].string, row.alias) << name;
+        EXPECT_NEAR(left["alias_value"].num(), row.aliasValue, 1e-9) << name;
+    }
+    for (const char* name : {"EC0Y", "EB0Z", "EA0C"}) EXPECT_TRUE(listed.count(name)) << name << "\n" << r.out;
+    // The same numbers in the text and on the page.
+    EXPECT_NE(r.out.find("  EC0Y          -3.000 arcsec  gXY +3.000 arcsec"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  EB0Z          +6.000 arcsec  bYZ -6.000 arcsec"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  EA0C          +3.000 arcsec  aCZ +8.000 arcsec"), std::string::npos) << r.out;
+    const std::string html = test::readText(dir.file("r/report.html"));
+    EXPECT_NE(html.find("<td class=\"l\">EC0Y</td><td>-3.000</td><td class=\"l\">arcsec</td><td class=\"l\">gXY</td><td>3.000</td>"),
+              std::string::npos);
+    EXPECT_NE(html.find("<td class=\"l\">EA0C</td><td>3.000</td><td class=\"l\">arcsec</td><td class=\"l\">aCZ</td><td>8.000</td>"),
+              std::string::npos);
+}
+
+TEST(Verify, TheWorseGateAllowsATenthOfAMicronOrOnePercent) {
+    // The allowance on its own (verify.hpp VerifyWorse): max(0.1 µm, 1 % of before), on the span and the tool-tip error.
+    VerifyResult r;
+    const auto worse = [&](double beforeUm, double afterUm) {
+        r.residualBefore = beforeUm * kUm, r.residual = afterUm * kUm;
+        return compensationWorse(r).span;
+    };
+    EXPECT_FALSE(worse(0.001, 0.001));  // noise level: equal
+    EXPECT_FALSE(worse(0.001, 0.1));    // within the 0.1 µm floor
+    EXPECT_TRUE(worse(0.001, 0.102));
+    EXPECT_FALSE(worse(70.2, 70.8));    // within 1 % of 70.2 µm
+    EXPECT_TRUE(worse(70.2, 86.3));
+    EXPECT_FALSE(worse(70.2, 0.001));
+    r.residualBefore = r.residual = 0;
+    r.volumetric.available = true;
+    r.volumetric.maxBefore = 50 * kUm, r.volumetric.maxAfter = 50.4 * kUm;
+    EXPECT_FALSE(compensationWorse(r).any());
+    r.volumetric.maxAfter = 51 * kUm;
+    EXPECT_TRUE(compensationWorse(r).volumetric);
+    r.volumetric.available = false;  // corrected programs: no volumetric figure, no volumetric verdict
+    EXPECT_FALSE(compensationWorse(r).any());
+}
+
+TEST(Verify, ACompensationThatMakesTheMachineWorseFailsWhateverTheGate) {
+    // Oracle: the simulation on the true machine. (1) A controller that copies the values of what it can hold and
+    // nothing else: the ideal compensation of the deviations LinuxCNC's files take on the multi-tasking machine
+    // (kLinuxCncHolds, from their "compensated:" header), at their true values; the squareness and tilts left partly
+    // cancelled them, so the ball-bar span grows. (2) Every value with the wrong sign. Both exit 1 under a gate that
+    // the residual alone would pass (--max-residual-um 1000), the banner first in the text, in the JSON and on the page.
+    // (3) Noise-level figures do not trip it: a machine without errors, compensated by 0.001 µm.
+    test::ScratchDir dir("verify-worse");
+    const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
+                      t = src("samples/deviations/multitasking-truth.csv");
+    const auto rows = test::deviationRowsAsWritten(t);
+    auto r = test::runCli("emit --controller linuxcnc --machine " + m + " --deviations " + t + " --out " + dir.file("l"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    std::string copied = "name,alias,value,unit\n", flipped = "name,alias,value,unit\n";
+    std::vector<std::string> held;
+    for (const controllers::Coverage& c : readCompensated(readFolder(dir.file("l")))) held.push_back(c.deviation);
+    ASSERT_FALSE(held.empty());
+    for (const auto& [name, row] : rows) {
+        if (std::find(held.begin(), held.end(), name) != held.end()) copied += fmt::format("{},,{},{}\n", name, row.value, row.unit);
+        flipped += fmt::format("{},,{},{}\n", name, -row.value, row.unit);
+    }
+    test::writeText(dir.file("copied.csv"), copied);
+    test::writeText(dir.file("flipped.csv"), flipped);
+    for (const std::string name : {"copied", "flipped"}) {
+        r = test::runCli("verify --machine " + m + " --plan " + p + " --compensation " + dir.file(name + ".csv") + " --truth " + t +
+                         " --max-residual-um 1000 --json " + dir.file(name + ".json") + " --report " + dir.file(name + "/report.html"));
+        EXPECT_EQ(r.exitCode, 1) << name << "\n" << copied << r.out;
+        EXPECT_EQ(r.out.rfind("COMPENSATION MAKES THE MACHINE WORSE: largest dL span ", 0), 0u) << name << "\n" << r.out;
+        EXPECT_NE(r.out.find("verification passed: residual"), std::string::npos) << r.out;  // the 1000 um gate itself holds
+        EXPECT_NE(r.out.find("verification failed: COMPENSATION MAKES THE MACHINE WORSE"), std::string::npos) << r.out;
+        const JsonValue v = readJsonFile(dir.file(name + ".json"));
+        EXPECT_TRUE(v["makes_machine_worse"].boolean) << name;
+        EXPECT_TRUE(v["worse"]["span"].boolean) << name;
+        EXPECT_FALSE(v["passed"].boolean) << name;
+        EXPECT_GT(v["residual_um"].num(), v["residual_before_um"].num() + 1.0) << name;
+        const std::string html = test::readText(dir.file(name + "/report.html"));
+        const size_t banner = html.find("<div class=\"alarm\" role=\"alert\">COMPENSATION MAKES THE MACHINE WORSE");
+        EXPECT_NE(banner, std::string::npos) << name;
+        EXPECT_LT(banner, html.find("<h1>")) << name;  // above everything else on the page
+    }
+    // Without any gate too.
+    r = test::runCli("verify --machine " + m + " --plan " + p + " --compensation " + dir.file("flipped.csv") + " --truth " + t);
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    // Noise level: before 0, after ≈ 0.001 µm.
+    test::writeText(dir.file("zero.csv"), "name,alias,value,unit\n");
+    test::writeText(dir.file("tiny.csv"), "name,alias,value,unit\nEX0C,,0.001,um\n");
+    r = test::runCli("verify --machine " + m + " --plan " + p + " --compensation " + dir.file("tiny.csv") + " --truth " +
+                     dir.file("zero.csv") + " --json " + dir.file("tiny.json"));
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_FALSE(readJsonFile(dir.file("tiny.json"))["makes_machine_worse"].boolean);
+    EXPECT_EQ(r.out.find("WORSE"), std::string::npos) << r.out;
 }
 
 TEST(Verify, AShiftedDatumPassesTheSpanGateAndFailsTheVolumetricGate) {

@@ -14,7 +14,8 @@
 #               simulated real machine, with an HTML report each
 #
 # Every output stays in one folder (default out/quickstart/, emptied first; ignored by git); the last lines print the
-# before/after summary and where the reports are.
+# before/after summary, a "!!!" line for every compensation that leaves the machine worse than none, and where the
+# reports are. emit's WARNING lines are printed as they come.
 #
 # usage: bash tools/quickstart.sh [--out DIR] [--no-build] [--cnccomp PATH]
 #   --no-build   skip installing packages and building (the test tests/test_quickstart.cpp runs the chain this way)
@@ -74,6 +75,7 @@ step "5 emit: compensation files for every controller, with the residual they le
 for c in "${controllers[@]}"; do
   cnccomp emit --controller $c --machine $M --deviations "$D" --plan $P --out "$out/5-emit/$c" > "$out/5-emit/$c.txt"
   echo "$c: $(grep '^predicted residual' "$out/5-emit/$c.txt" | sed 's/.*: largest/largest/')"
+  grep 'WARNING' "$out/5-emit/$c.txt" | sed "s/^/$c: /" || true  # every warning of emit, not only in 5-emit/<c>.txt
 done
 
 step "6 correct: the part program, and each test program with its tool length (from its header)"
@@ -88,10 +90,14 @@ echo "corrected $(ls "$out"/6-correct/testprog | wc -l) test programs into 6-cor
 
 step "7 verify: the test programs through what you would load, on the real machine (simulation with the truth)"
 verify() {  # verify NAME COMPENSATION [options]: report and JSON in 7-verify/NAME
-  local name=$1 comp=$2; shift 2
+  # Exit status 1 (a gate failed, or the compensation makes the machine worse: the first line says so) is a result
+  # to show, not a reason to stop; 2 (bad input) stops.
+  local name=$1 comp=$2 status=0; shift 2
   cnccomp verify --machine $M --plan $P --compensation "$comp" --truth $T --report "$out/7-verify/$name/report.html" \
-    --json "$out/7-verify/$name/verify.json" "$@" > "$out/7-verify/$name.txt"
-  grep -E '^(residual|verification passed)' "$out/7-verify/$name.txt" | sed "s/^/$name: /"
+    --json "$out/7-verify/$name/verify.json" "$@" > "$out/7-verify/$name.txt" 2>&1 || status=$?
+  if ((status > 1)); then cat "$out/7-verify/$name.txt" >&2; exit "$status"; fi
+  grep -E '^(COMPENSATION MAKES|residual|verification passed)|error: verification failed: [^C]' "$out/7-verify/$name.txt" |
+    sed "s/^/$name: /"
 }
 verify ideal "$D" --max-residual-um 1           # a perfect TCP controller with the identified set: gate at 1 um
 verify corrected-programs "$out/6-correct/testprog" --max-residual-um 1
@@ -110,6 +116,11 @@ step "summary: largest ball-bar dL span of the six runs and largest tool-tip err
     printf '%-19s %-18s %-18s %-18s %-5s %s\n' "$name" "$predicted" "$verified" "${tip:--}" "$left" "$out/7-verify/$name/report.html"
   done
   echo
+  # A banner line for every compensation that leaves the real machine worse than none (verify's first line).
+  for name in ideal corrected-programs "${controllers[@]}"; do
+    banner=$(grep -m1 '^COMPENSATION MAKES THE MACHINE WORSE' "$out/7-verify/$name.txt" || true)
+    [ -z "$banner" ] || echo "!!! $name: $banner (7-verify/$name.txt)"
+  done
   echo "predicted: what cnccomp emit says the files leave on the identified machine; verified: cnccomp verify on the"
   echo "simulated real machine; left: deviations the controller's files cannot hold (named with the reason in"
   echo "7-verify/<name>.txt and in the report). Identification report: $out/3-identify/report.html"

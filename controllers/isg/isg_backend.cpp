@@ -222,8 +222,11 @@ void addColumn(std::string& head, std::string& row, const std::string& name, dou
 
 class IsgApplied final : public AppliedCompensation {
 public:
-    IsgApplied(const MachineModel& m, IsgModel model) : machine_(&m), model_(std::move(model)) {
-        for (char c : std::string("XYZ")) linear_.push_back(m.requireAxis(std::string(1, c)));
+    IsgApplied(const MachineModel& m, IsgModel model, const IsgConfig& cfg) : machine_(&m), model_(std::move(model)) {
+        for (char c : std::string("XYZ")) {
+            linear_.push_back(m.requireAxis(std::string(1, c)));
+            scale_.push_back(cfg.setToZero.find(c) != std::string::npos ? 0.0 : cfg.negate.find(c) != std::string::npos ? -1.0 : 1.0);
+        }
     }
     AxisVector driveCommands(const AxisVector& q) const override { return driveCommandsForTool(q, 0.0); }
     AxisVector driveCommandsForTool(const AxisVector& q, double toolLength) const override {
@@ -248,6 +251,10 @@ public:
             const Vec3 step = J.partialPivLu().solve(r);
             for (int k = 0; k < 3; ++k) p[linear_[k]] += step[k];
         }
+        // P-VOLC-00009 `negate` / `set_to_zero` of the compensation list: the compensation value of that Cartesian axis
+        // (corrected minus programmed) negated or zeroed before it reaches the axis.
+        const AxisVector programmed = m.toController(q);
+        for (int k = 0; k < 3; ++k) p[linear_[k]] = programmed[linear_[k]] + scale_[k] * (p[linear_[k]] - programmed[linear_[k]]);
         return m.fromController(p);
     }
     const IsgModel& model() const { return model_; }
@@ -256,6 +263,7 @@ private:
     const MachineModel* machine_;
     IsgModel model_;
     std::vector<int> linear_;
+    std::vector<double> scale_;  ///< per X Y Z: 1, −1 (negate) or 0 (set_to_zero)
 };
 
 class IsgBackend final : public Backend {
@@ -358,6 +366,10 @@ public:
             "absolute values: P0, N0 and the centres PXA.. are machine-frame positions at all axes 0 (controller zero); "
             "errors and tables replace any loaded before (not deltas)",
             "values in mm and rad, arguments in mm and degrees, in machine coordinates (TF5280 \"Units of measure\")",
+            "signs: the errors are written as ISO 230-1 / TF5280 define them (the error of the axis, not its correction); the "
+            "compensation values the control computes from them are used as computed: this list sets neither 'negate' nor "
+            "'set_to_zero' (P-VOLC-00009 \"Negate compensation values\", TF5280 \"Modification of compensation values "
+            "(optional)\"); an entry 'negate XYZ' in this list would flip every correction and double the error",
             "tool position only: the volumetric compensation does not correct tool orientation (TF5280 \"Overview\")",
             "[G] each axis' errors act at its machine zero, about its centre of rotation (rotary) or the origin (linear); "
             "workpiece axes carry the table's own errors",
@@ -387,7 +399,7 @@ public:
                 throw InputError(kLis, 0, fmt::format("chain {} lacks axis {} of machine '{}'", cfg.chain, a, m.name));
         std::vector<std::pair<std::string, std::vector<IsgBlock>>> blocks;
         for (const auto& [file, format] : cfg.files) blocks.emplace_back(file, parseIsgCsv(requireFile(files, file, "ISG").content, file));
-        return std::make_unique<IsgApplied>(m, IsgModel(cfg, blocks));
+        return std::make_unique<IsgApplied>(m, IsgModel(cfg, blocks), cfg);
     }
 };
 

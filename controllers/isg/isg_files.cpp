@@ -45,6 +45,13 @@ IsgConfig parseIsgConfig(const std::string& text, const std::string& name) {
             for (char ch : c.chain)
                 if (std::string("XYZABC").find(ch) == std::string::npos)
                     throw InputError(name, l.number, fmt::format("chain '{}': axes are X Y Z A B C", c.chain));
+        } else if (key == "negate" || key == "set_to_zero") {
+            // P-VOLC-00009 and TF5280 "Modification of compensation values (optional)": a set of Cartesian axes.
+            std::string& set = key == "negate" ? c.negate : c.setToZero;
+            set = std::string(tok[1]);
+            for (char ch : set)
+                if (std::string("XYZ").find(ch) == std::string::npos)
+                    throw InputError(name, l.number, fmt::format("{} '{}': the Cartesian axes X Y Z", key, set));
         } else if (key == "workpiece_axes") {
             const double n = requireNumber(tok[1], name, l.number, "a number of axes");
             if (n < 0 || n > 6 || n != static_cast<int>(n)) throw InputError(name, l.number, "workpiece_axes must be 0..6");

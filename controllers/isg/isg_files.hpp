@@ -17,6 +17,11 @@ struct IsgConfig {
     std::string chain;                ///< axis letters, workpiece → machine origin → tool tip (TF5240)
     int workpieceAxes = 0;
     std::vector<std::pair<std::string, std::string>> files;  ///< file name, format
+    /// P-VOLC-00009 `negate` (TF5280 "Modification of compensation values (optional)"): the Cartesian axes (of X Y Z)
+    /// whose computed compensation value the control negates, e.g. "XY"; `set_to_zero`: those whose value it sets to
+    /// 0. cnccomp writes neither (the values are meant to be used as computed, which its files' header states) and
+    /// reads both, so that verify sees what a list that sets them does.
+    std::string negate{}, setToZero{};
 };
 std::string formatIsgConfig(const IsgConfig& c, const std::string& header);
 /// InputError(file:line) on unknown keys, bad numbers, a format other than ISG_CSV.

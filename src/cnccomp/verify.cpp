@@ -312,16 +312,48 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
         const int d = m.deviationIndex(c.deviation.substr(0, c.deviation.find(' ')));  // "EBB (constant part)" → EBB
         if (d >= 0) {
             const DeviationDef& def = m.deviations[static_cast<size_t>(d)];
-            double v = 0;
-            for (int j = 0; j < def.size(); ++j) v = std::max(v, std::abs(simulated.values[def.offset + j]));
-            if (def.size() == 1) v = simulated.values[def.offset];
+            const double unit = def.isAngle() ? kArcsec : kUm;
             rem.valueKnown = true;
-            rem.value = def.isAngle() ? v / kArcsec : v / kUm;
+            rem.isoName = def.name;
             rem.unit = def.isAngle() ? "arcsec" : "um";
+            if (def.kind == DeviationKind::Location) {
+                rem.value = simulated.isoValue(d) / unit;  // the ISO value, not the link value (iso_names.hpp)
+                if (!def.alias.empty()) rem.alias = def.alias, rem.aliasValue = simulated.aliasValue(d) / unit;
+            } else {  // a component error: its largest coefficient, the same under either name
+                double v = 0;
+                for (int j = 0; j < def.size(); ++j) v = std::max(v, std::abs(simulated.values[def.offset + j]));
+                rem.value = v / unit;
+            }
         }
         out.remaining.push_back(rem);
     }
+    out.worse = compensationWorse(out);
     return out;
+}
+
+VerifyWorse compensationWorse(const VerifyResult& r) {
+    const auto allowance = [](double before) { return std::max(kWorseFloorMm, kWorseRelative * before); };
+    VerifyWorse w;
+    w.spanAllowance = allowance(r.residualBefore);
+    w.span = r.residual > r.residualBefore + w.spanAllowance;
+    if (r.volumetric.available) {
+        w.volumetricAllowance = allowance(r.volumetric.maxBefore);
+        w.volumetric = r.volumetric.maxAfter > r.volumetric.maxBefore + w.volumetricAllowance;
+    }
+    return w;
+}
+
+std::string worseBanner(const VerifyResult& r) {
+    const VerifyWorse& w = r.worse;
+    if (!w.any()) return {};
+    std::string s = "COMPENSATION MAKES THE MACHINE WORSE:";
+    if (w.span)
+        s += fmt::format(" largest dL span {:.3f} -> {:.3f} um (allowed growth {:.3f} um){}", r.residualBefore / kUm,
+                         r.residual / kUm, w.spanAllowance / kUm, w.volumetric ? ";" : "");
+    if (w.volumetric)
+        s += fmt::format(" volumetric tool-tip error {:.3f} -> {:.3f} um (allowed growth {:.3f} um)", r.volumetric.maxBefore / kUm,
+                         r.volumetric.maxAfter / kUm, w.volumetricAllowance / kUm);
+    return s + "; do not load it";
 }
 
 }  // namespace cnccomp

@@ -89,13 +89,37 @@ struct VerifyVolumetric {
     double tiltBefore = 0, tiltAfter = 0;                             ///< largest tool-axis error, rad
 };
 
+/// A deviation the compensation leaves, named and valued the way an engineer adjusts it by hand: under its ISO 230-1
+/// name its ISO value (DeviationSet::isoValue: the standard's reference axis and sign, iso_names.hpp), and under the
+/// paper alias the alias' own value (DeviationSet::aliasValue), never the link value of the kinematic chain. Units as
+/// the deviation CSV writer writes them (µm, arcsec). A component error (EXX …) shows its largest coefficient.
 struct VerifyRemaining {
-    std::string deviation;      ///< name as the backend lists it
+    std::string deviation;      ///< name as the backend lists it (e.g. "EC0Y", "EBB (constant part)")
     std::string reason;
     bool valueKnown = false;    ///< the name is a deviation of the machine
-    double value = 0;           ///< in the simulated machine, display units
+    std::string isoName;        ///< the machine's ISO name of that deviation (valueKnown)
+    double value = 0;           ///< under the ISO name, in the simulated machine, display units
     std::string unit;           ///< "um" or "arcsec"
+    std::string alias;          ///< the paper alias, empty when the machine has none (or a component error)
+    double aliasValue = 0;      ///< under the alias (alias non-empty), same unit
 };
+
+/// verify's own gate, which holds whatever the options say: a compensation that leaves the machine worse than none.
+/// "Worse" = the largest span after exceeds the one before by more than the allowance, or the volumetric tool-tip
+/// error (max) after exceeds the one before by more than its allowance. Allowance = max(0.1 µm, 1 % of before).
+/// Why: verify simulates the readings without noise, so after and before differ only by what the compensation does
+/// and by the rounding of the values in its files; 0.1 µm is what the closed loop holds every backend to for what it
+/// claims (tests/test_verify_loop.cpp, README "Test programs and verification"), and below the 0.2–0.5 µm reading noise
+/// the samples simulate for a ball bar. The 1 % leaves alone a compensation that changes a large error by less than
+/// an engineer would act on ([G] a judgement, not a figure of a standard).
+struct VerifyWorse {
+    bool span = false;          ///< the largest span grew beyond its allowance
+    bool volumetric = false;    ///< the volumetric tool-tip error grew beyond its allowance
+    double spanAllowance = 0, volumetricAllowance = 0;  ///< mm
+    bool any() const { return span || volumetric; }
+};
+inline constexpr double kWorseFloorMm = 1e-4;    ///< 0.1 µm
+inline constexpr double kWorseRelative = 0.01;   ///< 1 % of before
 
 struct VerifyResult {
     std::string machine;
@@ -106,7 +130,14 @@ struct VerifyResult {
     std::vector<VerifyRemaining> remaining;
     double residualBefore = 0;  ///< largest span of any run before compensation, mm
     double residual = 0;        ///< largest span of any run after compensation, mm (what --max-residual-um gates)
+    VerifyWorse worse;          ///< the compensation leaves the machine worse than none (exit status 1 in any case)
 };
+
+/// Whether after exceeds before by more than max(kWorseFloorMm, kWorseRelative · before) (VerifyWorse).
+VerifyWorse compensationWorse(const VerifyResult& result);
+/// The banner of a compensation that makes the machine worse: "COMPENSATION MAKES THE MACHINE WORSE: largest ΔL span
+/// 70.250 -> 86.300 um (allowance 0.703 um); …"; empty when it does not.
+std::string worseBanner(const VerifyResult& result);
 
 /// Runs the loop. `simulated` is the machine the commands reach (truth or identified); `simulatedName` says which.
 /// Throws ModelError / InputError (a corrected program missing or malformed, commands outside the travel …).

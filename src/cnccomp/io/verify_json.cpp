@@ -63,11 +63,16 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
     o += fmt::format("  \"machine\": {},\n  \"simulated\": {},\n  \"compensation\": {},\n", str(r.machine), str(r.simulated),
                      str(r.compensation));
     o += fmt::format("  \"residual_before_um\": {},\n  \"residual_um\": {},\n", um(r.residualBefore), um(r.residual));
-    const bool gated = gateUm || volumetricGateUm;
-    const bool passed = verifyGatePassed(r, gateUm, volumetricGateUm);
+    // `passed` is false when a gate given fails or when the compensation makes the machine worse (a gate that holds
+    // whatever the options say): the exit status of verify is 0 exactly when it is true.
+    const bool passed = verifyGatePassed(r, gateUm, volumetricGateUm) && !r.worse.any();
+    o += fmt::format("  \"makes_machine_worse\": {},\n  \"worse\": {{\"span\": {}, \"volumetric\": {}, \"span_allowance_um\": {}, "
+                     "\"volumetric_allowance_um\": {}, \"banner\": {}}},\n",
+                     r.worse.any() ? "true" : "false", r.worse.span ? "true" : "false", r.worse.volumetric ? "true" : "false",
+                     um(r.worse.spanAllowance), r.volumetric.available ? um(r.worse.volumetricAllowance) : "null",
+                     r.worse.any() ? str(worseBanner(r)) : "null");
     o += fmt::format("  \"max_residual_um\": {},\n  \"max_volumetric_um\": {},\n  \"passed\": {},\n",
-                     gateUm ? num(*gateUm) : "null", volumetricGateUm ? num(*volumetricGateUm) : "null",
-                     gated ? (passed ? "true" : "false") : "null");
+                     gateUm ? num(*gateUm) : "null", volumetricGateUm ? num(*volumetricGateUm) : "null", passed ? "true" : "false");
     o += "  \"runs\": [\n";
     for (size_t i = 0; i < r.runs.size(); ++i) {
         const VerifyRun& run = r.runs[i];
@@ -87,8 +92,12 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
                      um(v.maxAfter), um(v.rmsAfter), num(v.tiltBefore / kArcsec), num(v.tiltAfter / kArcsec));
     o += fmt::format("  \"remaining\": {}\n}}\n", list(r.remaining.size(), [&](size_t i) {
                          const VerifyRemaining& x = r.remaining[i];
-                         return fmt::format("{{\"deviation\": {}, \"reason\": {}, \"value\": {}, \"unit\": {}}}", str(x.deviation),
-                                            str(x.reason), x.valueKnown ? num(x.value) : "null", x.valueKnown ? str(x.unit) : "null");
+                         // The ISO value under the ISO name, the alias' own value under the alias (VerifyRemaining).
+                         return fmt::format("{{\"deviation\": {}, \"reason\": {}, \"iso_name\": {}, \"value\": {}, \"unit\": {}, "
+                                            "\"alias\": {}, \"alias_value\": {}}}",
+                                            str(x.deviation), str(x.reason), x.valueKnown ? str(x.isoName) : "null",
+                                            x.valueKnown ? num(x.value) : "null", x.valueKnown ? str(x.unit) : "null",
+                                            x.alias.empty() ? "null" : str(x.alias), x.alias.empty() ? "null" : num(x.aliasValue));
                      }));
     return o;
 }

@@ -13,8 +13,10 @@ namespace cnccomp {
 /// The gates of `cnccomp verify`: the residual (largest ΔL span after) at most `gateUm`, and the volumetric tool-tip
 /// error after at most `volumetricGateUm` (failed when there is no volumetric figure). Unset gates pass.
 bool verifyGatePassed(const VerifyResult& result, std::optional<double> gateUm, std::optional<double> volumetricGateUm);
-/// `gateUm`, `volumetricGateUm`: the --max-residual-um / --max-volumetric-um gates, if any (the JSON says whether they
-/// passed).
+/// `gateUm`, `volumetricGateUm`: the --max-residual-um / --max-volumetric-um gates, if any. `passed` is true when
+/// every gate given holds and the compensation does not make the machine worse (`makes_machine_worse`, `worse`:
+/// VerifyResult::worse, always checked); `remaining` lists each deviation left under the backend's name with its ISO
+/// name and ISO value, and the paper alias with the alias' value (VerifyRemaining).
 std::string formatVerifyJson(const VerifyResult& result, std::optional<double> gateUm = std::nullopt,
                              std::optional<double> volumetricGateUm = std::nullopt);
 

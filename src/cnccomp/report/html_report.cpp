@@ -48,6 +48,8 @@ table { border-collapse: collapse; margin: 8px 0; font-size: 13px; }
 th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: right; }
 th { background: #f2f2f2; } td.l, th.l { text-align: left; }
 .facts td { text-align: left; border: none; padding: 1px 12px 1px 0; }
+.alarm { background: #c00000; color: white; font-weight: bold; font-size: 20px; padding: 14px 18px; margin: 0 0 12px 0;
+         border: 3px solid #700000; }
 .warn { background: #fff4e0; border: 1px solid #f0c070; padding: 6px 10px; margin: 4px 0; font-size: 13px; }
 .plots { display: flex; flex-wrap: wrap; gap: 12px; }
 figure { margin: 0; border: 1px solid #ddd; padding: 4px; background: white; }
@@ -110,6 +112,7 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
     o += "  \"facts\": " + jsonArray(d.facts, [](const auto& f) {
              return fmt::format("[{}, {}]", jsonString(f.first), jsonString(f.second));
          }) + ",\n";
+    o += "  \"alarms\": " + jsonArray(d.alarms, [](const std::string& w) { return jsonString(w); }) + ",\n";
     o += "  \"warnings\": " + jsonArray(d.warnings, [](const std::string& w) { return jsonString(w); }) + ",\n";
     o += "  \"after_note\": " + jsonString(d.afterNote) + ",\n";
     appendRows(o, "runs", d.runs, [&](const RunSection& r, size_t i) {
@@ -152,8 +155,10 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
             return jsonArray(v, [](const CoverageRow& r) { return jsonString(r.deviation); });
         };
         const std::string remaining = jsonArray(c.notCompensated, [](const CoverageRow& r) {
-            return fmt::format("{{\"deviation\": {}, \"value\": {}, \"unit\": {}, \"reason\": {}}}", jsonString(r.deviation),
-                               jsonNumber(r.value), jsonString(r.unit), jsonString(r.note));
+            return fmt::format("{{\"deviation\": {}, \"value\": {}, \"unit\": {}, \"alias\": {}, \"alias_value\": {}, "
+                               "\"reason\": {}}}",
+                               jsonString(r.deviation), jsonNumber(r.value), jsonString(r.unit),
+                               r.alias.empty() ? "null" : jsonString(r.alias), jsonNumber(r.aliasValue), jsonString(r.note));
         });
         return fmt::format("{{\"name\": {}, \"files\": {}, \"compensated\": {}, \"not_compensated\": {}, "
                            "\"before_max_um\": {}, \"before_rms_um\": {}, \"after_max_um\": {}, \"after_rms_um\": {}, \"points\": {}, "
@@ -174,6 +179,7 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
                                      files.plots.size(), d.runs.size(), d.maps.size()));
     std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
     h += fmt::format("<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n", esc(d.title), kStyle);
+    for (const std::string& a : d.alarms) h += fmt::format("<div class=\"alarm\" role=\"alert\">{}</div>\n", esc(a));
     h += fmt::format("<h1>{}</h1>\n<table class=\"facts\">\n<tr><td>machine</td><td>{}</td></tr>\n", esc(d.title), esc(d.machine));
     for (const auto& [k, v] : d.facts) h += fmt::format("<tr><td>{}</td><td>{}</td></tr>\n", esc(k), esc(v));
     h += "</table>\n";
@@ -288,12 +294,17 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
             const bool values = std::any_of(c.notCompensated.begin(), c.notCompensated.end(),
                                             [](const CoverageRow& r) { return std::isfinite(r.value); });
             if (values) {  // the deviations left, with their value in the machine the figures are for
-                h += fmt::format("<p class=\"no\">Deviations {} leaves, and why:</p>\n<table>\n<tr><th class=\"l\">deviation</th>"
-                                 "<th>value</th><th class=\"l\">unit</th><th class=\"l\">why not compensated</th></tr>\n",
+                // ISO value under the ISO name, the alias' own value under the alias: what an engineer adjusts by hand.
+                h += fmt::format("<p class=\"no\">Deviations {} leaves, and why (value under the ISO 230-1 name, and under the "
+                                 "paper alias where the machine has one):</p>\n<table>\n<tr><th class=\"l\">deviation</th>"
+                                 "<th>ISO value</th><th class=\"l\">unit</th><th class=\"l\">paper alias</th><th>alias value</th>"
+                                 "<th class=\"l\">why not compensated</th></tr>\n",
                                  esc(c.name));
                 for (const CoverageRow& r : c.notCompensated)
-                    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td></tr>\n",
-                                     esc(r.deviation), fixed(r.value, 3), r.unit == "um" ? "µm" : esc(r.unit), esc(r.note));
+                    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td>"
+                                     "<td class=\"l\">{}</td></tr>\n",
+                                     esc(r.deviation), fixed(r.value, 3), r.unit == "um" ? "µm" : esc(r.unit), esc(r.alias),
+                                     r.alias.empty() ? "" : fixed(r.aliasValue, 3), esc(r.note));
                 h += "</table>\n";
                 continue;
             }

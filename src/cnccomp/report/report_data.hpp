@@ -84,11 +84,14 @@ struct PassSpan {
     std::string warning;              ///< e.g. the compensated commands leave an axis' travel; empty = none
 };
 
-/// One deviation a compensation takes (how) or leaves (why not), with its value where known.
+/// One deviation a compensation takes (how) or leaves (why not), with its value where known: under its ISO 230-1 name
+/// the ISO value, under the paper alias the alias' own value (verify.hpp VerifyRemaining; iso_names.hpp).
 struct CoverageRow {
     std::string deviation, note;
-    double value = kUnknown;          ///< in `unit` (um or arcsec), in the machine the figures are for; NaN = not shown
+    double value = kUnknown;          ///< ISO value in `unit` (um or arcsec), in the machine the figures are for; NaN = not shown
     std::string unit;
+    std::string alias{};              ///< paper alias; empty = none
+    double aliasValue = kUnknown;     ///< value under the alias, same unit
 };
 
 /// A controller's compensation: files, coverage and the predicted (or verified) residual tool-tip error.
@@ -109,6 +112,8 @@ struct ReportData {
     const MachineModel* machineModel = nullptr;  ///< needed to draw `maps` (axis kinds); may be null without maps
     std::vector<std::pair<std::string, std::string>> facts;  ///< shown in the page header (inputs, solver, …)
     std::vector<std::string> warnings;
+    /// Shown first, as a red banner at the top of the page (verify: "COMPENSATION MAKES THE MACHINE WORSE …").
+    std::vector<std::string> alarms;
     std::string afterNote;             ///< what "after" means in the runs' figures (shown under their table)
     std::vector<RunSection> runs;
     std::vector<PassSpan> spans;       ///< verify: every pass of every run, ball bar and R-test

@@ -64,7 +64,8 @@ ControllerSection compensationSection(const MachineModel& m, const VerifyCompens
     }
     for (const controllers::Coverage& x : c.compensated) s.compensated.push_back({x.deviation, x.note, kUnknown, ""});
     for (const VerifyRemaining& x : r.remaining)
-        s.notCompensated.push_back({x.deviation, x.reason, x.valueKnown ? x.value : kUnknown, x.valueKnown ? x.unit : ""});
+        s.notCompensated.push_back({x.deviation, x.reason, x.valueKnown ? x.value : kUnknown, x.valueKnown ? x.unit : "", x.alias,
+                                    x.alias.empty() ? kUnknown : x.aliasValue});
     const VerifyVolumetric& v = r.volumetric;
     if (v.available) {
         s.beforeMax = v.maxBefore;
@@ -96,6 +97,12 @@ ReportData verificationReport(const MachineModel& m, const DeviationSet& simulat
                                              in.dialect)},
                {"residual", fmt::format("largest ΔL span after compensation {:.3f} µm (before {:.3f} µm)", r.residual / kUm,
                                         r.residualBefore / kUm)}};
+    // The gate that holds whatever the options say (verify.hpp VerifyWorse): first on the page when it fails.
+    if (r.worse.any()) d.alarms.push_back(worseBanner(r));
+    d.facts.push_back({"against no compensation",
+                       r.worse.any() ? "WORSE than none: exit status 1"
+                                     : fmt::format("not worse than none (growth allowed: max(0.1 µm, 1 % of before) = {:.3f} µm of span)",
+                                                   r.worse.spanAllowance / kUm)});
     if (in.gateUm)
         d.facts.push_back({"gate", fmt::format("--max-residual-um {:g}: {}", *in.gateUm,
                                                r.residual / kUm <= *in.gateUm ? "passed" : "FAILED (exit status 1)")});
