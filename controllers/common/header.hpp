@@ -21,7 +21,7 @@ struct HeaderInfo {
     std::vector<std::string> notes;    ///< free lines, e.g. "[G] sign convention not confirmed"
 };
 
-/// Header info from an emit request and the coverage found so far; the request's headerNotes follow `notes`.
+/// Header info from an emit request and the coverage found so far.
 HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controller, const EmitResult& coverage,
                           std::vector<std::string> notes = {});
 
