@@ -223,8 +223,9 @@ TEST(Verify, EveryBackendsDamagedFilesFailTheGate) {
     test::writeText(claimed, "name,alias,value,unit\nEY0A,,-5,um\nEZ0A,,-68,um\nEX0C,,-5,um\nEY0C,,-2,um\n");
     for (const Case& c : cases) {
         const std::string truth = c.claimedTruth ? claimed : full, good = dir.file(std::string(c.backend) + "-good");
-        auto r = test::runCli("emit --controller " + std::string(c.backend) + " --machine " + m + " --deviations " + truth +
-                              " --out " + good);
+        // The identified values as they are (--copy-identified): the damaged lines' numbers are those of that header.
+        auto r = test::runCli("emit --copy-identified --controller " + std::string(c.backend) + " --machine " + m +
+                              " --deviations " + truth + " --out " + good);
         ASSERT_EQ(r.exitCode, 0) << r.out;
         const auto gate = [&](const std::string& folder) {
             return test::runCli("verify --machine " + m + " --plan " + p + " --truth " + truth + " --compensation " + folder +
