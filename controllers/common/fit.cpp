@@ -177,7 +177,12 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
         DeviationSet p = zero;
         p.values[j] = h;
         p.present[static_cast<size_t>(d)] = 1;
-        const Eigen::VectorXd col = (residual(p) - r0) / h;
+        Eigen::VectorXd col;
+        try {
+            col = (residual(p) - r0) / h;
+        } catch (const ModelError&) {
+            continue;  // the controller refuses the value (e.g. a pitch table's data range): not a value it holds
+        }
         if ((col * h).lpNorm<Eigen::Infinity>() <= 1e-7) continue;  // the drives do not move by 0.1 nm: not held
         free.push_back(j);
         columns.push_back(col);
@@ -220,8 +225,12 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
             bool better = false;
             for (int halving = 0; halving < 6 && !better; ++halving, t *= 0.5) {
                 const Eigen::VectorXd xt = x + t * dx;
-                const Eigen::VectorXd rt = residual(setFree(xt));
-                if (rt.squaredNorm() < cost) x = xt, r = rt, better = true;
+                try {
+                    const Eigen::VectorXd rt = residual(setFree(xt));
+                    if (rt.squaredNorm() < cost) x = xt, r = rt, better = true;
+                } catch (const ModelError&) {
+                    // beyond a limit of the controller: a shorter step
+                }
             }
             if (!better) break;
             const double before = cost;
@@ -230,7 +239,12 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
         }
         fitted = setFree(x);
     }
-    out.fitted = figuresOf(m, identified, *filesFor(b, m, fitted), workspace);
+    try {
+        out.fitted = figuresOf(m, identified, *filesFor(b, m, fitted), workspace);
+    } catch (const ModelError&) {
+        fitted = zero;  // the controller refuses the fitted values: the fit falls back to none
+        out.fitted = out.none;
+    }
     out.fittedValues = fitted;
 
     // The choice: the smallest RMS among the candidates whose largest error is not above none's (none always qualifies).
