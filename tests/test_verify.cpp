@@ -230,8 +230,9 @@ TEST(Verify, EveryBackendsDamagedFilesFailTheGate) {
     test::writeText(claimed, "name,alias,value,unit\nEY0A,,-5,um\nEZ0A,,-68,um\nEX0C,,-5,um\nEY0C,,-2,um\n");
     for (const Case& c : cases) {
         const std::string truth = c.claimedTruth ? claimed : full, good = dir.file(std::string(c.backend) + "-good");
-        auto r = test::runCli("emit --controller " + std::string(c.backend) + " --machine " + m + " --deviations " + truth +
-                              " --out " + good);
+        // The identified values as they are (--copy-identified): the damaged lines' numbers are those of that header.
+        auto r = test::runCli("emit --copy-identified --controller " + std::string(c.backend) + " --machine " + m +
+                              " --deviations " + truth + " --out " + good);
         ASSERT_EQ(r.exitCode, 0) << r.out;
         const auto gate = [&](const std::string& folder) {
             return test::runCli("verify --machine " + m + " --plan " + p + " --truth " + truth + " --compensation " + folder +
@@ -331,16 +332,17 @@ TEST(Verify, NotCompensatedListReadFromAnyCommentSyntax) {
 }
 
 TEST(Verify, EmitWarnsWhenItsFilesLeaveMoreThanNoCompensation) {
-    // On the multi-tasking sample LinuxCNC's pins-and-tables route corrects the spindle and C offsets but cannot hold the squareness
-    // and tilts, which partly cancelled them: the predicted ball-bar span grows (86.7 against 70.2 um). The ISG files
-    // hold every deviation: no warning.
+    // On the multi-tasking sample the LinuxCNC files with the identified values copied (--copy-identified; by default
+    // emit writes values fitted to what the controller holds) correct the spindle and C offsets but cannot hold the
+    // squareness and tilts, which partly cancelled them: the predicted ball-bar span grows (86.7 against 70.2 um). The
+    // ISG files hold every deviation: no warning.
     test::ScratchDir dir("emit-worse");
     const std::string m = src("samples/machines/multitasking.xml"), p = src("samples/plans/multitasking-six-circles.xml"),
                       t = src("samples/deviations/multitasking-truth.csv");
-    auto r = test::runCli("emit --controller linuxcnc-pins --machine " + m + " --deviations " + t + " --plan " + p + " --out " +
-                          dir.file("l"));
+    auto r = test::runCli("emit --controller linuxcnc-pins --copy-identified --machine " + m + " --deviations " + t + " --plan " + p +
+                          " --out " + dir.file("l"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(r.out.find("WARNING: on this machine these files leave MORE error than no compensation (ball-bar span)"),
+    EXPECT_NE(r.out.find("WARNING: on this machine these files leave MORE error than no compensation (ball-bar span"),
               std::string::npos)
         << r.out;
     r = test::runCli("emit --controller isg --machine " + m + " --deviations " + t + " --plan " + p + " --out " + dir.file("i"));

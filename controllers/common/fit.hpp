@@ -3,6 +3,7 @@
 // best of the controller's adjustable values against the identified machine's tool-tip error over a stated workspace,
 // with "no compensation" and "the identified values copied" always among the candidates, so that the files never
 // leave more error than none on that workspace.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,10 +31,34 @@ struct FitOutcome {
     std::string chosen;          ///< "fitted", "identified", "none"
     FitFigures none, copied, fitted;
     std::vector<std::string> notes;  ///< header lines: the workspace, the candidates' figures, the choice
+    std::optional<DeviationSet> fittedValues{};  ///< the fitted candidate's values (written or not)
+    int heldValues = -1;         ///< entries of the deviation vector the files respond to (-1: not searched, the copy held all)
 };
 
-/// Fits the values `b` writes: every deviation the backend's files respond to is a free value, the others are zero;
-/// least squares on the tool-tip error of `identified` over `workspace` through b.emit() and b.apply().
+/// When one figure "leaves more" than another: by more than 1 % of it or 0.01 um, whichever is larger (below that the
+/// difference is the files' rounding and the solvers' tolerance, e.g. 0.001 vs 0.001 um).
+struct FitTolerance {
+    double relative = 0.01;
+    double absolute = 0.01e-3;  ///< mm
+};
+inline constexpr FitTolerance kFitTolerance{};
+/// The copy of the identified values leaving at most this fraction of none's largest tip error: the controller holds
+/// every deviation, and the fit is the copy (exactly).
+inline constexpr double kHoldsAllFraction = 0.02;
+
+/// Whether `a` leaves more tool-tip error than `b` (largest or RMS) beyond kFitTolerance.
+bool leavesMore(const FitFigures& a, const FitFigures& b);
+
+/// Tool-tip error of the identified machine over the workspace with `b`'s files for `written` loaded.
+FitFigures fitFigures(const Backend& b, const MachineModel& m, const DeviationSet& identified, const DeviationSet& written,
+                      const FitWorkspace& workspace);
+
+/// Fits the values `b` writes: every entry of the deviation vector the backend's files respond to is a free value, the
+/// others are zero; least squares on the tool-tip error of `identified` over `workspace` (every pose at every tool
+/// length) through b.emit() and b.apply(). Candidates: none (all zero), the identified values copied, the fit; the
+/// written one has the smallest RMS among those whose largest error is not above none's. When the copy leaves at most
+/// kHoldsAllFraction of none's largest error the controller holds everything and the copy is the fit (written ==
+/// identified exactly).
 FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const DeviationSet& identified,
                                const FitWorkspace& workspace);
 

@@ -49,6 +49,8 @@ HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controlle
     h.compensated = coverage.compensated;
     h.notCompensated = coverage.notCompensated;
     h.notes = std::move(notes);
+    // What the caller says of the values themselves (e.g. fitted to this controller over which workspace).
+    h.notes.insert(h.notes.end(), request.headerNotes.begin(), request.headerNotes.end());
     return h;
 }
 

@@ -156,21 +156,21 @@ void analyse(const MachineModel& m, const testprog::RunMotion& r, const BallbarT
     }
 }
 
-void volumetric(const MachineModel& m, const DeviationSet& simulated, const controllers::AppliedCompensation& comp,
-                const std::vector<testprog::RunMotion>& motions, const std::vector<RunCommands>& programmed, int perAxis,
-                VerifyVolumetric& v) {
+/// The grid over the box of the plan's commands (as the test programs write them) at the runs' tool lengths.
+PlanWorkspace gridOver(const MachineModel& m, const std::vector<testprog::RunMotion>& motions,
+                       const std::vector<RunCommands>& programmed, int perAxis) {
     const int n = m.axisCount();
     AxisVector lo = AxisVector::Constant(n, HUGE_VAL), hi = AxisVector::Constant(n, -HUGE_VAL);
     for (const RunCommands& c : programmed)
         for (const auto& pass : c.q)
             for (const AxisVector& q : pass) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
-    std::vector<AxisVector> grid;
+    PlanWorkspace w;
     std::vector<int> idx(n, 0);
     const int k = std::max(1, perAxis);
     for (;;) {
         AxisVector q(n);
         for (int a = 0; a < n; ++a) q[a] = k == 1 || hi[a] <= lo[a] ? 0.5 * (lo[a] + hi[a]) : lo[a] + (hi[a] - lo[a]) * idx[a] / (k - 1);
-        grid.push_back(q);
+        w.poses.push_back(q);
         int a = n - 1;
         for (; a >= 0; --a) {
             const int count = hi[a] > lo[a] ? k : 1;
@@ -180,11 +180,26 @@ void volumetric(const MachineModel& m, const DeviationSet& simulated, const cont
         if (a < 0) break;
     }
     for (const auto& r : motions)
-        if (std::find(v.toolLengths.begin(), v.toolLengths.end(), r.toolLength) == v.toolLengths.end())
-            v.toolLengths.push_back(r.toolLength);
+        if (std::find(w.toolLengths.begin(), w.toolLengths.end(), r.toolLength) == w.toolLengths.end())
+            w.toolLengths.push_back(r.toolLength);
+    std::string box;
+    for (int a = 0; a < n; ++a) {
+        const bool rotary = m.axisLink(a).kind == AxisKind::Rotary;
+        const double s = rotary ? 1 / kDeg : 1.0;
+        box += fmt::format("{}{}={:g}:{:g}", box.empty() ? "" : " ", m.axisNames[a], lo[a] * s, hi[a] * s);
+    }
+    w.note = fmt::format("{} per axis over the commands of the plan's runs ({}), tool lengths", k, box);
+    for (double L : w.toolLengths) w.note += fmt::format(" {:g}", L);
+    w.note += " mm";
+    return w;
+}
+
+void volumetric(const MachineModel& m, const DeviationSet& simulated, const controllers::AppliedCompensation& comp,
+                const PlanWorkspace& w, VerifyVolumetric& v) {
+    v.toolLengths = w.toolLengths;
     double sumBefore = 0, sumAfter = 0;
     for (double L : v.toolLengths) {
-        const auto f = controllers::evaluateCompensation(m, simulated, comp, grid, L);
+        const auto f = controllers::evaluateCompensation(m, simulated, comp, w.poses, L);
         v.maxBefore = std::max(v.maxBefore, f.maxBefore);
         v.maxAfter = std::max(v.maxAfter, f.maxAfter);
         v.tiltBefore = std::max(v.tiltBefore, f.maxAxisBefore);
@@ -198,15 +213,14 @@ void volumetric(const MachineModel& m, const DeviationSet& simulated, const cont
         v.rmsAfter = std::sqrt(sumAfter / static_cast<double>(v.points));
     }
     v.available = true;
-    std::string box;
-    for (int a = 0; a < n; ++a) {
-        const bool rotary = m.axisLink(a).kind == AxisKind::Rotary;
-        const double s = rotary ? 1 / kDeg : 1.0;
-        box += fmt::format("{}{}={:g}:{:g}", box.empty() ? "" : " ", m.axisNames[a], lo[a] * s, hi[a] * s);
-    }
-    v.note = fmt::format("{} per axis over the commands of the plan's runs ({}), tool lengths", k, box);
-    for (double L : v.toolLengths) v.note += fmt::format(" {:g}", L);
-    v.note += " mm";
+    v.note = w.note;
+}
+
+/// The commands of every run as the plan's test programs write them (generated in memory, read back by the
+/// post-processor).
+RunCommands writtenCommands(const MachineModel& m, const testprog::RunMotion& r, const testprog::TestProgram& prog,
+                            const VerifyOptions& options) {
+    return samplesOf(r, testprog::readTestProgram(m, r, prog.text, testprog::readerDialect(options.dialect), prog.file));
 }
 
 }  // namespace
@@ -214,6 +228,16 @@ void volumetric(const MachineModel& m, const DeviationSet& simulated, const cont
 std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const MachineModel& machine,
                                                                           const DeviationSet& identified) {
     return std::make_shared<IdealCompensation>(machine, identified);
+}
+
+PlanWorkspace planWorkspace(const MachineModel& m, const MeasurementPlan& plan, const VerifyOptions& options) {
+    const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
+    testprog::TestProgramOptions po;
+    po.dialect = options.dialect;
+    const testprog::TestProgramSet programs = testprog::makeTestPrograms(m, plan, po);
+    std::vector<RunCommands> programmed;
+    for (size_t i = 0; i < motions.size(); ++i) programmed.push_back(writtenCommands(m, motions[i], programs.programs[i], options));
+    return gridOver(m, motions, programmed, options.volumetricPerAxis);
 }
 
 double VerifyRun::spanBefore() const {
@@ -246,8 +270,7 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
         const testprog::RunMotion& r = motions[i];
         const testprog::TestProgram& prog = programs.programs[i];
         // The commands as written: the program generated in memory, read back by the post-processor.
-        const RunCommands before =
-            samplesOf(r, testprog::readTestProgram(m, r, prog.text, testprog::readerDialect(options.dialect), prog.file));
+        const RunCommands before = writtenCommands(m, r, prog, options);
         RunCommands after;
         if (comp.kind == VerifyCompensation::Kind::CorrectedPrograms) {
             const auto it = std::find_if(comp.programs.begin(), comp.programs.end(), [&](const auto& p) { return p.first == r.name; });
@@ -301,7 +324,7 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
         programmed.push_back(before);
     }
     if (comp.model) {
-        volumetric(m, simulated, *comp.model, motions, programmed, options.volumetricPerAxis, out.volumetric);
+        volumetric(m, simulated, *comp.model, gridOver(m, motions, programmed, options.volumetricPerAxis), out.volumetric);
     } else {
         out.volumetric.note = "a corrected program compensates its own poses only: no volumetric figure";
     }

@@ -55,6 +55,15 @@ struct VerifyOptions {
     int volumetricPerAxis = 5;  ///< grid over the plan's workspace: samples per axis
 };
 
+/// The plan's workspace, over which verify takes its volumetric figure: `options.volumetricPerAxis` samples per axis over
+/// the box of the commands of the plan's runs (as its test programs write them), at the runs' tool lengths.
+struct PlanWorkspace {
+    std::vector<AxisVector> poses;
+    std::vector<double> toolLengths;  ///< mm, each once, in the order of the runs
+    std::string note;                 ///< "5 per axis over the commands of the plan's runs (X=…), tool lengths 100 mm"
+};
+PlanWorkspace planWorkspace(const MachineModel& machine, const MeasurementPlan& plan, const VerifyOptions& options = {});
+
 /// One pass (direction) of a run, before and after compensation.
 struct VerifyPass {
     std::string label;                  ///< "CW", "CCW", "forward", "reverse"

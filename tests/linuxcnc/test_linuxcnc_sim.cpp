@@ -107,7 +107,7 @@ Figures runOracle(const std::string& machineName, const std::string& deviationNa
     ScratchDir dir("linuxcnc-oracle-" + machineName);
 
     // 1. The files exactly as the CLI writes them.
-    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc-pins --machine {} --deviations {} --out {} --date 2024-01-01",
+    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc-pins --copy-identified --machine {} --deviations {} --out {} --date 2024-01-01",
                                               machineFile, deviationFile, dir.file("emitted")));
     EXPECT_EQ(emit.exitCode, 0) << emit.out;
     const std::vector<OutputFile> files = readFolder(dir.path / "emitted");
