@@ -1,0 +1,122 @@
+// `cnccomp correct` refusing what it cannot do right (issue 18, part 2): a tool length nobody gave where a rotary
+// move's correction depends on it (a test program's header names its length and is read), a correction that does not
+// converge (exit 3, nothing written unless --keep-partial), and one word in exponent notation in a milling program
+// (no longer a 3-D printer clue for --dialect auto: the rs274ngc lexer refuses that line).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sstream>
+
+#include "cnccomp/io/deviation_csv.hpp"
+#include "postproc/dialect.hpp"
+#include "postproc/processor.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp::pp {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");
+const std::string kTruth = test::sourcePath("samples/deviations/multitasking-truth.csv");
+const std::string kPlan = test::sourcePath("samples/plans/multitasking-six-circles.xml");
+
+std::string correctArgs(const std::string& in, const std::string& out) {
+    return "correct --machine " + kMachine + " --deviations " + kTruth + " --in " + in + " --out " + out;
+}
+
+/// The test program of the plan's run `run` (LinuxCNC), written by `cnccomp testprog` into `dir`/tp.
+std::string testProgram(const test::ScratchDir& dir, const std::string& run) {
+    if (!fs::exists(dir.file("tp"))) {
+        const auto r = test::runCli("testprog --machine " + kMachine + " --plan " + kPlan + " --dialect linuxcnc --out " +
+                                    dir.file("tp"));
+        EXPECT_EQ(r.exitCode, 0) << r.out;
+    }
+    for (const auto& e : fs::directory_iterator(dir.file("tp")))
+        if (e.path().filename().string().find(run) != std::string::npos) return e.path().string();
+    ADD_FAILURE() << "no program for " << run;
+    return {};
+}
+
+TEST(PostprocCorrectGuards, HeaderToolLengthIsFoundCaseInsensitively) {
+    // The header lines as cnccomp testprog writes them (postproc/testprog/test_program.cpp): LinuxCNC, Fanuc
+    // (upper case), Klartext (a numbered ';' block).
+    auto h = toolLengthFromHeader("%\n(run B-X)\n(to correct this program for the measured machine: cnccomp correct "
+                                  "--tool-length 360)\nG0 X0\n");
+    ASSERT_TRUE(h);
+    EXPECT_EQ(h->mm, 360);
+    EXPECT_EQ(h->line, 3u);
+    h = toolLengthFromHeader("O1001 (X)\n(TO CORRECT THIS PROGRAM FOR THE MEASURED MACHINE: CNCCOMP CORRECT --TOOL-LENGTH 100.5)\n");
+    ASSERT_TRUE(h);
+    EXPECT_EQ(h->mm, 100.5);
+    h = toolLengthFromHeader("0 BEGIN PGM TP01 MM\n1 ; to correct this program: cnccomp correct --tool-length 0\n");
+    ASSERT_TRUE(h);
+    EXPECT_EQ(h->mm, 0);
+    EXPECT_FALSE(toolLengthFromHeader("G0 X0\n(cnccomp correct --tool-length)\n(cnccomp correct --tool-length abc)\n"));
+}
+
+TEST(PostprocCorrectGuards, TestProgramWithoutToolLengthOptionTakesItsHeaders) {
+    // Oracle: the same program corrected with the length given on the command line (the header's number) gives the
+    // same bytes; without it the correction assumed 0 before and left tens of um on the true machine.
+    test::ScratchDir dir("pp-guard-header");
+    const std::string p = testProgram(dir, "C-radial");
+    const std::string text = test::readText(p);
+    const size_t at = text.find("cnccomp correct --tool-length ");
+    ASSERT_NE(at, std::string::npos);
+    const std::string length = text.substr(at + 30, text.find(')', at) - at - 30);
+    auto r = test::runCli(correctArgs(p, dir.file("a.ngc")));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("tool length: " + length + " mm, from the program's header"), std::string::npos) << r.out;
+    r = test::runCli(correctArgs(p, dir.file("b.ngc")) + " --tool-length " + length);
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_EQ(r.out.find("from the program's header"), std::string::npos) << r.out;
+    EXPECT_EQ(test::readText(dir.file("a.ngc")), test::readText(dir.file("b.ngc")));
+    r = test::runCli(correctArgs(p, dir.file("c.ngc")) + " --tool-length 0");
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(test::readText(dir.file("a.ngc")), test::readText(dir.file("c.ngc")));
+}
+
+TEST(PostprocCorrectGuards, RotaryProgramWithoutAnyToolLengthIsRefusedUnlessZeroIsGiven) {
+    test::ScratchDir dir("pp-guard-nolength");
+    std::string text = test::readText(testProgram(dir, "C-radial"));
+    const size_t at = text.find("cnccomp correct --tool-length");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 29, "(header line removed)");
+    test::writeText(dir.file("p.ngc"), text);
+    auto r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    for (const char* s : {"p.ngc:", "depends on the tool length", "--tool-length 0 when 0 is meant"})
+        EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(dir.file("o.ngc")));
+    r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")) + " --tool-length 0");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_TRUE(fs::exists(dir.file("o.ngc")));
+    // A program without rotary moves needs no length: the multitasking machine's linear moves at B = C = 0.
+    test::writeText(dir.file("lin.ngc"), "G21 G90\nG0 X10 Y0 Z50\nG1 X20 Y5 Z40 F500\nG1 X30 Y-5 Z45\nM2\n");
+    r = test::runCli(correctArgs(dir.file("lin.ngc"), dir.file("lin-out.ngc")));
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+}
+
+TEST(PostprocCorrectGuards, ExponentWordDoesNotMakeAMillingProgramPrinterCode) {
+    // Before: "G1 X1e1" counted as an extruder word (X1 E1), the program was read as printer code.
+    const std::string program = "G21 G90\nG0 X0 Y0 Z50\nG1 X1e1 Y5 F500\nG1 X20 Y5\nM2\n";
+    const DetectedDialect d = detectDialect(program);
+    EXPECT_EQ(d.dialect, Dialect::Rs274ngc) << d.reason;
+    EXPECT_FALSE(d.certain);
+    // Printer code is still recognised by its E words, also written right after G1.
+    EXPECT_EQ(detectDialect("G28\nG1 X10 Y10 E0.5 F1200\n").dialect, Dialect::Printer);
+    EXPECT_EQ(detectDialect("G28\nG1E5 F1800\n").dialect, Dialect::Printer);
+    test::ScratchDir dir("pp-guard-exp");
+    test::writeText(dir.file("p.ngc"), program);
+    const auto r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("dialect: rs274ngc"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("line 3: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("exponent notation"), std::string::npos) << r.out;
+    const std::string out = test::readText(dir.file("o.ngc"));
+    EXPECT_NE(out.find("G1 X1e1 Y5 F500\n"), std::string::npos) << out;  // passed through as written
+    EXPECT_EQ(out.find("X0.97"), std::string::npos) << out;  // not read as X1 E1 and rewritten as X0.9717e1
+}
+
+}  // namespace
+}  // namespace cnccomp::pp
