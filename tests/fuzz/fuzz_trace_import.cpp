@@ -1,7 +1,9 @@
 // libFuzzer target: the instrument file import (importRunTrace / importTrace, src/cnccomp/io/trace_import.cpp), each
 // input read as a time-sampled file of a C-radial run recorded CW then CCW, as an angle-sampled file of the same run,
-// and as a file without a run. Seeds: tests/fuzz/seeds/trace/ (written by `cnccomp simulate --instrument time|angle`
-// for that run with a 15° step).
+// and as a file without a run. Seeds: tests/fuzz/seeds/trace/, small files of that run (15° step) in the layouts the
+// import takes (README "Measured ball-bar data"): angle-sampled with `# key: value` metadata; time-sampled CW then CCW
+// with a pass column, 4° overshoot and a missing sample; time-sampled with ';', decimal comma, CRLF and a byte-order
+// mark. Their ΔL values are made up (sines of a few um): the fuzz target checks the reader, not the numbers.
 #include "cnccomp/io/trace_import.hpp"
 #include "fuzz_reader.hpp"
 
