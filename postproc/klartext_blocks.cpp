@@ -257,7 +257,12 @@ void KlartextInterpreter::tool(const std::vector<std::string>& rest) {
     if (i < rest.size() && !rest[i].empty() && rest[i].front() == '"') {
         ++i;  // tool by name: its length comes from the default tool length
     } else if (i < rest.size() && std::isdigit(static_cast<unsigned char>(rest[i].front()))) {
-        toolNo = static_cast<int>(number(rest[i], "TOOL CALL number"));
+        // A whole number in the range of the setup's tool lengths (Setup::addToolLength): a larger one would not
+        // fit an int (found by the Klartext fuzz target, tests/test_fuzz_findings.cpp).
+        const double n = number(rest[i], "TOOL CALL number");
+        if (!(n >= 0 && n <= 100000 && n == std::floor(n)))
+            fail(fmt::format("TOOL CALL number '{}' is not a tool number 0 … 100000", rest[i]));
+        toolNo = static_cast<int>(n);
         ++i;
     }
     double dl = 0;
