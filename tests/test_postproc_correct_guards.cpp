@@ -57,43 +57,63 @@ TEST(PostprocCorrectGuards, HeaderToolLengthIsFoundCaseInsensitively) {
 
 TEST(PostprocCorrectGuards, TestProgramWithoutToolLengthOptionTakesItsHeaders) {
     // Oracle: the same program corrected with the length given on the command line (the header's number) gives the
-    // same bytes; without it the correction assumed 0 before and left tens of um on the true machine.
+    // same bytes. Issue 18: with an assumed 0 they left 45 um on the true machine, so on some of them the output for 0
+    // differs.
     test::ScratchDir dir("pp-guard-header");
-    const std::string p = testProgram(dir, "C-radial");
-    const std::string text = test::readText(p);
-    const size_t at = text.find("cnccomp correct --tool-length ");
-    ASSERT_NE(at, std::string::npos);
-    const std::string length = text.substr(at + 30, text.find(')', at) - at - 30);
-    auto r = test::runCli(correctArgs(p, dir.file("a.ngc")));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(r.out.find("tool length: " + length + " mm, from the program's header"), std::string::npos) << r.out;
-    r = test::runCli(correctArgs(p, dir.file("b.ngc")) + " --tool-length " + length);
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_EQ(r.out.find("from the program's header"), std::string::npos) << r.out;
-    EXPECT_EQ(test::readText(dir.file("a.ngc")), test::readText(dir.file("b.ngc")));
-    r = test::runCli(correctArgs(p, dir.file("c.ngc")) + " --tool-length 0");
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(test::readText(dir.file("a.ngc")), test::readText(dir.file("c.ngc")));
+    (void)testProgram(dir, "C-radial");
+    int differs = 0, programs = 0;
+    for (const auto& e : fs::directory_iterator(dir.file("tp"))) {
+        if (e.path().extension() != ".ngc") continue;
+        ++programs;
+        const std::string p = e.path().string(), text = test::readText(p);
+        const size_t at = text.find("cnccomp correct --tool-length ");
+        ASSERT_NE(at, std::string::npos) << p;
+        const std::string length = text.substr(at + 30, text.find(')', at) - at - 30);
+        auto r = test::runCli(correctArgs(p, dir.file("a.ngc")));
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+        EXPECT_NE(r.out.find("tool length: " + length + " mm, from the program's header"), std::string::npos) << r.out;
+        r = test::runCli(correctArgs(p, dir.file("b.ngc")) + " --tool-length " + length);
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+        EXPECT_EQ(r.out.find("from the program's header"), std::string::npos) << r.out;
+        EXPECT_EQ(test::readText(dir.file("a.ngc")), test::readText(dir.file("b.ngc"))) << p;
+        r = test::runCli(correctArgs(p, dir.file("c.ngc")) + " --tool-length 0");
+        ASSERT_EQ(r.exitCode, 0) << r.out;
+        if (test::readText(dir.file("a.ngc")) != test::readText(dir.file("c.ngc"))) ++differs;
+        for (const char* f : {"a.ngc", "b.ngc", "c.ngc"}) fs::remove(dir.file(f));
+    }
+    EXPECT_EQ(programs, 6);
+    EXPECT_GE(differs, 1);
 }
 
 TEST(PostprocCorrectGuards, RotaryProgramWithoutAnyToolLengthIsRefusedUnlessZeroIsGiven) {
     test::ScratchDir dir("pp-guard-nolength");
-    std::string text = test::readText(testProgram(dir, "C-radial"));
-    const size_t at = text.find("cnccomp correct --tool-length");
-    ASSERT_NE(at, std::string::npos);
-    text.replace(at, 29, "(header line removed)");
-    test::writeText(dir.file("p.ngc"), text);
-    auto r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")));
-    EXPECT_EQ(r.exitCode, 2) << r.out;
-    for (const char* s : {"p.ngc:", "depends on the tool length", "--tool-length 0 when 0 is meant"})
-        EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
-    EXPECT_FALSE(fs::exists(dir.file("o.ngc")));
-    r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")) + " --tool-length 0");
-    EXPECT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_TRUE(fs::exists(dir.file("o.ngc")));
+    (void)testProgram(dir, "C-radial");
+    int refused = 0;
+    for (const auto& e : fs::directory_iterator(dir.file("tp"))) {
+        if (e.path().extension() != ".ngc") continue;
+        std::string text = test::readText(e.path().string());
+        const size_t at = text.find("cnccomp correct --tool-length");
+        ASSERT_NE(at, std::string::npos);
+        text.replace(at, 29, "header line removed");
+        test::writeText(dir.file("p.ngc"), text);
+        auto r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")));
+        if (r.exitCode == 2) {
+            ++refused;
+            for (const char* s : {"p.ngc:", "depends on the tool length", "--tool-length 0 when 0 is meant"})
+                EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+            EXPECT_FALSE(fs::exists(dir.file("o.ngc")));
+        } else {
+            EXPECT_EQ(r.exitCode, 0) << r.out;
+        }
+        r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")) + " --tool-length 0");
+        EXPECT_EQ(r.exitCode, 0) << r.out;
+        EXPECT_TRUE(fs::exists(dir.file("o.ngc")));
+        fs::remove(dir.file("o.ngc"));
+    }
+    EXPECT_GE(refused, 1);
     // A program without rotary moves needs no length: the multitasking machine's linear moves at B = C = 0.
     test::writeText(dir.file("lin.ngc"), "G21 G90\nG0 X10 Y0 Z50\nG1 X20 Y5 Z40 F500\nG1 X30 Y-5 Z45\nM2\n");
-    r = test::runCli(correctArgs(dir.file("lin.ngc"), dir.file("lin-out.ngc")));
+    const auto r = test::runCli(correctArgs(dir.file("lin.ngc"), dir.file("lin-out.ngc")));
     EXPECT_EQ(r.exitCode, 0) << r.out;
 }
 
