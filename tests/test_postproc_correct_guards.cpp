@@ -6,6 +6,9 @@
 
 #include <filesystem>
 #include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "cnccomp/io/deviation_csv.hpp"
 #include "postproc/dialect.hpp"
@@ -115,6 +118,43 @@ TEST(PostprocCorrectGuards, RotaryProgramWithoutAnyToolLengthIsRefusedUnlessZero
     test::writeText(dir.file("lin.ngc"), "G21 G90\nG0 X10 Y0 Z50\nG1 X20 Y5 Z40 F500\nG1 X30 Y-5 Z45\nM2\n");
     const auto r = test::runCli(correctArgs(dir.file("lin.ngc"), dir.file("lin-out.ngc")));
     EXPECT_EQ(r.exitCode, 0) << r.out;
+}
+
+TEST(PostprocCorrectGuards, CorrectionThatDoesNotConvergeWritesNothingUnlessKeepPartial) {
+    // An absurd deviation set: the sample truth × 20000 (mm offsets, degrees of tilt). The first blocks of the sample
+    // 5-axis program do not converge (tip residuals of um to km) and split to the subdivision limit.
+    test::ScratchDir dir("pp-guard-converge");
+    const std::string truth = test::readText(kTruth);
+    std::istringstream rows(truth);
+    std::string line, absurd;
+    std::getline(rows, line);
+    absurd = line + "\n";
+    while (std::getline(rows, line)) {
+        std::vector<std::string> c;
+        std::stringstream cells(line);
+        for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
+        ASSERT_EQ(c.size(), 5u) << line;
+        absurd += fmt::format("{},{},{},{},{}\n", c[0], c[1], std::stod(c[2]) * 20000, c[3], std::stod(c[4]) * 20000);
+    }
+    test::writeText(dir.file("absurd.csv"), absurd);
+    std::string program;
+    std::istringstream sample(test::readText(test::sourcePath("samples/gcode/multitasking-5axis.ngc")));
+    for (int k = 0; k < 16 && std::getline(sample, line); ++k) program += line + "\n";
+    test::writeText(dir.file("p.ngc"), program + "M2\n");
+    const std::string args = "correct --machine " + kMachine + " --deviations " + dir.file("absurd.csv") + " --in " +
+                             dir.file("p.ngc") + " --out " + dir.file("o.ngc") + " --tool-length H1=100 --report " +
+                             dir.file("r.csv");
+    auto r = test::runCli(args);
+    EXPECT_EQ(r.exitCode, 3) << r.out;
+    EXPECT_NE(r.out.find("the correction did not converge"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("nothing written"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir.file("o.ngc")));
+    EXPECT_FALSE(fs::exists(dir.file("r.csv")));
+    r = test::runCli(args + " --keep-partial");
+    EXPECT_EQ(r.exitCode, 3) << r.out;
+    EXPECT_NE(r.out.find("--keep-partial"), std::string::npos) << r.out;
+    EXPECT_TRUE(fs::exists(dir.file("o.ngc")));
+    EXPECT_TRUE(fs::exists(dir.file("r.csv")));
 }
 
 TEST(PostprocCorrectGuards, ExponentWordDoesNotMakeAMillingProgramPrinterCode) {
