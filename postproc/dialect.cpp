@@ -57,11 +57,14 @@ bool isKlartextHeader(std::string_view line) {
     return startsWith(line.substr(i), "BEGIN PGM ");
 }
 
-/// A G0/G1 block with an E word: extruder moves of a printer.
+/// A G0/G1 block with an E word: extruder moves of a printer. The E must stand after a blank (slicers write
+/// "G1 X10 E0.5") or right after the G0/G1 code ("G1E5"): an E right after the digits of another word is a number
+/// in exponent notation ("G1 X1e1"), which a milling program may hold by mistake and which the lexer refuses by line
+/// in the milling dialects (kExponent) — one such word must not turn a whole program into printer code.
 bool hasExtruderWord(std::string_view code) {
     if (!(startsWith(code, "G1") || startsWith(code, "G0"))) return false;
     for (size_t i = 1; i + 1 < code.size(); ++i)
-        if (code[i] == 'E' && (code[i - 1] == ' ' || std::isdigit(static_cast<unsigned char>(code[i - 1]))) &&
+        if (code[i] == 'E' && (code[i - 1] == ' ' || code[i - 1] == '\t' || i == 2) &&
             (std::isdigit(static_cast<unsigned char>(code[i + 1])) || code[i + 1] == '-' || code[i + 1] == '.'))
             return true;
     return false;

@@ -95,6 +95,7 @@ KlartextInterpreter::KlartextInterpreter(const AxisLayout& layout, const Setup& 
     }
     toolAxis_ = L_.axis('Z');
     tip_ = setup_.defaultToolLength;
+    tipAssumed_ = !setup_.defaultToolLengthGiven;
 }
 
 void KlartextInterpreter::fail(const std::string& what) const { throw InputError(inputName_, static_cast<int>(line_), what); }
@@ -115,6 +116,7 @@ void KlartextInterpreter::interpret(std::string_view text, uint64_t line, Klarte
     b.mode = mode_;
     b.controlLength = tlo_;
     b.tipLength = tip_;
+    b.tipLengthAssumed = tipAssumed_;
     tokenizeKlartext(text, b.tokens);
     tok_.clear();
     for (const KlartextToken& t : b.tokens) tok_.push_back(klartextUpper(text.substr(t.begin, t.end - t.begin)));
@@ -255,7 +257,12 @@ void KlartextInterpreter::tool(const std::vector<std::string>& rest) {
     if (i < rest.size() && !rest[i].empty() && rest[i].front() == '"') {
         ++i;  // tool by name: its length comes from the default tool length
     } else if (i < rest.size() && std::isdigit(static_cast<unsigned char>(rest[i].front()))) {
-        toolNo = static_cast<int>(number(rest[i], "TOOL CALL number"));
+        // A whole number in the range of the setup's tool lengths (Setup::addToolLength): a larger one would not
+        // fit an int (found by the Klartext fuzz target, tests/test_fuzz_findings.cpp).
+        const double n = number(rest[i], "TOOL CALL number");
+        if (!(n >= 0 && n <= 100000 && n == std::floor(n)))
+            fail(fmt::format("TOOL CALL number '{}' is not a tool number 0 … 100000", rest[i]));
+        toolNo = static_cast<int>(n);
         ++i;
     }
     double dl = 0;
@@ -270,9 +277,10 @@ void KlartextInterpreter::tool(const std::vector<std::string>& rest) {
     }
     double length = setup_.defaultToolLength;
     tip_ = setup_.defaultToolLength + dl;
+    tipAssumed_ = !setup_.defaultToolLengthGiven;
     if (toolNo == 0) length = 0;
     else if (toolNo > 0)
-        if (const auto l = setup_.toolLength(toolNo)) length = *l, tip_ = *l + dl;
+        if (const auto l = setup_.toolLength(toolNo)) length = *l, tip_ = *l + dl, tipAssumed_ = false;
     if (mode_ != ProgramMode::Joints && (length + dl != tlo_ || axis != toolAxis_)) {
         // The manual asks to reset TCPM before a TOOL CALL; the tool tip moves with the new length.
         toolAxis_ = axis;
@@ -491,6 +499,7 @@ void KlartextInterpreter::moveMode(const Words& w, KlartextBlock& b) {
     b.mode = mode_;
     b.controlLength = tlo_;
     b.tipLength = tip_;
+    b.tipLengthAssumed = tipAssumed_;
     b.scale = AxisVector::Ones(L_.count);
     b.offset = AxisVector::Zero(L_.count);
     for (int a = 0; a < L_.count; ++a) {

@@ -86,6 +86,7 @@ struct KlartextBlock {
     double tipLength = 0.0;             ///< mm: the physical tool point to correct: the called tool's length + DL from
                                         ///< the setup, or the setup's default length (+ DL) for TOOL CALL 0, a tool
                                         ///< the setup does not list, or before any TOOL CALL
+    bool tipLengthAssumed = false;      ///< tipLength is (+ DL) the default length that nobody gave
     AxisVector scale, offset;           ///< Move: program space = word · scale + offset for an absolute word
     bool tcpOnAtStart = false;          ///< M128 in this block switched TCP on before its motion
     bool tcpOffAtEnd = false;           ///< M129 in this block switched TCP off after its motion
@@ -166,6 +167,7 @@ private:
     int toolAxis_ = -1;
     double tlo_ = 0;
     double tip_ = 0;
+    bool tipAssumed_ = false;  ///< tip_ is the default length that nobody gave (Setup::defaultToolLengthGiven)
     int poleA0_ = -1, poleA1_ = -1;
     double pc0_ = 0, pc1_ = 0;
     bool poleKnown_ = false;

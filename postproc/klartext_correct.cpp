@@ -477,6 +477,9 @@ void KlartextCorrector::move() {
                                         s.tipError / kUm));
         cEnd = cNom;
     } else {
+        if (b_.tipLengthAssumed && options_.requireToolLength)
+            refuseAssumedToolLength(corrector_, layout_, cNom, cEnd, space.toolLength, options_.corrector.toleranceMm,
+                                    options_.inputName, line_);
         lastDelta_ = cEnd - cNom;
         haveDelta_ = true;
         corrected = true;

@@ -346,6 +346,7 @@ void Interpreter::fillConversions(BlockResult& r) const {
     r.feedMode = feedMode_;
     r.feed = feed_;
     r.tipLength = tloSign_ != 0 ? tloLength_ : options_.setup.defaultToolLength;
+    r.tipLengthAssumed = tloSign_ != 0 ? tloAssumed_ : !options_.setup.defaultToolLengthGiven;
     r.mode = mode_;
     r.tcpSource = tcpSource_;
     // The controller's tool length in TCP mode: the active G43 / G43.4 / G43.5 offset; Sinumerik always works with
@@ -789,6 +790,7 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         const auto len = options_.setup.toolLength(number);
         if (!len) warn(r, Warning::ToolLengthNotGiven, number);
         tloLength_ = len ? *len : options_.setup.defaultToolLength;
+        tloAssumed_ = !len && !options_.setup.defaultToolLengthGiven;
         tloSign_ = has(GKind::ToolLengthNeg) ? -1 : 1;
         tloKnown_ = true;
         if (layout_.zAxis < 0) warn(r, Warning::NoToolLengthAxis, 0);
@@ -804,6 +806,7 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
             tloLength_ = wordValue(b.words[r.axisWord[z]]) * (inch_ ? 25.4 : 1.0);
             tloSign_ = 1;
             tloKnown_ = true;
+            tloAssumed_ = false;  // G43.1 Z…: the program gives the length
         } else {
             tloKnown_ = false;
         }
@@ -813,6 +816,7 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
         tloSign_ = 0;
         tloLength_ = 0;
         tloKnown_ = true;
+        tloAssumed_ = false;
         if (tcpSource_ == TcpSource::FanucAngles || tcpSource_ == TcpSource::FanucVector) {
             mode_ = ProgramMode::Joints;
             tcpSource_ = TcpSource::None;

@@ -86,6 +86,7 @@ struct BlockResult {
     double feed = 0.0;                ///< F in effect (program units)
     int feedWord = -1;                ///< index of the block's F word
     double tipLength = 0.0;           ///< mm: active tool length (tool point along the tool direction)
+    bool tipLengthAssumed = false;    ///< tipLength is the default length that nobody gave (Setup::defaultToolLengthGiven)
     ProgramMode mode = ProgramMode::Joints;  ///< how this block's positions are read (start and end)
     TcpSource tcpSource = TcpSource::None;
     double controlLength = 0.0;       ///< mm, TCP: the controller's tool length (the programmed point is there)
@@ -185,6 +186,7 @@ private:
     int tloSign_ = 0;                ///< 0 none, +1 G43, -1 G44
     double tloLength_ = 0.0;         ///< mm
     bool tloKnown_ = true;
+    bool tloAssumed_ = false;        ///< tloLength_ is the default length that nobody gave (G43 Hn with n not listed)
     ProgramMode mode_ = ProgramMode::Joints;  ///< TCP mode (TcpVector: Fanuc G43.5; Sinumerik vectors are per block)
     TcpSource tcpSource_ = TcpSource::None;
     bool transform_ = false, modalMacro_ = false, cutterComp_ = false;

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <condition_variable>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <mutex>
@@ -14,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
 #include "postproc/block_writer.hpp"
 #include "postproc/klartext_correct.hpp"
 #include "postproc/line_reader.hpp"
@@ -58,6 +60,49 @@ double toleranceWithin(double tolMm, double floorMm, int linDecimals, CorrectSum
                               tolMm / kUm, floorMm / kUm, linDecimals, floorMm / kUm));
     }
     return floorMm;
+}
+
+void refuseAssumedToolLength(const Corrector& corrector, const AxisLayout& layout, const AxisVector& cNom,
+                             const AxisVector& cEnd, double toolLength, double toleranceMm, const std::string& name,
+                             uint64_t line) {
+    bool rotaryOff = false;
+    for (int a = 0; a < layout.count; ++a)
+        if (layout.rotary[a] && std::fabs(cNom[a]) > 1e-9) rotaryOff = true;
+    if (!rotaryOff) return;
+    const double off = corrector.tipDeviation(cNom, cEnd, toolLength + kToolLengthProbeMm);
+    if (!(off > toleranceMm)) return;
+    throw InputError(name, static_cast<int>(std::min<uint64_t>(line, INT32_MAX)),
+                     fmt::format("the correction of this rotary move depends on the tool length, which was not given: "
+                                 "corrected for a tool point at {:g} mm, it leaves a point {:g} mm further along the tool "
+                                 "{:.1f} um off its path; give the length the program was made for with --tool-length L "
+                                 "(--tool-length 0 when 0 is meant; G43 Hn: --tool-length Hn=L or --tool-table)",
+                                 toolLength, kToolLengthProbeMm, off / kUm));
+}
+
+std::optional<HeaderToolLength> toolLengthFromHeader(std::string_view head) {
+    static constexpr std::string_view kHint = "cnccomp correct --tool-length ";
+    uint64_t line = 0;
+    while (!head.empty() && line < 200) {
+        ++line;
+        const size_t eol = head.find('\n');
+        const std::string_view text = head.substr(0, eol);
+        head = eol == std::string_view::npos ? std::string_view{} : head.substr(eol + 1);
+        for (size_t i = 0; i + kHint.size() <= text.size(); ++i) {
+            size_t k = 0;
+            while (k < kHint.size() &&
+                   std::tolower(static_cast<unsigned char>(text[i + k])) == static_cast<unsigned char>(kHint[k]))
+                ++k;
+            if (k < kHint.size()) continue;
+            std::string_view rest = text.substr(i + k);
+            size_t n = 0;
+            while (n < rest.size() && (std::isdigit(static_cast<unsigned char>(rest[n])) || rest[n] == '.' ||
+                                       rest[n] == '-' || rest[n] == '+' || rest[n] == 'e' || rest[n] == 'E'))
+                ++n;
+            const auto v = parseNumber(rest.substr(0, n));
+            if (v && std::isfinite(*v) && std::fabs(*v) <= 1e5) return HeaderToolLength{*v, line};
+        }
+    }
+    return std::nullopt;
 }
 
 void checkTextHead(std::string_view head, const std::string& name) {
@@ -381,6 +426,9 @@ void FrontEnd::move(Record& rec) {
                                        s.tipError / kUm));
             cEnd = cNom;
         } else {
+            if (r.tipLengthAssumed && options_.requireToolLength)
+                refuseAssumedToolLength(corrector_, layout_, cNom, cEnd, space.toolLength, options_.corrector.toleranceMm,
+                                        options_.inputName, rec.number);
             lastDelta_ = cEnd - cNom;
             lastCNom_ = cNom;
             haveDelta_ = true;
@@ -1329,11 +1377,27 @@ private:
 }  // namespace
 
 CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& deviations, std::istream& in,
-                              std::ostream& out, const CorrectOptions& options) {
+                              std::ostream& out, const CorrectOptions& given) {
     CorrectSummary s;
-    LineReader reader(in, options.bufferSize);
+    LineReader reader(in, given.bufferSize);
     const std::string_view head = reader.head();
-    checkTextHead(head, options.inputName);
+    checkTextHead(head, given.inputName);
+    // No tool length given: a test program names the one it was made for in its header (cnccomp testprog).
+    CorrectOptions withHeader;
+    const std::optional<HeaderToolLength> header =
+        given.setup.defaultToolLengthGiven ? std::nullopt : toolLengthFromHeader(head);
+    if (header) {
+        withHeader = given;
+        withHeader.setup.defaultToolLength = header->mm;
+        withHeader.setup.defaultToolLengthGiven = true;
+    }
+    const CorrectOptions& options = header ? withHeader : given;
+    const auto noteHeader = [&](CorrectSummary& summary) {
+        if (!header) return;
+        summary.headerToolLength = header->mm;
+        summary.headerToolLengthLine = header->line;
+    };
+    noteHeader(s);
     // HEIDENHAIN Klartext (BEGIN PGM among the first lines, whatever --dialect says): its own corrector.
     const int klartext = klartextHeaderLine(head);
     if (klartext > 0 || options.dialect == Dialect::Heidenhain) {
@@ -1341,6 +1405,7 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
             throw InputError(options.inputName, 0,
                              "--dialect heidenhain: no BEGIN PGM among the first lines, not a HEIDENHAIN Klartext program");
         CorrectSummary k = correctKlartextProgram(machine, deviations, reader, out, options);
+        noteHeader(k);
         k.dialectDetected = !options.dialect || *options.dialect != Dialect::Heidenhain;
         k.dialectCertain = klartext > 0;
         k.dialectReason = "BEGIN PGM";
@@ -1391,6 +1456,9 @@ std::string formatSummary(const CorrectSummary& s, size_t maxListed) {
                      s.maxLinearCorrection / kUm, s.maxLinearLine, s.maxRotaryCorrection / kArcsec, s.maxRotaryLine);
     t += fmt::format("largest residual: {:.2g} um at endpoints, {:.3f} um on the path (checked midpoints), tool axis {:.3f} arcsec\n",
                      s.maxTipResidual / kUm, s.maxPathDeviation / kUm, s.maxAxisResidual / kArcsec);
+    if (s.headerToolLengthLine)
+        t += fmt::format("tool length: {:g} mm, from the program's header (line {}: cnccomp correct --tool-length {:g})\n",
+                         s.headerToolLength, s.headerToolLengthLine, s.headerToolLength);
     if (s.tcpMoves) t += fmt::format("moves in tool-tip (TCP) mode: {}\n", s.tcpMoves);
     if (s.unconverged) t += fmt::format("endpoints not converged (left unchanged): {}\n", s.unconverged);
     if (s.limited) t += fmt::format("moves over the tolerance after the subdivision limit: {}\n", s.limited);

@@ -31,6 +31,10 @@ struct CorrectOptions {
     /// interpreting, end-point correction) on a second thread, the back end (path check, splitting, writing) on the
     /// calling one — the same output byte for byte; 0: the machine's cores.
     int threads = 0;
+    /// A tool length nobody gave (no --tool-length L, setup file or test program header) is refused where a rotary
+    /// move's correction depends on it (refuseAssumedToolLength); false: it is taken as 0 (library callers that set
+    /// Setup themselves). `cnccomp correct` sets it.
+    bool requireToolLength = false;
 };
 
 struct Notice {
@@ -66,6 +70,8 @@ struct CorrectSummary {
     uint64_t clampedTolerance = 0;  ///< moves checked at the output resolution instead of --tol-um (too fine)
     double toleranceFloor = 0;      ///< mm: largest such resolution bound
     uint64_t offPathStarts = 0;     ///< moves starting off the nominal path (after a block passed through)
+    double headerToolLength = 0;    ///< mm: the tool length read from the program's header (test programs)
+    uint64_t headerToolLengthLine = 0;  ///< its line; 0: none was read (given on the command line or not at all)
     /// Blocks left uncorrected that --strict counts: reported pass-through, unconverged or unmet tolerance.
     uint64_t uncorrected() const { return (passedThrough - notCorrected) + unconverged + limited; }
     std::vector<Notice> passThrough;  ///< first kMaxNotices
@@ -97,6 +103,27 @@ double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const
 /// said once (a warning at `line`; `warned` remembers it).
 double toleranceWithin(double tolMm, double floorMm, int linDecimals, CorrectSummary& summary, std::ostream* report,
                        uint64_t line, bool& warned);
+
+/// How far along the tool `cnccomp correct` looks when no tool length was given (mm) [G]: a tool point this much
+/// further from the spindle than the assumed one (0 mm) stands for "the length the program was meant for".
+constexpr double kToolLengthProbeMm = 100.0;
+
+/// A tool length nobody gave (BlockResult::tipLengthAssumed): where a rotary axis is off 0 and the end point `cEnd`
+/// corrected for the tool point at `toolLength` leaves the point kToolLengthProbeMm further along the tool more than
+/// `toleranceMm` off its nominal place (`cNom`), the correction depends on that length: throws InputError naming
+/// `name`:`line` and asking for --tool-length (0 when meant). On a five-axis machine whose rotary axes match the tool
+/// axis exactly the whole tool line is corrected and nothing is refused.
+void refuseAssumedToolLength(const Corrector& corrector, const AxisLayout& layout, const AxisVector& cNom,
+                             const AxisVector& cEnd, double toolLength, double toleranceMm, const std::string& name,
+                             uint64_t line);
+
+/// The tool length a test program names in its header (`cnccomp testprog`: "… cnccomp correct --tool-length L",
+/// postproc/testprog/test_program.cpp), searched case-insensitively in the first 200 lines of `head`.
+struct HeaderToolLength {
+    double mm = 0;
+    uint64_t line = 0;
+};
+std::optional<HeaderToolLength> toolLengthFromHeader(std::string_view head);
 
 /// Refuses files that are empty or binary (NUL bytes, mostly control bytes) in their first bytes.
 void checkTextHead(std::string_view head, const std::string& name);

@@ -113,6 +113,7 @@ void Setup::addToolLength(std::string_view spec, const std::string& source, int 
         throw InputError(source, line, fmt::format("tool length '{}' is not a finite number of mm", valueText));
     if (eq == std::string_view::npos) {
         defaultToolLength = *v;
+        defaultToolLengthGiven = true;
         return;
     }
     std::string_view key = trim(spec.substr(0, eq));

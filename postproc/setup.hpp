@@ -27,6 +27,9 @@ struct Setup {
     std::vector<WorkOffset> offsets;
     std::vector<std::pair<int, double>> toolLengths;  ///< length-offset register (H / tool number) → mm
     double defaultToolLength = 0.0;                   ///< mm: tool point when no G43 is active (or H unknown)
+    /// defaultToolLength was given (--tool-length L, a setup file's "tool-length L", or the test program's header):
+    /// else it is 0 by assumption, and `cnccomp correct` refuses a rotary move whose correction depends on it.
+    bool defaultToolLengthGiven = false;
     bool inchDefault = false;                         ///< units when the program sets none (G20/G21)
     /// Machine positions (mm, deg) of axes until the program commands them (e.g. Y=0 for a lathe program on a
     /// mill-turn machine). Rotary axes not listed are taken at 0; linear axes not listed are unknown.

@@ -219,6 +219,7 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
                                         : ""));
     syntax->comment("instrument: set it at the first stop, start the data capture at the second stop, stop it at the last "
                     "stop");
+    // `cnccomp correct` reads the length back from this line when no --tool-length is given (pp::toolLengthFromHeader).
     syntax->comment(fmt::format("to correct this program for the measured machine: cnccomp correct --tool-length {:g}", r.toolLength));
     for (const std::string& g : syntax->unconfirmed()) syntax->comment(g);
     syntax->init();

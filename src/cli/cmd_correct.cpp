@@ -26,7 +26,7 @@ struct Options {
     int decimals = -1;
     int threads = 0;
     std::vector<std::string> workOffsets, toolLengths, assume;
-    bool tipOnly = false, rotaryShortest = false, strict = false;
+    bool tipOnly = false, rotaryShortest = false, strict = false, keepPartial = false;
     std::string units;
 };
 
@@ -84,6 +84,7 @@ void run(const Options& o) {
     co.tcpOffM = mCodeOption(o.tcpOff, "--tcp-off");
     if (co.tcpOnM >= 0 && co.tcpOnM == co.tcpOffM) throw InputError("--tcp-off", 0, "the same M code as --tcp-on");
     co.rotaryShortest = o.rotaryShortest;
+    co.requireToolLength = true;
     co.corrector.toleranceMm = o.tolUm * kUm;
     co.corrector.tipOnly = o.tipOnly;
     co.decimals = o.decimals;
@@ -110,20 +111,37 @@ void run(const Options& o) {
         co.report = &report->stream();
     }
     pp::CorrectSummary summary;
+    // A correction that does not converge (an end point the solver cannot reach, a move still over the tolerance at
+    // the subdivision limit) is a failure: nothing is written unless --keep-partial asks for the partial program.
+    bool failed = false;
     try {
         AtomicFile out(o.out);
         summary = pp::correctProgram(m, d, in, out.stream(), co);
-        out.commit();
-        if (report) report->commit();
+        failed = summary.unconverged + summary.limited > 0;
+        if (!failed || o.keepPartial) {
+            out.commit();
+            if (report) report->commit();
+        }
     } catch (...) {
         if (bar) std::fprintf(stderr, "\n");
         throw;
     }
     if (bar) std::fprintf(stderr, "\r%60s\r", "");
-    fmt::print("corrected {} for '{}' ({} deviations{}) -> {}\n", o.in, m.name,
+    const bool written = !failed || o.keepPartial;
+    fmt::print("{} {} for '{}' ({} deviations{}) -> {}\n", written ? "corrected" : "NOT corrected", o.in, m.name,
                std::count(d.present.begin(), d.present.end(), 1), d.values.cwiseAbs().maxCoeff() == 0 ? ", all zero" : "",
-               o.out);
+               written ? o.out : std::string("nothing written"));
     fmt::print("{}", pp::formatSummary(summary));
+    if (failed) {
+        fmt::print(stderr, "cnccomp: the correction did not converge: {} end point(s) not converged, {} move(s) over the "
+                           "tolerance at the subdivision limit; {}; exit status 3\n",
+                   summary.unconverged, summary.limited,
+                   o.keepPartial ? fmt::format("the partial program was written to {} (--keep-partial)", o.out)
+                                 : "nothing written (--keep-partial writes the partial program)");
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::exit(3);
+    }
     if (o.strict && summary.uncorrected() > 0) {
         // Scripted use: the files are written (and listed above), the exit status says not everything was corrected.
         fmt::print(stderr, "cnccomp: --strict: {} block(s) left uncorrected (passed through, not converged or over the "
@@ -147,13 +165,19 @@ const RegisterCommand reg([](CLI::App& app) {
         ->capture_default_str();
     c->add_option("--decimals", o->decimals, "decimals of changed numbers (default: the program's own, at least 4 in mm and deg, 5 in inch)");
     c->add_option("--work-offset", o->workOffsets, "work offset CODE=x,y,z[,a,b,c] in mm and deg, e.g. G54=100,0,-300 (repeatable)");
-    c->add_option("--tool-length", o->toolLengths, "tool length in mm: L (default tool point) or Hn=L for G43 Hn (repeatable)");
+    c->add_option("--tool-length", o->toolLengths,
+                  "tool length in mm: L (default tool point) or Hn=L for G43 Hn (repeatable). Without it: the length a "
+                  "test program's header names (cnccomp testprog), else 0 — refused where a rotary move's correction "
+                  "depends on it (--tool-length 0 when 0 is meant)");
     c->add_option("--tool-table", o->toolTable, "LinuxCNC tool table (T1 P1 Z12.5 ...): tool lengths for G43 / G43 Hn")
         ->check(CLI::ExistingFile);
     c->add_option("--tcp-on", o->tcpOn, "M code that switches tool-tip (TCP) programming on, e.g. M428 (LinuxCNC trt remap)");
     c->add_option("--tcp-off", o->tcpOff, "M code that switches tool-tip programming off, e.g. M429");
     c->add_flag("--strict", o->strict, "exit status 3 when any block is left uncorrected (passed through, not converged, "
                                        "tolerance not met)");
+    c->add_flag("--keep-partial", o->keepPartial,
+                "write the program (and --report) even when the correction does not converge (an end point not reached, "
+                "a move over the tolerance at the subdivision limit); the exit status is 3 all the same");
     c->add_option("--setup", o->setup, "setup file: lines 'work-offset G54=…', 'tool-length H3=…', 'units mm|inch'")
         ->check(CLI::ExistingFile);
     c->add_option("--assume", o->assume, "positions of axes until the program commands them, e.g. Y=0 (mm, deg; rotary default 0)");

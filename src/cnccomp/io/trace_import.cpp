@@ -242,7 +242,10 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
 
     // Rows → passes.
     std::vector<Row> rows;
-    for (const auto& [line, cells] : t.rows) {
+    for (const auto& row : t.rows) {
+        // Not a structured binding: clang 14 (the fuzz targets' compiler) cannot capture one in the lambda below.
+        const int line = row.first;
+        const std::vector<std::string>& cells = row.second;
         ++sum.rows;
         const auto cell = [&](int c) -> const std::string& {
             static const std::string empty;
