@@ -48,6 +48,7 @@ table { border-collapse: collapse; margin: 8px 0; font-size: 13px; }
 th, td { border: 1px solid #ccc; padding: 3px 8px; text-align: right; }
 th { background: #f2f2f2; } td.l, th.l { text-align: left; }
 .facts td { text-align: left; border: none; padding: 1px 12px 1px 0; }
+.alarm { background: #b00020; color: #fff; font-weight: bold; padding: 12px 16px; margin: 8px 0; font-size: 16px; }
 .warn { background: #fff4e0; border: 1px solid #f0c070; padding: 6px 10px; margin: 4px 0; font-size: 13px; }
 .plots { display: flex; flex-wrap: wrap; gap: 12px; }
 figure { margin: 0; border: 1px solid #ddd; padding: 4px; background: white; }
@@ -110,6 +111,7 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
     o += "  \"facts\": " + jsonArray(d.facts, [](const auto& f) {
              return fmt::format("[{}, {}]", jsonString(f.first), jsonString(f.second));
          }) + ",\n";
+    o += "  \"alarm\": " + (d.alarm.empty() ? std::string("null") : jsonString(d.alarm)) + ",\n";
     o += "  \"warnings\": " + jsonArray(d.warnings, [](const std::string& w) { return jsonString(w); }) + ",\n";
     o += "  \"after_note\": " + jsonString(d.afterNote) + ",\n";
     appendRows(o, "runs", d.runs, [&](const RunSection& r, size_t i) {
@@ -174,6 +176,7 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
                                      files.plots.size(), d.runs.size(), d.maps.size()));
     std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
     h += fmt::format("<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n", esc(d.title), kStyle);
+    if (!d.alarm.empty()) h += fmt::format("<div class=\"alarm\" role=\"alert\">WARNING: {}</div>\n", esc(d.alarm));
     h += fmt::format("<h1>{}</h1>\n<table class=\"facts\">\n<tr><td>machine</td><td>{}</td></tr>\n", esc(d.title), esc(d.machine));
     for (const auto& [k, v] : d.facts) h += fmt::format("<tr><td>{}</td><td>{}</td></tr>\n", esc(k), esc(v));
     h += "</table>\n";

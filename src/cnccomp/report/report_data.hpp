@@ -109,6 +109,8 @@ struct ReportData {
     const MachineModel* machineModel = nullptr;  ///< needed to draw `maps` (axis kinds); may be null without maps
     std::vector<std::pair<std::string, std::string>> facts;  ///< shown in the page header (inputs, solver, …)
     std::vector<std::string> warnings;
+    /// A banner above everything else (e.g. "the model does not fit the data": the numbers below cannot be trusted).
+    std::string alarm;
     std::string afterNote;             ///< what "after" means in the runs' figures (shown under their table)
     std::vector<RunSection> runs;
     std::vector<PassSpan> spans;       ///< verify: every pass of every run, ball bar and R-test
