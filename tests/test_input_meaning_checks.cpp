@@ -73,7 +73,7 @@ TEST(InputMeaning, OldDeviationFileIsRefusedWithTheConversion) {
     EXPECT_EQ(written.rfind(kFormat, 0), 0u) << written;
     test::writeText(dir.file("w.csv"), written);
     const DeviationSet back = readDeviationCsv(dir.file("w.csv"), m);
-    for (size_t i = 0; i < d.values.size(); ++i) EXPECT_NEAR(back.values[i], d.values[i], 1e-12);
+    for (Eigen::Index i = 0; i < d.values.size(); ++i) EXPECT_NEAR(back.values[i], d.values[i], 1e-12);
     // A file whose names mean the same in both readings needs no line (only component rows here).
     test::writeText(dir.file("comp.csv"), "name,alias,value,unit\nEXC[1],,2,um\n");
     EXPECT_NO_THROW(readDeviationCsv(dir.file("comp.csv"), m));
