@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -36,10 +37,19 @@ TEST(InputMeaning, PlanFeedOffTheRealOneIsRefused) {
                                              dir.file("d.csv")));
     ASSERT_EQ(ok.exitCode, 0) << ok.out;
     EXPECT_NE(ok.out.find("feed from the data, run B-X: 1000.0 mm/min (plan 1000"), std::string::npos) << ok.out;
+    // A real instrument's file does not say the feed (cnccomp's own files carry '# feed:', checked against the plan).
+    std::filesystem::create_directory(dir.file("raw"));
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("t"))) {
+        std::istringstream in(test::readText(e.path().string()));
+        std::string line, text;
+        while (std::getline(in, line))
+            if (line.rfind("# feed", 0) != 0) text += line + "\n";
+        test::writeText(dir.file("raw/" + e.path().filename().string()), text);
+    }
     for (const char* wrong : {"1010", "1020", "1050", "980"}) {
         test::writeText(dir.file("p.xml"), replaceAll(test::readText(p), "feed=\"1000\"", fmt::format("feed=\"{}\"", wrong)));
         const auto bad = test::runCli(fmt::format("identify --machine {} --plan {} --traces {} --out {}", m,
-                                                  dir.file("p.xml"), dir.file("t"), dir.file("d2.csv")));
+                                                  dir.file("p.xml"), dir.file("raw"), dir.file("d2.csv")));
         EXPECT_EQ(bad.exitCode, 2) << wrong << ": " << bad.out;
         EXPECT_NE(bad.out.find("B-X.csv:"), std::string::npos) << bad.out;
         EXPECT_NE(bad.out.find("The data give a feed of 1000.0 mm/min"), std::string::npos) << bad.out;

@@ -80,7 +80,7 @@ TEST(LsqAdequacy, Dbb5WithMissingComponentErrorsOfCDoesNotFit) {
     ASSERT_FALSE(a.suspected.empty());
     EXPECT_NE(a.suspected.front().find("of C: EXC EYC EZC EAC EBC ECC"), std::string::npos) << a.suspected.front();
     EXPECT_NE(a.option.find("--params all"), std::string::npos) << a.option;
-    // The C runs fail with a pattern of orders 2–6; the linear circles do not point at C.
+    // The C runs fail with a pattern of orders 1–6; the linear circles do not point at C.
     for (const RunAdequacy& ra : a.runs)
         if (ra.run == "C-X-low" || ra.run == "C-Y-high") {
             EXPECT_FALSE(ra.fits) << ra.run;

@@ -443,7 +443,7 @@ void printAdequacy(const Adequacy& a) {
     fmt::print("model adequacy ({:.1f} %): F = {:.3g}, allowed {:.3g} -> {}\n", 100 * a.confidence, a.statistic, a.threshold,
                a.fits ? "the model fits the data" : "THE MODEL DOES NOT FIT THE DATA");
     fmt::print("{:<18} {:>10} {:>10} {:>10}  {:<24} {:>9}  {}\n", "run", "noise um", "F", "allowed", "noise from",
-               "h2-6 %", "verdict");
+               "h1-6 %", "verdict");
     for (const RunAdequacy& ra : a.runs)
         fmt::print("{:<18} {:>10.4f} {:>10.3g} {:>10.3g}  {:<24} {:>9}  {}\n", ra.run, ra.noise / kUm, ra.statistic,
                    ra.threshold, ra.noiseSource,

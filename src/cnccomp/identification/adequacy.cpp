@@ -52,7 +52,7 @@ Noise estimateNoise(const Eigen::VectorXd& r, const std::vector<double>& angles,
     return {};
 }
 
-/// Amplitudes of orders 1..6 of r over the angles, and the share of Σ r² that orders 2..6 carry beyond orders 0..1.
+/// Amplitudes of orders 1..6 of r over the angles, and the share of Σ (r − mean)² that orders 1..6 carry.
 void harmonics(const Eigen::VectorXd& r, const std::vector<double>& anglesDeg, RunAdequacy& out) {
     const Eigen::Index n = r.size();
     if (static_cast<Eigen::Index>(anglesDeg.size()) != n || n < 2 * (2 * kHarmonics + 1)) return;
@@ -69,9 +69,10 @@ void harmonics(const Eigen::VectorXd& r, const std::vector<double>& anglesDeg, R
     if (!(total > 0)) return;
     const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> full(A);
     const Eigen::VectorXd c = full.solve(r);
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> low(A.leftCols(3));
-    const double restFull = (r - A * c).squaredNorm(), restLow = (r - A.leftCols(3) * low.solve(r)).squaredNorm();
-    out.harmonicShare = std::clamp((restLow - restFull) / total, 0.0, 1.0);
+    const double mean = r.mean();
+    const double centred = total - static_cast<double>(n) * mean * mean;
+    const double restFull = (r - A * c).squaredNorm();
+    out.harmonicShare = centred > 0 ? std::clamp((centred - restFull) / centred, 0.0, 1.0) : 0.0;
     for (int k = 1; k <= kHarmonics; ++k) out.harmonics.push_back(std::hypot(c[2 * k - 1], c[2 * k]));
 }
 
@@ -147,7 +148,7 @@ void testAdequacy(const LsqProblem& p, const Eigen::VectorXd& x, const IdentifyO
              std::all_of(a.runs.begin(), a.runs.end(), [](const RunAdequacy& ra) { return ra.fits; });
     if (a.fits) return;
 
-    // What is missing: the rotary axes turning in the failed runs whose residual is a pattern of orders 2–6, ranked by
+    // What is missing: the rotary axes turning in the failed runs whose residual is a pattern of orders 1–6, ranked by
     // how far their runs exceed the noise; linear-only runs point at the linear axes' motion errors.
     const MachineModel& machine = p.layout().machine();
     std::set<int> estimated;

@@ -54,7 +54,7 @@ struct RunAdequacy {
     double dof = 0, noiseDof = 0;     ///< degrees of freedom of the residual share and of the noise estimate
     double threshold = kNaN;          ///< F quantile at the run's confidence
     bool fits = true;
-    double harmonicShare = kNaN;      ///< share of Σ r² carried by orders 2–6 of the sweep angle (NaN: no sweep)
+    double harmonicShare = kNaN;      ///< share of Σ (r − mean)² carried by orders 1–6 of the sweep angle (NaN: no sweep)
     std::vector<double> harmonics;    ///< amplitude of orders 1..6 of the residual over the sweep angle, mm
     std::vector<std::string> turningAxes;
 };

@@ -126,7 +126,7 @@ void adequacy(Writer& w, const Adequacy& a) {
         w.field("noise_dof", ra.noiseDof);
         w.field("threshold", ra.threshold);
         w.field("fits", ra.fits);
-        w.field("harmonic_share_2_6", ra.harmonicShare);
+        w.field("harmonic_share_1_6", ra.harmonicShare);
         std::vector<double> um;
         for (double h : ra.harmonics) um.push_back(h / kUm);
         w.numbers("harmonics_um", um);

@@ -350,15 +350,15 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         const double t0 = ps.rows.front().x;
         // The feed from the data: a pass runs the sweep and both overshoot arcs, from its first to its last sample.
         // A plan feed 1 % off the real one turns into a stretched angle scale that moves the pattern between the CW
-        // and CCW passes (issue 18: EC0Y off by 1.8″ on the multi-tasking sample); refused beyond 0.3 % plus one
-        // sample period of the pass's duration [G].
+        // and CCW passes (issue 18: EC0Y off by 1.8″ on the multi-tasking sample, 0.9″ at 0.5 %); refused beyond 0.1 %
+        // plus one sample period of the pass's duration (where the first and last samples may fall) [G].
         if (ps.rows.size() >= 3) {
             const double duration = ps.rows.back().x - t0;
             const double travel = (hi - lo) + 2.0 * run->capture.overshootDeg;
             if (duration > 0) {
                 const double feed = travel / duration * M_PI / 180.0 * radius * 60.0;
                 const double dt = duration / static_cast<double>(ps.rows.size() - 1);
-                const double tol = 0.003 + dt / duration;
+                const double tol = 0.001 + dt / duration;
                 sum.feedEstimate = p == 0 ? feed : 0.5 * (sum.feedEstimate + feed);
                 sum.feedTolerance = tol;
                 const double off = feed / run->capture.feed - 1.0;
