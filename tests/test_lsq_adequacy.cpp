@@ -163,7 +163,7 @@ TEST(LsqAdequacy, CliWarnsFirstInTextJsonAndHtml) {
     ASSERT_EQ(id.exitCode, 0) << id.out;
     const size_t warn = id.out.find("WARNING: the model does not fit the data");
     ASSERT_NE(warn, std::string::npos) << id.out;
-    EXPECT_LT(warn, id.out.find("identified ")) << id.out;  // before the result's first line
+    EXPECT_LT(warn, id.out.find("identified 11 of 11")) << id.out;  // before the result's first line
     EXPECT_NE(id.out.find("component errors (error motions) of C"), std::string::npos) << id.out;
     EXPECT_NE(id.out.find("--params all"), std::string::npos) << id.out;
     const std::string json = test::readText(dir.file("r.json"));
