@@ -95,7 +95,7 @@ TEST(DeviationCsv, AcceptsEveryUnitAndEitherColumn) {
     const MachineModel& m = test::multitasking();
     test::ScratchDir dir("dev-units");
     test::writeText(dir.file("d.csv"),
-                    "name,alias,value,unit\n,dxBT,0.001,mm\nEZ0C1,,2,um\naBT,,1,deg\n,aXB,10,urad\nbXB,,10,um/m\n"
+                    "# cnccomp-deviations/2\nname,alias,value,unit\n,dxBT,0.001,mm\nEZ0C1,,2,um\naBT,,1,deg\n,aXB,10,urad\nbXB,,10,um/m\n"
                     "gXB,,0.0001,rad\nEC0Y,,-3,arcsec\n");
     const DeviationSet d = readDeviationCsv(dir.file("d.csv"), m);
     EXPECT_NEAR(d.get("EX0C1"), 1e-3, 1e-15);

@@ -169,7 +169,7 @@ TEST(IsoNames, TheSameGeometryReadsUnderEitherName) {
     // ISO terms, EC0Y = −3", EA0Z = −5", EB0Z = 6", EA0C = 8 − 5 = 3", EB0C = −5.5 + 6 = 0.5".
     const MachineModel& m = test::multitasking();
     test::ScratchDir dir("iso-names");
-    test::writeText(dir.file("iso.csv"), "name,value,unit\nEC0Y,-3,arcsec\nEA0Z,-5,arcsec\nEB0Z,6,arcsec\nEA0C,3,arcsec\n"
+    test::writeText(dir.file("iso.csv"), "# cnccomp-deviations/2\nname,value,unit\nEC0Y,-3,arcsec\nEA0Z,-5,arcsec\nEB0Z,6,arcsec\nEA0C,3,arcsec\n"
                                          "EB0C,0.5,arcsec\nEX0C,-15,um\n");
     test::writeText(dir.file("paper.csv"), "alias,value,unit\ngXY,3,arcsec\naYZ,5,arcsec\nbYZ,-6,arcsec\naCZ,8,arcsec\n"
                                            "bCZ,-5.5,arcsec\ndxCZ,-15,um\n");
@@ -182,14 +182,14 @@ TEST(IsoNames, TheSameGeometryReadsUnderEitherName) {
     EXPECT_EQ(a.present, b.present);
     // Absent deviations are zero under their ISO names in an ISO file: EA0C absent with EA0Z given means C is square
     // to Y (aCZ = aYZ), and zero under the alias in a paper file (aCZ = 0).
-    test::writeText(dir.file("iso2.csv"), "name,value,unit\nEA0Z,-5,arcsec\n");
+    test::writeText(dir.file("iso2.csv"), "# cnccomp-deviations/2\nname,value,unit\nEA0Z,-5,arcsec\n");
     test::writeText(dir.file("paper2.csv"), "name,value,unit\naYZ,5,arcsec\n");
     EXPECT_NEAR(readDeviationCsv(dir.file("iso2.csv"), m).get("EA0C"), 0.0, 1e-18);
     EXPECT_NEAR(readDeviationCsv(dir.file("paper2.csv"), m).get("aCZ"), 0.0, 1e-18);
     // A negative alias sign: CYZ = −EA0Z on the table-table machine (90° minus the angle Y∠Z).
     const MachineModel tt = sample("table-table-ac");
-    test::writeText(dir.file("tt-iso.csv"), "name,value,unit\nEA0Z,35,um/m\nEC0Y,2,um/m\nEC0A,149,um/m\n");
-    test::writeText(dir.file("tt-paper.csv"), "name,value,unit\nCYZ,-35,um/m\nCXY,-2,um/m\nEC0A,149,um/m\n");
+    test::writeText(dir.file("tt-iso.csv"), "# cnccomp-deviations/2\nname,value,unit\nEA0Z,35,um/m\nEC0Y,2,um/m\nEC0A,149,um/m\n");
+    test::writeText(dir.file("tt-paper.csv"), "# cnccomp-deviations/2\nname,value,unit\nCYZ,-35,um/m\nCXY,-2,um/m\nEC0A,149,um/m\n");
     const DeviationSet c = readDeviationCsv(dir.file("tt-iso.csv"), tt), e = readDeviationCsv(dir.file("tt-paper.csv"), tt);
     EXPECT_LT((c.values - e.values).cwiseAbs().maxCoeff(), 1e-16);
     EXPECT_NEAR(c.linkValue("EC0A"), 147e-6, 1e-15);  // EC0A = [A.c] − CXY
@@ -277,8 +277,8 @@ TEST(IsoNames, EveryControllerFileIsTheSameFromEitherSpelling) {
     int compared = 0;
     for (const Case& c : cases) {
         const MachineModel m = sample(c.machine);
-        test::writeText(dir.file("iso.csv"), c.iso);
-        test::writeText(dir.file("paper.csv"), c.paper);
+        test::writeText(dir.file("iso.csv"), "# cnccomp-deviations/2\n" + c.iso);
+        test::writeText(dir.file("paper.csv"), "# cnccomp-deviations/2\n" + c.paper);
         const DeviationSet a = readDeviationCsv(dir.file("iso.csv"), m), b = readDeviationCsv(dir.file("paper.csv"), m);
         for (const controllers::Backend* be : controllers::backends()) {
             std::string errA, errB;

@@ -57,6 +57,22 @@ IdentificationReport handMade() {
 
 const char* kGolden = R"({
   "schema": "cnccomp-identification-report/1",
+  "adequacy": {
+    "tested": false,
+    "fits": true,
+    "verdict": "not tested",
+    "test": "F = (sum r^2 / dof) / noise^2 per run and overall; noise from passes, the plan's noise-um, or successive differences",
+    "confidence": 0.999,
+    "statistic": null,
+    "threshold": null,
+    "dof": 0,
+    "inflation": 1,
+    "inflation_rule": "",
+    "suspected_missing": [],
+    "option": "",
+    "message": "",
+    "runs": []
+  },
   "machine": "m",
   "method": "least-squares",
   "solver": "levenberg-marquardt",

@@ -47,7 +47,7 @@ TEST(PostprocThreads, ImpellerInTcpModeIsTheSameOnOneAndTwoThreads) {
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
     test::ScratchDir dir("pp-threads");
     test::writeText(dir.file("m.xml"), test::kXyzacTrtMachine);
-    test::writeText(dir.file("d.csv"), "name,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\n"
+    test::writeText(dir.file("d.csv"), "# cnccomp-deviations/2\nname,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\n"
                                        "EC0A,,-6,arcsec\nEX0C,,15,um\nEY0C,,-9,um\nEA0C,,7,arcsec\nEB0C,,-5,arcsec\n");
     const MachineModel m = readMachineXml(dir.file("m.xml"));
     const DeviationSet d = readDeviationCsv(dir.file("d.csv"), m);

@@ -51,7 +51,7 @@ struct Errors {
     double yc = 4;                                       // Y: EC0Y
 };
 inline const char* kDeviationCsv =
-    "name,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\nEC0A,,-6,arcsec\n"
+    "# cnccomp-deviations/2\nname,alias,value,unit\nEY0A,,8,um\nEZ0A,,-12,um\nEA0A,,12,arcsec\nEB0A,,10,arcsec\nEC0A,,-6,arcsec\n"
     "EX0C,,15,um\nEY0C,,-9,um\nEA0C,,7,arcsec\nEB0C,,-5,arcsec\nEC0Y,,4,arcsec\n";
 
 struct World {

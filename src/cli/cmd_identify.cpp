@@ -122,7 +122,9 @@ void run(Options o) {
                    {"solver", fmt::format("{}: {} after {} iteration(s)", rep.solver, rep.termination, rep.iterations)},
                    {"fit", fmt::format("{} samples, rank {}/{}, condition number {:.4g}, sigma {:.4f} µm", rep.observations,
                                        rep.rank, rep.unknowns, rep.conditionNumber, rep.sigma / kUm)}};
-        d.warnings = rep.warnings;
+        if (!rep.adequacy.fits) d.alarms.push_back("WARNING: " + rep.adequacy.message);
+        for (const std::string& w : rep.warnings)
+            if (rep.adequacy.fits || w != rep.adequacy.message) d.warnings.push_back(w);
         d.afterNote = "the run with the identified deviations compensated";
         d.runs = runs;
         d.deviations = report::deviationRows(rep);
@@ -139,9 +141,17 @@ void run(Options o) {
     for (const auto& [path, e] : extras) staged.add(path, e->write);
     staged.commit();
 
+    // A model that does not fit says so before anything else of the result.
+    if (res.report && !res.report->adequacy.fits) fmt::print("WARNING: {}\n", res.report->adequacy.message);
     fmt::print("{} -> {}{}\n", res.summary, o.out, o.report.empty() ? "" : ", report -> " + o.report);
     if (res.report) printReport(*res.report);
     printCircularTests(runs);
+    if (res.measured)
+        for (size_t i = 0; i < res.measured->ballbar.size() && plan; ++i)
+            if (const TraceImportSummary& s = res.measured->ballbar[i].summary; s.feedEstimate > 0)
+                fmt::print("feed from the data, run {}: {:.1f} mm/min (plan {:g}, {:+.2f} %, allowed ±{:.2f} %)\n",
+                           plan->runs[i].name, s.feedEstimate, plan->runs[i].capture.feed,
+                           100 * (s.feedEstimate / plan->runs[i].capture.feed - 1), 100 * s.feedTolerance);
     printDeviations(res.deviations, truth ? &*truth : nullptr);
 }
 

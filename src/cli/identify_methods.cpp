@@ -112,6 +112,7 @@ IdentifyOptions engineOptions(const IdentifyRequest& r, std::vector<int> default
     io.seed = r.seed;
     io.bounds = parseBounds(m, r.bounds);
     if (!r.start.empty()) io.start = readDeviationCsv(r.start, m);
+    if (r.plan && std::isfinite(r.plan->noiseUm)) io.statedNoise = r.plan->noiseUm * kUm;
     return io;
 }
 
@@ -386,8 +387,10 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
         } else if (run.kind == Dbb5Run::Kind::ConeFrustum) {
             const Dbb5ConeEvaluation c = evaluateDbb5ConeRun(m, run, traces[i], &out.deviations);
             fmt::print("cone frustum {}: circularity {:.4f} um; measured - predicted by the identified errors: rms {:.4f} "
-                       "um, max {:.4f} um\n",
-                       run.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm);
+                       "um, max {:.4f} um ({})\n",
+                       run.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm,
+                       r.formulas ? "not used by the formulas: an independent check"
+                                  : "a run of the fit, not an independent check");
         }
     }
     std::vector<std::string> names;
@@ -432,6 +435,23 @@ IdentifyOutcome runIdentification(const IdentifyRequest& r) {
     throw ModelError("unknown plan method");
 }
 
+void printAdequacy(const Adequacy& a) {
+    if (!a.tested) {
+        fmt::print("model adequacy: not tested (no run has a sweep, repeated passes or a stated noise)\n");
+        return;
+    }
+    fmt::print("model adequacy ({:.1f} %): F = {:.3g}, allowed {:.3g} -> {}\n", 100 * a.confidence, a.statistic, a.threshold,
+               a.fits ? "the model fits the data" : "THE MODEL DOES NOT FIT THE DATA");
+    fmt::print("{:<18} {:>10} {:>10} {:>10}  {:<24} {:>9}  {}\n", "run", "noise um", "F", "allowed", "noise from",
+               "h1-6 %", "verdict");
+    for (const RunAdequacy& ra : a.runs)
+        fmt::print("{:<18} {:>10.4f} {:>10.3g} {:>10.3g}  {:<24} {:>9}  {}\n", ra.run, ra.noise / kUm, ra.statistic,
+                   ra.threshold, ra.noiseSource,
+                   std::isfinite(ra.harmonicShare) ? fmt::format("{:.0f}", 100 * ra.harmonicShare) : "-",
+                   ra.fits ? "fits" : "DOES NOT FIT");
+    if (!a.fits) fmt::print("intervals: {}\n", a.inflationRule);
+}
+
 void printReport(const IdentificationReport& r) {
     fmt::print("{}: {} after {} iteration(s); cost {:.6g} -> {:.6g} um^2; rank {}/{}, condition number {:.4g}, "
                "sigma {} um\n",
@@ -468,6 +488,7 @@ void printReport(const IdentificationReport& r) {
     fmt::print("{:<18} {:>8} {:>14} {:>14}\n", "run", "samples", "rms before um", "rms after um");
     for (const RunResidual& rr : r.runs)
         fmt::print("{:<18} {:>8} {:>14.4f} {:>14.4f}\n", rr.run, rr.samples, rr.rmsBefore / kUm, rr.rmsAfter / kUm);
+    printAdequacy(r.adequacy);
     for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
 }
 

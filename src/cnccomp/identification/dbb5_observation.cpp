@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/identification/plan_method.hpp"
 
 namespace cnccomp {
 
@@ -16,6 +17,14 @@ Dbb5Observation::Dbb5Observation(const MachineModel& machine, Dbb5Run run, const
                                      trace.angleDeg.size(), trace.dL.size()));
     const Kinematics nominal(machine);
     setup_ = dbb5SetupCommands(machine, run_);
+    anglesDeg_ = trace.angleDeg;
+    if (run_.kind == Dbb5Run::Kind::RotaryCircle) {
+        turning_ = {run_.axis};
+    } else if (run_.kind == Dbb5Run::Kind::ConeFrustum) {
+        const auto [outer, inner] = tableRotaryAxes(machine);
+        for (const std::string& a : {outer, inner})
+            if (!a.empty()) turning_.push_back(a);
+    }
     measured_.resize(static_cast<Eigen::Index>(trace.dL.size()));
     for (size_t i = 0; i < trace.dL.size(); ++i) {
         if (!std::isfinite(trace.angleDeg[i]) || !std::isfinite(trace.dL[i]))

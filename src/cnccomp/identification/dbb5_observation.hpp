@@ -21,11 +21,17 @@ public:
     bool jacobian(const DifferentiableMachine& m, const double* nuisance, const std::vector<int>& flat,
                   Eigen::Ref<Eigen::MatrixXd> J) const override;
 
+    std::vector<double> sweepAnglesDeg() const override { return anglesDeg_; }
+    /// The turning axis of a rotary circle; every rotary axis the machine moves in a cone frustum; none for linear circles.
+    std::vector<std::string> turningAxes() const override { return turning_; }
+
     const Dbb5Run& run() const { return run_; }
 
 private:
     Dbb5Run run_;
     Eigen::VectorXd measured_;
+    std::vector<double> anglesDeg_;
+    std::vector<std::string> turning_;
     AxisVector setup_;
     std::vector<AxisVector> commands_;
 };

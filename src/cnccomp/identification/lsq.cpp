@@ -9,6 +9,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/iso_names.hpp"
+#include "cnccomp/identification/adequacy.hpp"
 #include "cnccomp/identification/identifiability.hpp"
 #include "cnccomp/identification/levenberg_marquardt.hpp"
 #include "cnccomp/identification/nlopt_solver.hpp"
@@ -144,6 +145,7 @@ IdentificationResult identify(const MachineModel& machine, const Observations& o
         rep.warnings.push_back(fmt::format("{} of {} unknowns are not identifiable from these measurements",
                                            rep.unidentified.size(), rep.unknowns));
     if (rep.dof <= 0) rep.warnings.push_back("no redundancy (observations ≤ rank): no uncertainty estimate");
+    testAdequacy(problem, so.x, options, rep);  // the residual against the noise; its warning comes first
 
     // Present = estimated deviations with every coefficient identified; unidentified ones keep the start values.
     for (int di : devs) res.deviations.present[di] = 1;

@@ -31,6 +31,8 @@ struct IdentifyOptions {
     int monteCarlo = 0;                 ///< number of resampled solutions (0 = none)
     std::uint64_t seed = 1;             ///< Monte Carlo random seed
     std::optional<DeviationSet> start;  ///< starting values; deviations not estimated keep these values
+    double statedNoise = std::numeric_limits<double>::quiet_NaN();  ///< instrument noise, mm (plan noise-um)
+    std::string componentOption = "--params all";  ///< the option named when component errors seem missing
 };
 
 struct IdentificationResult {

@@ -171,6 +171,10 @@ void DifferentiableMachine::toolPointJacobian(const AxisVector& q, const Vec3& t
 
 // ---------------------------------------------------------------------------------------------------------------
 
+std::vector<std::string> BallbarObservation::turningAxes() const {
+    return {rotatesHead(run_.test) ? run_.headAxis : run_.tableAxis};
+}
+
 BallbarObservation::BallbarObservation(const MachineModel& machine, BallbarRun run, const BallbarTrace& trace)
     : run_(std::move(run)) {
     run_.validate();

@@ -105,6 +105,13 @@ public:
                           const std::vector<int>& /*flat*/, Eigen::Ref<Eigen::MatrixXd> /*J*/) const {
         return false;
     }
+
+    /// Model adequacy (identification/adequacy.hpp): the sweep angle of every sample in degrees, in recording order
+    /// (empty for runs without one sweep, e.g. R-test poses); samples at equal angles are repeats (passes).
+    virtual std::vector<double> sweepAnglesDeg() const { return {}; }
+    /// Rotary axes that turn during the run (their component errors are what a residual pattern over the sweep
+    /// angle points to); empty when only linear axes move.
+    virtual std::vector<std::string> turningAxes() const { return {}; }
 };
 
 using Observations = std::vector<std::unique_ptr<ObservationModel>>;
@@ -129,6 +136,8 @@ public:
     bool jacobian(const DifferentiableMachine& m, const double* nuisance, const std::vector<int>& flat,
                   Eigen::Ref<Eigen::MatrixXd> J) const override;
 
+    std::vector<double> sweepAnglesDeg() const override { return anglesDeg_; }
+    std::vector<std::string> turningAxes() const override;
     const BallbarRun& run() const { return run_; }
     const std::vector<AxisVector>& commands() const { return commands_; }
 

@@ -45,6 +45,35 @@ struct RunResidual {
     double maxAfter = 0;                 ///< largest |residual| after, mm
 };
 
+/// Model adequacy of one run (identification/adequacy.hpp): its residual against the noise its data can have.
+struct RunAdequacy {
+    std::string run;
+    std::string noiseSource;          ///< "passes", "stated", "successive differences" (see adequacy.hpp)
+    double noise = kNaN;              ///< one sample's noise standard deviation, mm
+    double statistic = kNaN;          ///< F = (Σ r² / dof) / noise²
+    double dof = 0, noiseDof = 0;     ///< degrees of freedom of the residual share and of the noise estimate
+    double threshold = kNaN;          ///< F quantile at the run's confidence
+    bool fits = true;
+    double harmonicShare = kNaN;      ///< share of Σ (r − mean)² carried by orders 1–6 of the sweep angle (NaN: no sweep)
+    std::vector<double> harmonics;    ///< amplitude of orders 1..6 of the residual over the sweep angle, mm
+    std::vector<std::string> turningAxes;
+};
+
+/// Does the model fit the data? A χ²/F test of the residual against the noise, per run and overall, with the residual's
+/// harmonics as the signature of what is missing.
+struct Adequacy {
+    bool tested = false;              ///< false: no run carries a noise estimate
+    bool fits = true;
+    double confidence = 0.999;        ///< overall; each run at 1 − (1 − confidence) / runs (Bonferroni)
+    double statistic = kNaN, threshold = kNaN, dof = 0, noiseDof = 0;  ///< overall F test
+    double inflation = 1;             ///< factor applied to stddev and 95 % intervals (1 when the model fits)
+    std::string inflationRule;        ///< how `inflation` was found
+    std::vector<std::string> suspected;  ///< "component errors of C (EXC EYC EZC EAC EBC ECC)", …
+    std::string option;               ///< the option that adds them, e.g. "--params all"
+    std::string message;              ///< the warning line (empty when the model fits)
+    std::vector<RunAdequacy> runs;
+};
+
 struct IdentificationReport {
     std::string machine;
     std::string method = "least-squares";
@@ -67,6 +96,7 @@ struct IdentificationReport {
     int monteCarloSamples = 0;
     Eigen::MatrixXd covariance;          ///< internal units, parameter order; NaN rows for unidentified ones
     std::vector<std::string> warnings;
+    Adequacy adequacy;                   ///< the residual against the noise (warnings[0] when the model does not fit)
 
     /// Index of a parameter by name or alias, or -1.
     int find(const std::string& nameOrAlias) const;

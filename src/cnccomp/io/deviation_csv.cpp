@@ -1,12 +1,14 @@
 #include "cnccomp/io/deviation_csv.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <ostream>
 #include <sstream>
 
 #include <Eigen/LU>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/iso_names.hpp"
@@ -27,6 +29,24 @@ std::pair<std::string, int> splitIndex(const std::string& s, const std::string& 
     return {s.substr(0, open), static_cast<int>(*k)};
 }
 
+/// The format line cnccomp writes first (before any header comment of a backend is fine too): from it on, location
+/// errors under ISO names are ISO 230-1 values (iso_names.hpp), not the link values files carried before 2026-11-23.
+constexpr const char* kFormatLine = "# cnccomp-deviations/2: location errors under ISO 230-1 names are ISO values (iso_names.hpp)";
+constexpr const char* kFormatTag = "# cnccomp-deviations/";
+
+/// True when one of the comment lines before the header is the format line (any version tag).
+bool hasFormatLine(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    while (std::getline(in, line)) {
+        const std::string_view t = trim(line);
+        if (t.empty()) continue;
+        if (t.front() != '#') return false;  // the header: no format line before it
+        if (t.rfind(kFormatTag, 0) == 0) return true;
+    }
+    return false;
+}
+
 struct Given {
     int line = 0;
     bool iso = true;        ///< value under the ISO name (else under the alias)
@@ -34,6 +54,53 @@ struct Given {
     bool hasAliasValue = false;
     double aliasValue = 0, unit = 1;  ///< internal units; unit = internal units per file unit of the row
 };
+
+/// A file in the layout cnccomp wrote before its ISO names took ISO 230-1's meaning (no format line, no alias_value
+/// column) whose location rows would describe another machine under the old meaning (every value the link's own error
+/// component, unlisted ones zero) is refused with the conversion: the ISO values of the old geometry.
+void refuseOldMeaning(const std::string& path, const CsvTable& t, bool aliasValueColumn, const MachineModel& machine,
+                      const std::map<std::pair<int, int>, Given>& given, const DeviationSet& set) {
+    if (aliasValueColumn || given.empty() || hasFormatLine(path)) return;
+    DeviationSet old(machine);
+    old.values = set.values;
+    bool anyLocationName = false;
+    int firstLine = 0;
+    for (const DeviationDef& d : machine.deviations)
+        if (d.kind == DeviationKind::Location) old.values[d.offset] = 0;
+    for (const auto& [key, g] : given) {
+        const DeviationDef& d = machine.deviations[static_cast<size_t>(key.first)];
+        if (d.kind != DeviationKind::Location) continue;
+        if (!g.iso) {
+            old.values[d.offset] = g.value * d.aliasSign;  // an alias names the paper's value in either meaning
+            continue;
+        }
+        old.values[d.offset] = g.value;
+        anyLocationName = true;
+        if (firstLine == 0 || g.line < firstLine) firstLine = g.line;
+    }
+    if (!anyLocationName) return;
+    std::vector<std::string> changed, conversion;
+    for (int i = 0; i < static_cast<int>(machine.deviations.size()); ++i) {
+        const DeviationDef& d = machine.deviations[static_cast<size_t>(i)];
+        if (d.kind != DeviationKind::Location) continue;
+        const double scale = d.isAngle() ? kArcsec : kUm;
+        const double now = set.isoValue(i), before = old.isoValue(i);
+        if (std::abs(now - before) > 1e-7 * scale) changed.push_back(d.name);
+        if (std::abs(before) > 1e-9 * scale)
+            conversion.push_back(fmt::format("{},,{:.6f},{}", d.name, before / scale, d.isAngle() ? "arcsec" : "um"));
+    }
+    if (changed.empty()) return;
+    std::string rows;
+    for (const std::string& c : conversion) rows += "\n    " + c;
+    throw InputError(
+        path, firstLine > 0 ? firstLine : t.header.line,
+        fmt::format("this deviation file has no format line and no alias_value column, the layout cnccomp wrote before "
+                    "its names took ISO 230-1's meaning (before, a name's value was its link's own error component); on "
+                    "machine '{}' that changes {} (the geometry differs). If the values are ISO 230-1 values, add the "
+                    "line '{}' at the top. If the file was written by cnccomp before that change, replace its location "
+                    "rows by the ISO values of the same geometry and add that line:{}",
+                    machine.name, fmt::join(changed, ", "), kFormatLine, rows.empty() ? "\n    (every location error zero)" : rows));
+}
 
 }  // namespace
 
@@ -144,6 +211,7 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
         const Eigen::VectorXd x = lu.solve(b);
         for (int r = 0; r < n; ++r) set.values[machine.deviations[static_cast<size_t>(loc[static_cast<size_t>(r)])].offset] = x[r];
     }
+    refuseOldMeaning(path, t, cAliasValue >= 0, machine, given, set);
     for (const auto& [key, g] : given) {
         if (!g.hasAliasValue) continue;
         const DeviationDef& d = machine.deviations[static_cast<size_t>(key.first)];
@@ -158,7 +226,7 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
 
 std::string formatDeviationCsv(const DeviationSet& set, bool all) {
     std::ostringstream out;
-    out << "name,alias,value,unit,alias_value\n";
+    out << kFormatLine << '\n' << "name,alias,value,unit,alias_value\n";
     const MachineModel& m = set.machine();
     for (size_t i = 0; i < m.deviations.size(); ++i) {
         if (!all && !set.present[i]) continue;

@@ -312,6 +312,12 @@ MeasurementPlan readPlanXml(const std::string& path) {
     plan.machine = xml::textOr(root, "machine", "");
     plan.description = xml::textOr(root, "description", "");
     plan.line = root.GetLineNum();
+    if (root.Attribute("noise-um")) {
+        plan.noiseUm = xml::number(root, path, "noise-um", 0.0);
+        if (!(plan.noiseUm > 0) || !std::isfinite(plan.noiseUm))
+            xml::fail(root, path, "noise-um (the instrument's stated noise, one sample's standard deviation) must be a "
+                                  "positive number of um");
+    }
     RunCapture instrument;
     const XMLElement* instrumentElement = root.FirstChildElement("instrument");
     if (instrumentElement) {
@@ -348,8 +354,9 @@ MeasurementPlan readPlanXml(const std::string& path) {
 std::string formatPlanXml(const MeasurementPlan& plan) {
     std::ostringstream o;
     o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    o << fmt::format("<plan machine=\"{}\" description=\"{}\">\n", escapeXml(plan.machine, "machine name"),
-                     esc(plan.description));
+    o << fmt::format("<plan machine=\"{}\" description=\"{}\"{}>\n", escapeXml(plan.machine, "machine name"),
+                     esc(plan.description),
+                     std::isfinite(plan.noiseUm) ? fmt::format(" noise-um=\"{:g}\"", plan.noiseUm) : "");
     // One <instrument> when every ball-bar run shares its settings; runs write what differs from it.
     std::vector<const BallbarRun*> ballbar;
     for (const auto& r : plan.runs) ballbar.push_back(&r);

@@ -95,12 +95,55 @@ void combinations(Writer& w, const std::string& k, const std::vector<Combination
     w.close(']');
 }
 
+/// Model adequacy (identification/adequacy.hpp): verdict, statistic, threshold, suspected missing terms, per run.
+void adequacy(Writer& w, const Adequacy& a) {
+    w.key("adequacy");
+    w.open('{');
+    w.field("tested", a.tested);
+    w.field("fits", a.fits);
+    w.field("verdict", !a.tested ? "not tested" : a.fits ? "the model fits the data" : "the model does not fit the data");
+    w.field("test", "F = (sum r^2 / dof) / noise^2 per run and overall; noise from passes, the plan's noise-um, or "
+                    "successive differences");
+    w.field("confidence", a.confidence);
+    w.field("statistic", a.statistic);
+    w.field("threshold", a.threshold);
+    w.field("dof", a.dof);
+    w.field("inflation", a.inflation);
+    w.field("inflation_rule", a.inflationRule);
+    w.strings("suspected_missing", a.suspected);
+    w.field("option", a.option);
+    w.field("message", a.message);
+    w.key("runs");
+    w.open('[');
+    for (const RunAdequacy& ra : a.runs) {
+        w.element();
+        w.open('{');
+        w.field("run", ra.run);
+        w.field("noise_source", ra.noiseSource);
+        w.field("noise_um", ra.noise / kUm);
+        w.field("statistic", ra.statistic);
+        w.field("dof", ra.dof);
+        w.field("noise_dof", ra.noiseDof);
+        w.field("threshold", ra.threshold);
+        w.field("fits", ra.fits);
+        w.field("harmonic_share_1_6", ra.harmonicShare);
+        std::vector<double> um;
+        for (double h : ra.harmonics) um.push_back(h / kUm);
+        w.numbers("harmonics_um", um);
+        w.strings("turning_axes", ra.turningAxes);
+        w.close('}');
+    }
+    w.close(']');
+    w.close('}');
+}
+
 }  // namespace
 
 std::string formatReportJson(const IdentificationReport& r) {
     Writer w;
     w.open('{');
     w.field("schema", "cnccomp-identification-report/1");
+    adequacy(w, r.adequacy);  // first: whether the numbers below can be believed
     w.field("machine", r.machine);
     w.field("method", r.method);
     w.field("solver", r.solver);

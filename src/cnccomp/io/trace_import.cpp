@@ -351,6 +351,34 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         const double omegaDeg = run->capture.feed / 60.0 / radius * 180.0 / M_PI;  // deg/s
         const double a0 = (ps.direction > 0 ? lo : hi) - ps.direction * run->capture.overshootDeg;
         const double t0 = ps.rows.front().x;
+        // The feed from the data: a pass runs the sweep and both overshoot arcs, from its first to its last sample.
+        // A plan feed 1 % off the real one turns into a stretched angle scale that moves the pattern between the CW
+        // and CCW passes (issue 18: EC0Y off by 1.8″ on the multi-tasking sample, 0.9″ at 0.5 %); refused beyond 0.1 %
+        // plus one sample period of the pass's duration (where the first and last samples may fall) [G].
+        if (ps.rows.size() >= 3) {
+            const double duration = ps.rows.back().x - t0;
+            const double travel = (hi - lo) + 2.0 * run->capture.overshootDeg;
+            if (duration > 0) {
+                const double feed = travel / duration * M_PI / 180.0 * radius * 60.0;
+                const double dt = duration / static_cast<double>(ps.rows.size() - 1);
+                const double tol = 0.001 + dt / duration;
+                sum.feedEstimate = p == 0 ? feed : 0.5 * (sum.feedEstimate + feed);
+                sum.feedTolerance = tol;
+                const double off = feed / run->capture.feed - 1.0;
+                if (std::abs(off) > tol)
+                    throw InputError(
+                        path, ps.rows.back().line,
+                        fmt::format("{}lasts {:.3f} s from its first to its last sample; at the plan's feed {:g} mm/min on "
+                                    "the radius {:g} mm, the {:g}° of the run (sweep and both overshoot arcs) take {:.3f} s. "
+                                    "The data give a feed of {:.1f} mm/min ({:+.2f} % from the plan, more than the {:.2f} % "
+                                    "allowed): the angles would be stretched. Give the real feed in the plan (feed=\"{:.1f}\" "
+                                    "on run '{}'), or record angle-sampled files",
+                                    passes.size() > 1 ? fmt::format("pass {} ({}) ", p + 1, ps.direction > 0 ? "CCW" : "CW")
+                                                      : std::string("the pass "),
+                                    duration, run->capture.feed, radius, travel, travel / omegaDeg, feed, 100 * off,
+                                    100 * tol, feed, run->name));
+            }
+        }
         for (Row& r : ps.rows) r.x = a0 + ps.direction * omegaDeg * (r.x - t0);
     }
 

@@ -31,6 +31,8 @@ struct TraceImportSummary {
     int trimmed = 0;          ///< samples outside the sweep (feed-in / feed-out), dropped
     int metadataChecked = 0;  ///< "# key: value" lines checked against the run
     double driftRemoved = 0;  ///< ΔL drift removed between the first and the last sample, mm (0: not asked)
+    double feedEstimate = 0;  ///< time-sampled: the feed the passes' durations give, mm/min (0: not estimated)
+    double feedTolerance = 0; ///< relative deviation from the plan's feed allowed for that file (refused beyond)
 };
 
 struct MeasuredTrace {

@@ -75,6 +75,9 @@ std::vector<RunSection> measuredRunSections(const MachineModel& m, const Measure
         const TraceImportSummary& sum = t.summary;
         s.notes.push_back(fmt::format("{}-sampled file: {} rows, {} kept, {} missing, {} outside the sweep (overshoot)", sum.layout,
                                       sum.rows, t.trace.dL.size(), sum.missing, sum.trimmed));
+        if (sum.feedEstimate > 0)
+            s.notes.push_back(fmt::format("feed from the passes' durations: {:.1f} mm/min (plan {:g}, within {:.2f} %)",
+                                          sum.feedEstimate, run.capture.feed, 100 * sum.feedTolerance));
         if (run.capture.removeDrift) s.notes.push_back(fmt::format("drift removed: {:.3f} µm over the file", sum.driftRemoved / kUm));
         if (relative)
             s.notes.push_back(fmt::format("relative instrument: length offset dL0 = {:.3f} µm estimated and taken off", dL0 / kUm));
