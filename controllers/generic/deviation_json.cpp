@@ -3,7 +3,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/deviation_range.hpp"
 #include "controllers/generic/json.hpp"
 
 namespace cnccomp::controllers::generic {

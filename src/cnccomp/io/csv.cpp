@@ -1,6 +1,9 @@
 #include "cnccomp/io/csv.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 
@@ -11,6 +14,17 @@
 #include "cnccomp/machine.hpp"
 
 namespace cnccomp {
+
+void requireRegularFile(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) throw InputError(path, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
+    if (S_ISDIR(st.st_mode)) throw InputError(path, 0, "is a folder, not a file");
+    const char* kind = S_ISFIFO(st.st_mode)                          ? "a FIFO (named pipe)"
+                       : S_ISSOCK(st.st_mode)                        ? "a socket"
+                       : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                                                                     : "not a regular file";
+    if (!S_ISREG(st.st_mode)) throw InputError(path, 0, fmt::format("is {}, not a file; only regular files are read", kind));
+}
 
 std::string separatorName(char separator) { return separator == '\t' ? "tab" : std::string(1, separator); }
 

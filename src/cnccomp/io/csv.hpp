@@ -24,6 +24,11 @@ namespace cnccomp {
 
 struct MachineModel;
 
+/// Throws InputError unless `path` names a regular file (or a link to one): a folder is "a folder, not a file", a
+/// FIFO / socket / device is named as such and never opened (opening a FIFO blocks until a writer comes). Every
+/// reader calls it before opening its input (CsvReader, xml::load).
+void requireRegularFile(const std::string& path);
+
 struct CsvRow {
     int line = 0;
     std::vector<std::string> cells;

@@ -1,4 +1,5 @@
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/deviation_range.hpp"
 
 #include <cmath>
 #include <map>

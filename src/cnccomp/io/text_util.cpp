@@ -134,14 +134,6 @@ private:
     int error_ = 0;
 };
 
-void requireRegularFile(const std::string& path) {
-    struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) throw InputError(path, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
-    if (S_ISDIR(st.st_mode)) throw InputError(path, 0, "is a folder, not a file");
-    if (!S_ISREG(st.st_mode))
-        throw InputError(path, 0, fmt::format("is {}, not a file; only regular files are read", kindOf(st.st_mode)));
-}
-
 std::string checkOutputPath(const std::string& path) {
     if (path.empty()) throw InputError(path, 0, "the output path is empty");
     std::string target = path;

@@ -14,11 +14,6 @@ std::optional<double> parseNumber(std::string_view s);
 /// Trim ASCII white space.
 std::string_view trim(std::string_view s);
 
-/// Throws InputError unless `path` names a regular file (or a link to one): a folder is "a folder, not a file", a
-/// FIFO / socket / device is named as such and never opened (opening a FIFO blocks until a writer comes). Every
-/// reader calls it before opening its input.
-void requireRegularFile(const std::string& path);
-
 /// Checks, before any work, that `path` can be written atomically: its folder exists and it is absent or a regular
 /// file (a symbolic link is followed to its target). A directory, a device (/dev/null), a FIFO or a socket is refused
 /// with an InputError naming the path: the atomic rename would replace the node itself. Returns the path the file will

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp::xml {
