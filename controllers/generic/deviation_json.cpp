@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_range.hpp"
 #include "controllers/generic/json.hpp"
 
 namespace cnccomp::controllers::generic {
@@ -64,11 +65,16 @@ DeviationSet readDeviationJson(const std::string& text, const std::string& file,
             throw InputError(file, e.line, fmt::format("'{}': kind, link or component differ from machine '{}'", name, m.name));
         if (location) {
             d.values[def.offset] = e.require("value", Json::Type::Number, file).number;
+            if (const std::string why = deviationRangeProblem(def, d.values[def.offset]); !why.empty())
+                throw InputError(file, e.line, why);
         } else {
             const std::vector<double> c = e.require("coefficients", Json::Type::Array, file).numbers(file);
             if (static_cast<int>(c.size()) != def.size())
                 throw InputError(file, e.line, fmt::format("'{}' needs {} coefficients, has {}", name, def.size(), c.size()));
-            for (int i = 0; i < def.size(); ++i) d.values[def.offset + i] = c[i];
+            for (int i = 0; i < def.size(); ++i) {
+                if (const std::string why = deviationRangeProblem(def, c[i]); !why.empty()) throw InputError(file, e.line, why);
+                d.values[def.offset + i] = c[i];
+            }
         }
         d.present[k] = 1;
     }

@@ -24,18 +24,6 @@ constexpr const char* kValueColumns[] = {"dx_machine_um",     "dy_machine_um",  
 
 double unitOf(bool rotary) { return rotary ? kDeg : 1.0; }
 
-std::vector<std::string> splitComma(std::string_view line) {
-    std::vector<std::string> out;
-    size_t start = 0;
-    for (;;) {
-        const size_t c = line.find(',', start);
-        out.emplace_back(trim(line.substr(start, c == std::string_view::npos ? std::string_view::npos : c - start)));
-        if (c == std::string_view::npos) break;
-        start = c + 1;
-    }
-    return out;
-}
-
 }  // namespace
 
 void GridMap::at(const AxisVector& q, Vec3& tipError, Vec3& axisError) const {
@@ -341,21 +329,18 @@ GridMap parseGridMapCsv(const std::string& text, const std::string& file, const 
     int headerLine = 0;
     std::vector<std::vector<double>> rows;
     std::vector<int> lines;
-    for (const TextLine& l : splitLines(text)) {
-        const std::string_view s = trim(l.text);
-        if (s.empty() || s.front() == '#') continue;
-        const auto cells = splitComma(s);
-        if (header.empty()) {
-            header = cells;
-            headerLine = l.number;
-            continue;
-        }
-        if (cells.size() != header.size())
-            throw InputError(file, l.number, fmt::format("{} cells for {} columns", cells.size(), header.size()));
+    CsvReader reader(text, file);  // the one CSV reader (io/csv.hpp): BOM, CRLF, quoting, line numbers
+    header = reader.header().cells;
+    headerLine = reader.header().line;
+    CsvRow row;
+    while (reader.next(row)) {
+        if (row.cells.size() != header.size())
+            throw InputError(file, row.line, fmt::format("{} cells for {} columns", row.cells.size(), header.size()));
         std::vector<double> v;
-        for (size_t i = 0; i < cells.size(); ++i) v.push_back(requireNumber(cells[i], file, l.number, "a value of " + header[i]));
+        for (size_t i = 0; i < row.cells.size(); ++i)
+            v.push_back(requireNumber(row.cells[i], file, row.line, "a value of " + header[i]));
         rows.push_back(std::move(v));
-        lines.push_back(l.number);
+        lines.push_back(row.line);
     }
     const int n = m.axisCount();
     if (static_cast<int>(header.size()) != n + 6) throw InputError(file, headerLine, fmt::format("expected {} axis columns and 6 error columns", n));

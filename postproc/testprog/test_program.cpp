@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/kinematics.hpp"
 
@@ -290,32 +291,13 @@ TestProgramSet makeTestPrograms(const MachineModel& m, const MeasurementPlan& pl
 }
 
 void writeTestPrograms(const TestProgramSet& set, const std::string& dir, const std::vector<std::string>& inputs) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) throw InputError(dir, 0, "the output folder is not a folder");
-    fs::create_directories(dir, ec);
-    if (ec) throw InputError(dir, 0, "cannot create the output folder: " + ec.message());
-    std::vector<std::pair<std::string, const std::string*>> files;
-    for (const TestProgram& p : set.programs) files.emplace_back((fs::path(dir) / p.file).string(), &p.text);
-    files.emplace_back((fs::path(dir) / set.indexFile).string(), &set.index);
-    for (const auto& [path, text] : files) {
-        (void)text;
-        for (const std::string& in : inputs) refuseToOverwrite(path, {in});
-        if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
-            throw InputError(path, 0, "exists and is not a regular file: not overwritten");
-    }
-    std::vector<std::string> staged;
-    try {
-        for (const auto& [path, text] : files) {
-            const std::string tmp = path + ".cnccomp-staged";
-            writeFileAtomically(tmp, [&](std::ostream& s) { s << *text; });
-            staged.push_back(tmp);
-        }
-        for (size_t i = 0; i < files.size(); ++i) fs::rename(staged[i], files[i].first);
-    } catch (...) {
-        for (const std::string& s : staged) fs::remove(s, ec);
-        throw;
-    }
+    // All or none (io/output_set.hpp): every program is staged beside its target, then all are renamed together; a
+    // full disk or a read-only folder leaves the targets as they were and removes a folder this call created.
+    OutputSet out(inputs);
+    out.makeFolder(dir);
+    for (const TestProgram& p : set.programs) out.add(OutputSet::fileIn(dir, p.file), p.text);
+    out.add(OutputSet::fileIn(dir, set.indexFile), set.index);
+    out.commit();
 }
 
 }  // namespace cnccomp::testprog

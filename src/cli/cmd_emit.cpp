@@ -13,6 +13,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
+#include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "controllers/backend.hpp"
@@ -188,11 +189,11 @@ void run(const Options& o) {
         req.headerNotes = fit.notes;
     }
     const controllers::EmitResult r = b.emit(req);
-    namespace fs = std::filesystem;
-    fs::create_directories(o.out);
-    for (const controllers::OutputFile& f : r.files) refuseToOverwrite((fs::path(o.out) / f.name).string(), {o.machine, o.deviations});
-    for (const controllers::OutputFile& f : r.files)
-        writeFileAtomically((fs::path(o.out) / f.name).string(), [&](std::ostream& s) { s << f.content; });
+    // All or none (io/output_set.hpp): a full disk or a read-only folder leaves no file and no new folder.
+    OutputSet out({o.machine, o.deviations, o.plan});
+    out.makeFolder(o.out);
+    for (const controllers::OutputFile& f : r.files) out.add(OutputSet::fileIn(o.out, f.name, o.controller), f.content);
+    out.commit();
     fmt::print("{} compensation for '{}' from {} ({} files in {})\n", b.name(), m.name, o.deviations, r.files.size(), o.out);
     for (const controllers::OutputFile& f : r.files) fmt::print("  {}\n", f.name);
     for (const std::string& l : r.summary) fmt::print("{}\n", l);

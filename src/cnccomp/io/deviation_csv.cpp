@@ -1,4 +1,5 @@
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/deviation_range.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -104,6 +105,18 @@ void refuseOldMeaning(const std::string& path, const CsvTable& t, bool aliasValu
 
 }  // namespace
 
+std::string deviationRangeProblem(const DeviationDef& d, double value) {
+    if (!std::isfinite(value)) return fmt::format("'{}' is not a finite number", d.name);
+    if (d.isAngle() ? std::abs(value) <= kMaxDeviationAngle : std::abs(value) <= kMaxDeviationLength) return {};
+    return d.isAngle()
+               ? fmt::format("'{}' = {:g} arcsec ({:g} deg) is beyond any machine's deviation (at most ±{:g} arcsec = ±1 deg); "
+                             "check the value and its unit",
+                             d.name, value / kArcsec, value / kDeg, kMaxDeviationAngle / kArcsec)
+               : fmt::format("'{}' = {:g} mm is beyond any machine's deviation (at most ±{:g} mm); check the value and its "
+                             "unit",
+                             d.name, value, kMaxDeviationLength);
+}
+
 DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machine) {
     const CsvTable t = readCsv(path);
     const int cName = t.column("name"), cAlias = t.column("alias"), cAliasValue = t.column("alias_value");
@@ -150,6 +163,7 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
         g.iso = iso;
         g.unit = unit->toInternal;
         g.value = t.requireNumber(row, cValue) * unit->toInternal;
+        if (const std::string why = deviationRangeProblem(d, g.value); !why.empty()) throw InputError(path, row.line, why);
         const bool both = !rawName.empty() && !rawAlias.empty();
         if (const auto av = t.number(row, cAliasValue); av && !d.alias.empty()) {
             g.hasAliasValue = true;

@@ -1,6 +1,8 @@
 #include "cnccomp/io/machine_xml.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -26,8 +28,10 @@ Link readLink(const XMLElement& e, const std::string& path) {
     l.name = xml::text(e, path, "name");
     const std::string element = e.Name();
     if (element == "fixed") {
+        xml::allowAttributes(e, path, {"name", "offset", "rotation"});
         l.kind = AxisKind::Fixed;
     } else if (element == "axis") {
+        xml::allowAttributes(e, path, {"name", "type", "direction", "min", "max", "modulo", "machine-zero", "offset", "rotation"});
         const std::string type = xml::text(e, path, "type");
         if (type == "linear") l.kind = AxisKind::Linear;
         else if (type == "rotary") l.kind = AxisKind::Rotary;
@@ -44,7 +48,7 @@ Link readLink(const XMLElement& e, const std::string& path) {
         if (l.modulo && l.kind != AxisKind::Rotary) xml::fail(e, path, "only a rotary axis can be modulo");
         l.machineZero = xml::number(e, path, "machine-zero", 0.0) * unit;
     } else {
-        xml::fail(e, path, "expected <axis> or <fixed>");
+        xml::unknownElement(e, path, {"axis", "fixed"});
     }
     // Nominal placement: offset (mm) then rotation Rz(c)·Ry(b)·Rx(a), angles in degrees.
     const Vec3 off = xml::vec3(e, path, "offset", Vec3::Zero());
@@ -57,9 +61,14 @@ Link readLink(const XMLElement& e, const std::string& path) {
     return l;
 }
 
-void readChain(const XMLElement* e, const std::string& path, Chain& chain) {
+void readChain(const XMLElement* e, const std::string& path, Chain& chain, std::map<std::string, int>& lines) {
     if (!e) return;
-    for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) chain.links.push_back(readLink(*c, path));
+    if (std::string(e->Name()) == "tool") xml::allowAttributes(*e, path, {"direction"});
+    else xml::allowAttributes(*e, path, {});
+    for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+        chain.links.push_back(readLink(*c, path));
+        lines[chain.links.back().name] = c->GetLineNum();
+    }
 }
 
 ComponentBasis readBasis(const XMLElement& e, const std::string& path, const Link& link) {
@@ -93,25 +102,38 @@ MachineModel readMachineXml(const std::string& path) {
     tinyxml2::XMLDocument doc;
     xml::load(doc, path);
     const XMLElement& root = xml::root(doc, path, "machine");
+    xml::allowAttributes(root, path, {"name", "description"});
+    for (const XMLElement* c = root.FirstChildElement(); c; c = c->NextSiblingElement()) {
+        const std::string n = c->Name();
+        if (n != "workpiece" && n != "tool" && n != "deviations") xml::unknownElement(*c, path, {"workpiece", "tool", "deviations"});
+        if (c->NextSiblingElement(c->Name())) xml::fail(*c->NextSiblingElement(c->Name()), path, fmt::format("a machine has one <{}>", n));
+    }
     MachineModel m;
     m.sourceFile = path;
     m.name = xml::text(root, path, "name");
     m.description = xml::textOr(root, "description", "");
-    readChain(root.FirstChildElement("workpiece"), path, m.workpiece);
+    std::map<std::string, int> lines;  // link name → line, for messages after finalize()
+    readChain(root.FirstChildElement("workpiece"), path, m.workpiece, lines);
     const XMLElement* tool = root.FirstChildElement("tool");
     if (!tool) xml::fail(root, path, "missing <tool> chain");
-    readChain(tool, path, m.tool);
+    readChain(tool, path, m.tool, lines);
     const Vec3 td = xml::vec3(*tool, path, "direction", -Vec3::UnitZ());
     if (td.norm() < 1e-12) xml::fail(*tool, path, "tool direction must not be zero");
     m.toolDirection = td.normalized();
 
     if (const XMLElement* devs = root.FirstChildElement("deviations")) {
+        xml::allowAttributes(*devs, path, {});
         for (const XMLElement* e = devs->FirstChildElement(); e; e = e->NextSiblingElement()) {
             DeviationDef d;
             const std::string kind = e->Name();
             if (kind == "location") d.kind = DeviationKind::Location;
             else if (kind == "component") d.kind = DeviationKind::Component;
-            else xml::fail(*e, path, "expected <location> or <component>");
+            else xml::unknownElement(*e, path, {"location", "component"});
+            if (d.kind == DeviationKind::Location)
+                xml::allowAttributes(*e, path, {"name", "alias", "alias-sign", "description", "link", "component"});
+            else
+                xml::allowAttributes(*e, path, {"name", "alias", "alias-sign", "description", "link", "component", "basis",
+                                                "order", "nodes"});
             d.name = xml::text(*e, path, "name");
             d.alias = xml::textOr(*e, "alias", "");
             const std::string sign = xml::textOr(*e, "alias-sign", "+1");
@@ -147,6 +169,25 @@ MachineModel readMachineXml(const std::string& path) {
     } catch (const ModelError& ex) {
         throw InputError(path, root.GetLineNum(), ex.what());
     }
+    // X, Y and Z are the machine's three primary linear axes, at right angles (ISO 841:2001 §4.3: the right-handed
+    // rectangular system). Two of them (nearly) parallel is a typing mistake in `direction` or `rotation`; secondary
+    // axes (U, V, W, ... along X, Y, Z) may be parallel to them. Inclined axes exist (a lathe's Y at 60-75° to X),
+    // so only less than 10° apart is refused [G: the bound is ours].
+    for (int a = 0; a < m.axisCount(); ++a)
+        for (int b = 0; b < a; ++b) {
+            const auto primary = [&](int i) {
+                const std::string& n = m.axisNames[static_cast<size_t>(i)];
+                return m.axisLink(i).kind == AxisKind::Linear && (n == "X" || n == "Y" || n == "Z");
+            };
+            if (!primary(a) || !primary(b)) continue;
+            const double sine = m.nominalDirection(a).cross(m.nominalDirection(b)).norm();
+            if (sine < std::sin(10 * kDeg))
+                throw InputError(path, lines[m.axisNames[static_cast<size_t>(a)]],
+                                 fmt::format("axes {} and {} are parallel ({:.2f} deg apart in the bed frame); X, Y and Z "
+                                             "must move in three different directions (check direction and rotation)",
+                                             m.axisNames[static_cast<size_t>(b)], m.axisNames[static_cast<size_t>(a)],
+                                             std::asin(std::min(1.0, sine)) / kDeg));
+        }
     return m;
 }
 

@@ -154,6 +154,11 @@ std::string runName(const XMLElement& e, const std::string& path) {
 }
 
 BallbarRun readBallbarRun(const XMLElement& e, const std::string& path, bool absolute, const RunCapture& instrument) {
+    xml::allowAttributes(e, path, {"name", "test", "LB", "RB", "RC", "ZC", "start", "end", "step", "tool-ball-offset",
+                                   "work-ball-offset", "estimate-mounting", "head-axis", "table-axis", "feed", "feed-radius",
+                                   "overshoot", "directions", "angle-column", "time-column", "length-column", "pass-column",
+                                   "length-unit", "angle-unit", "time-unit", "decimal", "length", "drift"});
+    if (e.FirstChildElement()) xml::fail(*e.FirstChildElement(), path, fmt::format("<{}> takes no child elements", e.Name()));
     BallbarRun r;
     r.name = runName(e, path);
     const std::string test = xml::text(e, path, "test");
@@ -199,12 +204,16 @@ void readAxisChildren(const XMLElement& e, const std::string& path, bool sweeps,
         RotarySweep s;
         s.axis = xml::text(*c, path, "axis");
         if (n == "hold") {
+            xml::allowAttributes(*c, path, {"axis", "deg"});
             s.startDeg = s.endDeg = xml::number(*c, path, "deg");
         } else if (n == "sweep" && sweeps) {
+            xml::allowAttributes(*c, path, {"axis", "start", "end"});
             s.startDeg = xml::number(*c, path, "start");
             s.endDeg = xml::number(*c, path, "end");
+        } else if (sweeps) {
+            xml::unknownElement(*c, path, {"sweep", "hold"});
         } else {
-            xml::fail(*c, path, sweeps ? "expected <sweep> or <hold>" : "expected <hold>");
+            xml::unknownElement(*c, path, {"hold"});
         }
         for (const RotarySweep& o : out)
             if (o.axis == s.axis) xml::fail(*c, path, fmt::format("axis '{}' is given twice", s.axis));
@@ -219,6 +228,7 @@ int wholeNumber(const XMLElement& e, const std::string& path, const char* attr, 
 }
 
 RtestRun readRtestRun(const XMLElement& e, const std::string& path) {
+    xml::allowAttributes(e, path, {"name", "ball", "nest-length", "steps", "ball-offset", "estimate-ball"});
     RtestRun r;
     r.name = runName(e, path);
     if (!xml::has(e, "ball")) xml::fail(e, path, "missing attribute 'ball'");
@@ -237,6 +247,8 @@ RtestRun readRtestRun(const XMLElement& e, const std::string& path) {
 }
 
 Dbb5Run readDbb5Run(const XMLElement& e, const std::string& path) {
+    xml::allowAttributes(e, path, {"name", "kind", "LB", "tool-length", "ball", "start", "end", "step", "plane", "cone-tilt",
+                                   "tool-angle", "bar-angle", "setup", "axis", "direction"});
     Dbb5Run r;
     r.name = runName(e, path);
     const std::string kind = xml::text(e, path, "kind");
@@ -308,6 +320,7 @@ MeasurementPlan readPlanXml(const std::string& path) {
     tinyxml2::XMLDocument doc;
     xml::load(doc, path);
     const auto& root = xml::root(doc, path, "plan");
+    xml::allowAttributes(root, path, {"machine", "description"});
     MeasurementPlan plan;
     plan.machine = xml::textOr(root, "machine", "");
     plan.description = xml::textOr(root, "description", "");
@@ -323,6 +336,8 @@ MeasurementPlan readPlanXml(const std::string& path) {
     if (instrumentElement) {
         if (instrumentElement->NextSiblingElement("instrument"))
             xml::fail(*instrumentElement->NextSiblingElement("instrument"), path, "a plan has at most one <instrument>");
+        xml::allowAttributes(*instrumentElement, path, {"angle-column", "time-column", "length-column", "pass-column",
+                                                        "length-unit", "angle-unit", "time-unit", "decimal", "length", "drift"});
         readInstrument(*instrumentElement, path, instrument);
     }
     std::set<std::string> names;
@@ -343,7 +358,9 @@ MeasurementPlan readPlanXml(const std::string& path) {
             plan.dbb5Runs.push_back(readDbb5Run(*e, path));
             name = plan.dbb5Runs.back().name;
         } else {
-            xml::fail(*e, path, "expected <run>, <absolute-run>, <rtest> or <dbb5> (or one <instrument>)");
+            xml::fail(*e, path, fmt::format("expected <run>, <absolute-run>, <rtest> or <dbb5> (or one <instrument>); did you "
+                                            "mean <{}>?",
+                                            xml::nearestName(kind, {"run", "absolute-run", "rtest", "dbb5", "instrument"})));
         }
         if (!names.insert(name).second) xml::fail(*e, path, fmt::format("run name '{}' is used twice", name));
     }

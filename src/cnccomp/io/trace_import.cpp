@@ -10,16 +10,12 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp {
 namespace {
-
-struct Metadata {
-    std::string key, value;
-    int line = 0;
-};
 
 struct Row {
     int line = 0;
@@ -28,81 +24,16 @@ struct Row {
     std::string pass;             ///< pass label ("" without a pass column)
 };
 
-struct Table {
-    std::vector<Metadata> metadata;
-    std::vector<std::string> header;
-    int headerLine = 0;
-    char separator = ',';
-    std::vector<std::pair<int, std::vector<std::string>>> rows;  ///< line, cells
-};
-
 std::string lower(std::string s) {
     for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
 }
 
-std::vector<std::string> splitCells(std::string_view line, char sep) {
-    std::vector<std::string> out;
-    size_t start = 0;
-    while (true) {
-        const size_t at = line.find(sep, start);
-        std::string cell(trim(line.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start)));
-        if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') cell = std::string(trim(cell.substr(1, cell.size() - 2)));
-        out.push_back(std::move(cell));
-        if (at == std::string_view::npos) break;
-        start = at + 1;
-    }
-    return out;
-}
-
-Table readTable(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, 0, "cannot open file");
-    std::ostringstream buf;
-    buf << in.rdbuf();
-    std::string text = buf.str();
-    if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
-        throw InputError(path, 1, "UTF-16 text; export the trace as UTF-8 (or ASCII) CSV");
-    if (text.rfind("\xef\xbb\xbf", 0) == 0) text.erase(0, 3);  // UTF-8 byte-order mark
-    Table t;
-    std::istringstream lines(text);
-    std::string line;
-    int n = 0;
-    bool haveHeader = false;
-    while (std::getline(lines, line)) {
-        ++n;
-        if (line.find('\0') != std::string::npos) throw InputError(path, n, "binary data where CSV text was expected");
-        const std::string_view s = trim(line);
-        if (s.empty()) continue;
-        if (s.front() == '#') {
-            const std::string_view body = trim(s.substr(1));
-            const size_t colon = body.find(':');
-            if (colon != std::string_view::npos && colon > 0)
-                t.metadata.push_back({std::string(trim(body.substr(0, colon))), std::string(trim(body.substr(colon + 1))), n});
-            continue;
-        }
-        if (!haveHeader) {
-            t.separator = s.find(';') != std::string_view::npos ? ';' : s.find('\t') != std::string_view::npos ? '\t' : ',';
-            t.header = splitCells(s, t.separator);
-            t.headerLine = n;
-            haveHeader = true;
-            continue;
-        }
-        auto cells = splitCells(s, t.separator);
-        if (cells.size() > t.header.size())
-            throw InputError(path, n, fmt::format("{} cells, but the header has {} columns (separator '{}')", cells.size(),
-                                                  t.header.size(), t.separator == '\t' ? "tab" : std::string(1, t.separator)));
-        t.rows.emplace_back(n, std::move(cells));
-    }
-    if (!haveHeader) throw InputError(path, n, "empty file; expected a CSV header line");
-    return t;
-}
-
-int findColumn(const Table& t, const std::string& name) {
-    for (size_t i = 0; i < t.header.size(); ++i)
-        if (t.header[i] == name) return static_cast<int>(i);
-    for (size_t i = 0; i < t.header.size(); ++i)
-        if (lower(t.header[i]) == lower(name)) return static_cast<int>(i);
+int findColumn(const CsvRow& header, const std::string& name) {
+    for (size_t i = 0; i < header.cells.size(); ++i)
+        if (header.cells[i] == name) return static_cast<int>(i);
+    for (size_t i = 0; i < header.cells.size(); ++i)
+        if (lower(header.cells[i]) == lower(name)) return static_cast<int>(i);
     return -1;
 }
 
@@ -134,11 +65,31 @@ struct Pass {
     std::vector<Row> rows;
 };
 
+constexpr double kUmInMm = 1e-3;
+/// Spans below this (mm) are numerically zero (a run no deviation of a simulated truth shows).
+constexpr double kNumericalZero = 1e-8;
+/// A span this many times the other runs' (or less) is taken for a unit mistake.
+constexpr double kUnitRatio = 200.0;
+/// The largest |ΔL| a ball bar records: ±1 mm (Renishaw QC20-W measuring range [G]) or 1% of a long bar's length.
+double maxBallbarTravel(double barLength) { return std::max(1.0, 0.01 * barLength); }
+
+double peakToPeak(const std::vector<double>& v) {
+    if (v.empty()) return 0.0;
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    return *hi - *lo;
+}
+
+std::string lengthUnitText(double unit) {
+    return unit == 1.0 ? "mm" : unit == 1e-3 ? "um" : unit == 1e-6 ? "nm" : unit == 25.4 ? "in" : fmt::format("{:g} mm", unit);
+}
+
 bool near(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(1.0, std::abs(b)); }
 
-void checkMetadata(const std::string& path, const Table& t, const BallbarRun& run, const std::string& machine,
-                   TraceImportSummary& summary) {
-    for (const Metadata& m : t.metadata) {
+/// Checks the `# key: value` comments from index `from` on.
+void checkMetadata(const std::string& path, const std::vector<CsvComment>& comments, size_t from, const BallbarRun& run,
+                   const std::string& machine, TraceImportSummary& summary) {
+    for (size_t i = from; i < comments.size(); ++i) {
+        const CsvComment& m = comments[i];
         const std::string key = lower(m.key);
         const auto mismatch = [&](const std::string& planned) {
             throw InputError(path, m.line, fmt::format("the file says {} '{}', but run '{}' of the plan has {}: this file "
@@ -221,32 +172,39 @@ double linearPathRadius(const BallbarRun& r) {
 namespace {
 
 MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const RunCapture& cap, const std::string& machine) {
-    const Table t = readTable(path);
+    CsvReader reader(path);
+    const CsvRow& header = reader.header();
+    const int headerLine = header.line;
+    const char separator = reader.separator();
     MeasuredTrace out;
     out.path = path;
     TraceImportSummary& sum = out.summary;
-    if (run) checkMetadata(path, t, *run, machine, sum);
+    if (run) checkMetadata(path, reader.comments(), 0, *run, machine, sum);
+    const size_t commentsChecked = reader.comments().size();
 
-    const int cL = findColumn(t, cap.lengthColumn);
+    const int cL = findColumn(header, cap.lengthColumn);
     if (cL < 0)
-        throw InputError(path, t.headerLine, fmt::format("missing column '{}' (ΔL) in the header", cap.lengthColumn));
-    int cX = findColumn(t, cap.angleColumn);
+        throw InputError(path, headerLine, fmt::format("missing column '{}' (ΔL) in the header", cap.lengthColumn));
+    int cX = findColumn(header, cap.angleColumn);
     const bool timeSampled = cX < 0;
-    if (timeSampled) cX = findColumn(t, cap.timeColumn);
+    if (timeSampled) cX = findColumn(header, cap.timeColumn);
     if (cX < 0)
-        throw InputError(path, t.headerLine, fmt::format("missing column '{}' (angle) or '{}' (time) in the header",
-                                                         cap.angleColumn, cap.timeColumn));
-    const int cP = findColumn(t, cap.passColumn);
+        throw InputError(path, headerLine, fmt::format("missing column '{}' (angle) or '{}' (time) in the header (found {} "
+                                                       "column(s) separated by '{}')",
+                                                       cap.angleColumn, cap.timeColumn, header.cells.size(),
+                                                       separatorName(separator)));
+    const int cP = findColumn(header, cap.passColumn);
+    const std::string nameX = header.cells[cX], nameL = header.cells[cL], nameP = cP >= 0 ? header.cells[cP] : "";
     sum.layout = timeSampled ? "time" : "angle";
     const double xUnit = timeSampled ? cap.timeUnit : cap.angleUnit;
 
-    // Rows → passes.
+    // Rows → samples, one row at a time (a large file streams).
     std::vector<Row> rows;
-    for (const auto& row : t.rows) {
-        // Not a structured binding: clang 14 (the fuzz targets' compiler) cannot capture one in the lambda below.
-        const int line = row.first;
-        const std::vector<std::string>& cells = row.second;
+    CsvRow csvRow;
+    while (reader.next(csvRow)) {
         ++sum.rows;
+        const int line = csvRow.line;
+        const auto& cells = csvRow.cells;
         const auto cell = [&](int c) -> const std::string& {
             static const std::string empty;
             return c < static_cast<int>(cells.size()) ? cells[c] : empty;
@@ -257,15 +215,37 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         }
         Row r;
         r.line = line;
-        r.x = parseCell(path, line, t.header[cX], cell(cX), t.separator, cap.decimal) * xUnit;
-        r.dL = parseCell(path, line, t.header[cL], cell(cL), t.separator, cap.decimal) * cap.lengthUnit;
+        r.x = parseCell(path, line, nameX, cell(cX), separator, cap.decimal) * xUnit;
+        r.dL = parseCell(path, line, nameL, cell(cL), separator, cap.decimal) * cap.lengthUnit;
         if (cP >= 0) {
             r.pass = cell(cP);
-            if (r.pass.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", t.header[cP]));
+            if (r.pass.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", nameP));
         }
         rows.push_back(std::move(r));
     }
-    if (rows.empty()) throw InputError(path, t.headerLine, "no samples: every row lacks a value");
+    if (run) checkMetadata(path, reader.comments(), commentsChecked, *run, machine, sum);
+    if (rows.empty()) throw InputError(path, headerLine, "no samples: every row lacks a value");
+    if (run) {
+        // Against the bar length: a ball bar records at most ±1 mm (or 1% of a long bar); more is a unit mistake
+        // (a µm export read under length-unit="mm").
+        double lo = HUGE_VAL, hi = -HUGE_VAL;
+        const Row* worst = &rows.front();
+        for (const Row& r : rows) {
+            lo = std::min(lo, *r.dL);
+            hi = std::max(hi, *r.dL);
+            if (std::abs(*r.dL) > std::abs(*worst->dL)) worst = &r;
+        }
+        const double size = cap.relativeLength ? hi - lo : std::abs(*worst->dL);
+        const double limit = maxBallbarTravel(run->LB);
+        if (size > limit)
+            throw InputError(path, worst->line,
+                             fmt::format("ΔL {} {:.4g} mm, more than a ball bar of {:g} mm records (±{:g} mm): the file is "
+                                         "likely in {} while the plan reads it in {} (length-unit of <instrument> or of run "
+                                         "'{}')",
+                                         cap.relativeLength ? "spans" : "reaches", size, run->LB, limit,
+                                         cap.lengthUnit == 1.0 ? "um" : cap.lengthUnit == 1e-3 ? "nm" : "a smaller unit",
+                                         lengthUnitText(cap.lengthUnit), run->name));
+    }
 
     const std::vector<int> planned = run && !run->capture.passes.empty() ? run->capture.passes
                                      : std::vector<int>{run && run->stepDeg < 0 ? -1 : +1};
@@ -321,7 +301,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         for (size_t i = 0; i < passes.size(); ++i) passes[i].direction = planned[std::min(i, planned.size() - 1)];
     }
     if (run && passes.size() != planned.size())
-        throw InputError(path, passes.size() > planned.size() ? passes[planned.size()].rows.front().line : t.headerLine,
+        throw InputError(path, passes.size() > planned.size() ? passes[planned.size()].rows.front().line : headerLine,
                          fmt::format("the file has {} pass(es), but run '{}' of the plan records {} ({})", passes.size(),
                                      run->name, planned.size(), planned.size() == 2 ? "a CCW and a CW pass" : "one pass"));
     for (size_t i = 0; i < passes.size() && run; ++i)
@@ -340,14 +320,14 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         Pass& ps = passes[p];
         for (const Row& r : ps.rows) tau[p].push_back(timeSampled ? r.x : static_cast<double>(r.line));
         if (!timeSampled) continue;
-        if (!run) throw InputError(path, t.headerLine, "a time-sampled file needs its run (feed, radius, start angle)");
+        if (!run) throw InputError(path, headerLine, "a time-sampled file needs its run (feed, radius, start angle)");
         if (!(run->capture.feed > 0))
-            throw InputError(path, t.headerLine,
+            throw InputError(path, headerLine,
                              fmt::format("time-sampled file: run '{}' of the plan needs feed=\"F\" (mm/min) to turn time "
                                          "into angle", run->name));
         const double radius = run->capture.feedRadius > 0 ? run->capture.feedRadius : linearPathRadius(*run);
         if (!(radius > 0))
-            throw InputError(path, t.headerLine, fmt::format("run '{}': the feed radius is 0; give feed-radius in the plan", run->name));
+            throw InputError(path, headerLine, fmt::format("run '{}': the feed radius is 0; give feed-radius in the plan", run->name));
         const double omegaDeg = run->capture.feed / 60.0 / radius * 180.0 / M_PI;  // deg/s
         const double a0 = (ps.direction > 0 ? lo : hi) - ps.direction * run->capture.overshootDeg;
         const double t0 = ps.rows.front().x;
@@ -405,11 +385,11 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
             sampleAt(ang[0], val[0], tau[0], s, v1, t1);
             sampleAt(ang[0], val[0], tau[0], e, v2, t2);
         } else {
-            throw InputError(path, t.headerLine, fmt::format("drift removal needs a full turn or a CCW and a CW pass; run "
+            throw InputError(path, headerLine, fmt::format("drift removal needs a full turn or a CCW and a CW pass; run "
                                                              "'{}' sweeps {:g}° in one pass", run->name, hi - lo));
         }
         if (!(t2 > t1 + 1e-12))
-            throw InputError(path, t.headerLine, "drift removal: the samples at the sweep's ends are not apart in time");
+            throw InputError(path, headerLine, "drift removal: the samples at the sweep's ends are not apart in time");
         const double rate = (v2 - v1) / (t2 - t1);
         const double tFirst = tau[0].front();
         double tLast = tFirst;
@@ -470,7 +450,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         }
         const size_t minimum = run ? 5 : 3;
         if (kept.size() < minimum)
-            throw InputError(path, kept.empty() ? t.headerLine : kept.back().line,
+            throw InputError(path, kept.empty() ? headerLine : kept.back().line,
                              fmt::format("{} sample(s){}; at least {} are needed to fit the trace", kept.size(), which,
                                          minimum));
         DirectedTrace dt;
@@ -497,6 +477,32 @@ std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::ve
     std::vector<MeasuredTrace> out;
     out.reserve(runs.size());
     for (const BallbarRun& r : runs) out.push_back(importRunTrace(OutputSet::fileIn(dir, r.name + ".csv"), r, machine));
+    // Against the other runs: one file in another unit than the plan says (an mm export under a dL_um header) spans
+    // 1000x less (or more) than the rest. Runs of one machine differ by a few times, not by hundreds.
+    if (out.size() >= 3) {
+        std::vector<double> spans;
+        for (const MeasuredTrace& t : out) spans.push_back(peakToPeak(t.trace.dL));
+        for (size_t i = 0; i < out.size(); ++i) {
+            std::vector<double> others;
+            for (size_t k = 0; k < out.size(); ++k)
+                if (k != i && spans[k] > kNumericalZero) others.push_back(spans[k]);
+            if (others.size() < 2 || !(spans[i] > kNumericalZero)) continue;
+            std::nth_element(others.begin(), others.begin() + static_cast<long>(others.size() / 2), others.end());
+            const double median = others[others.size() / 2];
+            const double ratio = spans[i] / median;
+            if (ratio > 1.0 / kUnitRatio && ratio < kUnitRatio) continue;
+            const double unit = runs[i].capture.lengthUnit;
+            const bool small = ratio < 1;
+            const std::string likely = small ? (unit == 1e-3 ? "mm" : unit == 1e-6 ? "um" : "a larger unit")
+                                             : (unit == 1.0 ? "um" : unit == 1e-3 ? "nm" : "a smaller unit");
+            throw InputError(out[i].path, 0,
+                             fmt::format("ΔL spans {:.4g} um, {:.0f} times {} than the median of the other runs ({:.4g} um): "
+                                         "this file is likely in {} while the plan reads it in {} (length-unit of "
+                                         "<instrument> or of run '{}')",
+                                         spans[i] / kUmInMm, small ? 1 / ratio : ratio, small ? "less" : "more",
+                                         median / kUmInMm, likely, lengthUnitText(unit), runs[i].name));
+        }
+    }
     return out;
 }
 

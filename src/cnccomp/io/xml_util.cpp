@@ -1,16 +1,23 @@
 #include "cnccomp/io/xml_util.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <sstream>
 
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp::xml {
 
 void load(tinyxml2::XMLDocument& doc, const std::string& path) {
+    requireRegularFile(path);  // a folder or a FIFO is named, never opened
     const tinyxml2::XMLError err = doc.LoadFile(path.c_str());
     if (err == tinyxml2::XML_ERROR_FILE_NOT_FOUND || err == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
         throw InputError(path, 0, "cannot open file");
@@ -28,6 +35,56 @@ const tinyxml2::XMLElement& root(const tinyxml2::XMLDocument& doc, const std::st
 
 void fail(const tinyxml2::XMLElement& e, const std::string& path, const std::string& message) {
     throw InputError(path, e.GetLineNum(), fmt::format("<{}>: {}", e.Name(), message));
+}
+
+std::string nearestName(std::string_view word, std::initializer_list<const char*> known) {
+    const auto low = [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); };
+    std::string best;
+    size_t bestDistance = SIZE_MAX;
+    for (const char* k : known) {
+        const std::string_view b(k);
+        std::vector<size_t> row(b.size() + 1);
+        for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+        for (size_t i = 1; i <= word.size(); ++i) {
+            size_t diagonal = row[0];
+            row[0] = i;
+            for (size_t j = 1; j <= b.size(); ++j) {
+                const size_t up = row[j];
+                row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (low(word[i - 1]) == low(b[j - 1]) ? 0 : 1)});
+                diagonal = up;
+            }
+        }
+        if (row[b.size()] < bestDistance) {
+            bestDistance = row[b.size()];
+            best = k;
+        }
+    }
+    return best;
+}
+
+namespace {
+std::string listOf(std::initializer_list<const char*> known) {
+    std::string s;
+    for (const char* k : known) s += (s.empty() ? "" : ", ") + std::string(k);
+    return s;
+}
+}  // namespace
+
+void allowAttributes(const tinyxml2::XMLElement& e, const std::string& path, std::initializer_list<const char*> known) {
+    for (const tinyxml2::XMLAttribute* a = e.FirstAttribute(); a; a = a->Next()) {
+        const std::string_view name = a->Name();
+        bool ok = false;
+        for (const char* k : known) ok = ok || name == k;
+        if (ok) continue;
+        if (known.size() == 0) fail(e, path, fmt::format("unknown attribute '{}'; this element takes none", name));
+        fail(e, path, fmt::format("unknown attribute '{}'; did you mean '{}'? (known: {})", name, nearestName(name, known),
+                                  listOf(known)));
+    }
+}
+
+void unknownElement(const tinyxml2::XMLElement& e, const std::string& path, std::initializer_list<const char*> known) {
+    throw InputError(path, e.GetLineNum(), fmt::format("unknown element <{}>; did you mean <{}>? (expected here: {})", e.Name(),
+                                                       nearestName(e.Name(), known), listOf(known)));
 }
 
 bool has(const tinyxml2::XMLElement& e, const char* attr) { return e.Attribute(attr) != nullptr; }

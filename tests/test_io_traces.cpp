@@ -1,0 +1,98 @@
+// Measured traces in the wrong unit (issue 18): an mm export under a dL_um header, or µm data under
+// length-unit="mm", is refused naming the likely unit; a large file streams.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/trace_import.hpp"
+#include "test_support.hpp"
+
+namespace cnccomp {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");
+const std::string kPlan = test::sourcePath("samples/plans/multitasking-six-circles.xml");
+const std::string kTruth = test::sourcePath("samples/deviations/multitasking-truth.csv");
+
+std::string simulateInto(const test::ScratchDir& dir) {
+    const std::string traces = dir.file("traces");
+    const auto r = test::runCli("simulate --machine " + kMachine + " --plan " + kPlan + " --deviations " + kTruth + " --out " + traces);
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return traces;
+}
+
+/// Rewrites the ΔL column (the last) of a cnccomp trace file, value ↦ value·factor.
+void scaleTrace(const std::string& path, double factor) {
+    std::ifstream in(path);
+    std::string line, out;
+    bool header = false;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#' || !header) {
+            header = header || (!line.empty() && line[0] != '#');
+            out += line + "\n";
+            continue;
+        }
+        const size_t comma = line.rfind(',');
+        out += line.substr(0, comma + 1) + fmt::format("{:.9g}", std::stod(line.substr(comma + 1)) * factor) + "\n";
+    }
+    test::writeText(path, out);
+}
+
+template <typename F>
+std::string inputErrorOf(F&& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no InputError)";
+}
+
+// One mm export among µm files (issue 18: identify gave EX0C1 5.34 µm for 12): refused, the file and "mm" named.
+TEST(TraceUnits, OneFileInMillimetresAmongMicrometresIsRefused) {
+    test::ScratchDir dir("io-traces-mm");
+    const std::string traces = simulateInto(dir);
+    const MeasurementPlan plan = readPlanXml(kPlan);
+    ASSERT_NO_THROW(importRunTraces(traces, plan.runs));
+    scaleTrace(traces + "/C-radial.csv", 1e-3);
+    const std::string e = inputErrorOf([&] { importRunTraces(traces, plan.runs); });
+    EXPECT_NE(e.find("C-radial.csv"), std::string::npos) << e;
+    EXPECT_NE(e.find("likely in mm"), std::string::npos) << e;
+    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
+                                dir.file("d.csv"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("likely in mm"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir.file("d.csv")));
+}
+
+// µm data read under length-unit="mm": ΔL of millimetres, beyond any ball bar's travel; refused naming µm.
+TEST(TraceUnits, MicrometreDataUnderMillimetreUnitIsRefused) {
+    test::ScratchDir dir("io-traces-um");
+    const std::string traces = simulateInto(dir);
+    MeasurementPlan plan = readPlanXml(kPlan);
+    for (BallbarRun& r : plan.runs) r.capture.lengthUnit = 1.0;
+    const std::string e = inputErrorOf([&] { importRunTraces(traces, plan.runs); });
+    EXPECT_NE(e.find("B-X.csv:"), std::string::npos) << e;
+    EXPECT_NE(e.find("likely in um"), std::string::npos) << e;
+    EXPECT_NE(e.find("±1 mm"), std::string::npos) << e;
+}
+
+// A folder standing where a trace belongs is named as a folder (issue 18 called it an "empty file").
+TEST(TraceUnits, AFolderNamedLikeATraceIsNamed) {
+    test::ScratchDir dir("io-traces-folder");
+    const std::string traces = simulateInto(dir);
+    fs::remove(traces + "/B-X.csv");
+    fs::create_directories(traces + "/B-X.csv");
+    const std::string e = inputErrorOf([&] { importRunTraces(traces, readPlanXml(kPlan).runs); });
+    EXPECT_NE(e.find("B-X.csv: is a folder, not a file"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace cnccomp
