@@ -455,10 +455,12 @@ LinearCircleFit identifyLinearCircle(const LinearCircle& circle, const std::vect
         Eigen::VectorXd z = Eigen::VectorXd::Zero(rank);
         for (int i = 0; i < s.rank; ++i) z += s.V.col(i) * (s.projected[i] / s.singular[i]);
         const Eigen::VectorXd dx = -(scale.asDiagonal() * (B * z));  // r = meas − pred, J = ∂r/∂x
+        // Converged when the Gauss–Newton step is below 1e-9 of the point (scaled units, B orthonormal).
+        if (z.norm() <= 1e-9 * (scale.cwiseInverse().asDiagonal() * x).norm() + 1e-12) break;
         double lambda = 1;
         bool accepted = false;
         Eigen::VectorXd xn, rn;
-        for (int h = 0; h < 20; ++h, lambda /= 2) {
+        for (int h = 0; h < 8; ++h, lambda /= 2) {
             xn = x + lambda * dx;
             evaluate(xn, rn, nullptr);
             if (rn.squaredNorm() <= cost) {
