@@ -179,8 +179,10 @@ struct LinearCircleFit {
 LinearCircleFit identifyLinearCircle(const LinearCircle& circle, const std::vector<LinearCirclePass>& passes,
                                      const LinearCircleSettings& settings = {});
 
-/// Checks a pass against its stated arc (directions, finiteness, monotone angles, coverage within one sample
-/// spacing or 1°, no gap over 10°); throws ModelError naming the pass and what was expected. `index`: 0-based.
+/// Checks a pass against its stated arc: direction ±1, feed > 0, sweep in (0, 720]°, one ΔL per angle, ≥ 8 samples,
+/// finite values, angles monotone in the pass direction (wrapped angles are unwrapped), first and last sample within
+/// max(1°, 1.5 sample spacings) of the arc's ends, no gap over max(10°, 3 spacings). Throws ModelError naming the
+/// pass (1-based) and what was expected. `index`: 0-based.
 void checkLinearCirclePass(const LinearCirclePass& pass, int index);
 
 }  // namespace cnccomp
