@@ -548,8 +548,10 @@ TEST(ControllerLinuxcnc, TestProgramsRunInJointModeWhereTheTrtPinsDoNothing) {
     // 2. Joint mode: the drives get the program words plus the table trims, whatever the pins and G54 say. Oracle:
     // the files' own tables read independently (parseCompTable), and the folder with the pins set to their nominal
     // values (the "tables only" run of the review) gives the same prediction.
-    const auto emit = test::runCli("emit --controller linuxcnc-pins --machine " + mfile + " --deviations " + truth + " --out " +
-                                   dir.file("pins") + " --date 2024-01-01");
+    // The identified values copied (--copy-identified): fitted to the joint mode these programs run in, the pins would
+    // be left at their nominal values (they act in tool-tip mode only), and this test is about what they do there.
+    const auto emit = test::runCli("emit --controller linuxcnc-pins --copy-identified --machine " + mfile + " --deviations " +
+                                   truth + " --out " + dir.file("pins") + " --date 2024-01-01");
     ASSERT_EQ(emit.exitCode, 0) << emit.out;
     const MachineModel m = readMachineXml(mfile);
     std::filesystem::copy(dir.file("pins"), dir.file("tables"));

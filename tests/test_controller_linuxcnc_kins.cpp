@@ -222,6 +222,7 @@ void checkMachine(const Sample& s, int poses, Figures& fig) {
                 AxisVector cc(n), p;
                 for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
                 tcp.toProgram(cc, L, p);
+                p[m.requireAxis("Z")] += L;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                 for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
                 target = toolPose(nominal, q, tipInTool);  // the nominal machine at those joints
             }
@@ -390,6 +391,7 @@ TEST(LinuxcncKinsComponent, SingularPoseOfTheMultitaskingMachine) {
                 AxisVector cc(m.axisCount()), p;
                 for (int i = 0; i < m.axisCount(); ++i) cc[i] = cj[i] * unitOf(m, i);
                 tcp.toProgram(cc, L, p);
+                p[m.requireAxis("Z")] += L;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                 for (int i = 0; i < m.axisCount(); ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
             }
             std::vector<double> j = cj;
@@ -438,10 +440,12 @@ TEST(LinuxcncKinsComponent, SolvesFromFarAwayJoints) {
                 CPose world{};
                 AxisVector cc(n), p;
                 for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
-                if (mode == 0)
+                if (mode == 0) {
                     p = cc;
-                else
+                } else {
                     tcp.toProgram(cc, L, p);
+                    p[m.requireAxis("Z")] += L;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
+                }
                 for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
                 if (k.inverse(&world, joints.data(), nullptr, nullptr) != 0) {
                     ++failures;
@@ -546,6 +550,7 @@ TEST(LinuxcncKinsComponent, InverseCostPerCall) {
                     AxisVector cc(n), p;
                     for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
                     tcp.toProgram(cc, 80.0, p);
+                    p[m.requireAxis("Z")] += 80.0;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                     for (int i = 0; i < n; ++i) slot(words[t], m.axisNames[i]) = p[i] / unitOf(m, i);
                 }
             }

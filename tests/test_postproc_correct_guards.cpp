@@ -35,8 +35,11 @@ std::string testProgram(const test::ScratchDir& dir, const std::string& run) {
                                     dir.file("tp"));
         EXPECT_EQ(r.exitCode, 0) << r.out;
     }
+    // File names are TP<nn>_<run>.ngc with '-' written as '_' (postproc/testprog).
+    std::string key = run;
+    std::replace(key.begin(), key.end(), '-', '_');
     for (const auto& e : fs::directory_iterator(dir.file("tp")))
-        if (e.path().filename().string().find(run) != std::string::npos) return e.path().string();
+        if (e.path().filename().string().find(key) != std::string::npos) return e.path().string();
     ADD_FAILURE() << "no program for " << run;
     return {};
 }
@@ -121,29 +124,34 @@ TEST(PostprocCorrectGuards, RotaryProgramWithoutAnyToolLengthIsRefusedUnlessZero
 }
 
 TEST(PostprocCorrectGuards, CorrectionThatDoesNotConvergeWritesNothingUnlessKeepPartial) {
-    // An absurd deviation set: the sample truth × 20000 (mm offsets, degrees of tilt). The first blocks of the sample
-    // 5-axis program do not converge (tip residuals of um to km) and split to the subdivision limit.
+    // A correction that cannot meet its goal: the sample truth x 395 (mm offsets, up to 0.99 deg of tilt: still inside
+    // the range the deviation reader accepts, src/cnccomp/io/deviation_range.hpp) and a tolerance of 1e-5 um with nine
+    // decimals (so the tolerance is not raised to the digits): the moves of the sample 5-axis program split to the
+    // subdivision limit without meeting it. (The first version of this test used the truth x 20000, which the reader now
+    // refuses as beyond any machine.)
     test::ScratchDir dir("pp-guard-converge");
     const std::string truth = test::readText(kTruth);
     std::istringstream rows(truth);
     std::string line, absurd;
-    std::getline(rows, line);
-    absurd = line + "\n";
     while (std::getline(rows, line)) {
+        if (line.empty() || line[0] == '#' || line.rfind("name,", 0) == 0) {
+            absurd += line + "\n";
+            continue;
+        }
         std::vector<std::string> c;
         std::stringstream cells(line);
         for (std::string cell; std::getline(cells, cell, ',');) c.push_back(cell);
         ASSERT_EQ(c.size(), 5u) << line;
-        absurd += fmt::format("{},{},{},{},{}\n", c[0], c[1], std::stod(c[2]) * 20000, c[3], std::stod(c[4]) * 20000);
+        absurd += fmt::format("{},{},{},{},{}\n", c[0], c[1], std::stod(c[2]) * 395, c[3], std::stod(c[4]) * 395);
     }
     test::writeText(dir.file("absurd.csv"), absurd);
     std::string program;
     std::istringstream sample(test::readText(test::sourcePath("samples/gcode/multitasking-5axis.ngc")));
-    for (int k = 0; k < 16 && std::getline(sample, line); ++k) program += line + "\n";
+    for (int k = 0; k < 20 && std::getline(sample, line); ++k) program += line + "\n";
     test::writeText(dir.file("p.ngc"), program + "M2\n");
     const std::string args = "correct --machine " + kMachine + " --deviations " + dir.file("absurd.csv") + " --in " +
-                             dir.file("p.ngc") + " --out " + dir.file("o.ngc") + " --tool-length H1=100 --report " +
-                             dir.file("r.csv");
+                             dir.file("p.ngc") + " --out " + dir.file("o.ngc") +
+                             " --tool-length H1=100 --tol-um 0.00001 --decimals 9 --report " + dir.file("r.csv");
     auto r = test::runCli(args);
     EXPECT_EQ(r.exitCode, 3) << r.out;
     EXPECT_NE(r.out.find("the correction did not converge"), std::string::npos) << r.out;

@@ -280,7 +280,7 @@ TEST(VerifyReport, AWorseCompensationShowsARedBannerAtTheTopOfThePage) {
     // Every value of the truth with the wrong sign: the compensation doubles the errors. The page opens with the red
     // banner (its text in the summary's alarms), whatever the gates; headless Chromium shows it at the top.
     test::ScratchDir dir("verify-report-worse");
-    std::string flipped = "name,alias,value,unit\n";
+    std::string flipped = "# cnccomp-deviations/2: location errors under ISO 230-1 names are ISO values (iso_names.hpp)\nname,alias,value,unit\n";
     for (const auto& [name, row] : test::deviationRowsAsWritten(kTruth))
         flipped += name + ",," + std::to_string(-row.value) + "," + row.unit + "\n";
     test::writeText(dir.file("flipped.csv"), flipped);

@@ -320,7 +320,7 @@ MeasurementPlan readPlanXml(const std::string& path) {
     tinyxml2::XMLDocument doc;
     xml::load(doc, path);
     const auto& root = xml::root(doc, path, "plan");
-    xml::allowAttributes(root, path, {"machine", "description"});
+    xml::allowAttributes(root, path, {"machine", "description", "noise-um"});
     MeasurementPlan plan;
     plan.machine = xml::textOr(root, "machine", "");
     plan.description = xml::textOr(root, "description", "");
