@@ -495,23 +495,8 @@ LinearCircleFit identifyLinearCircle(const LinearCircle& circle, const std::vect
     constexpr double kCoupled = 1e-6;
     std::vector<char> unidentified(n, 0);
     for (int j = 0; j < n; ++j) unidentified[j] = P(j, j) > kCoupled;
-    std::vector<int> group(n, -1);
     int groups = 0;
-    for (int j = 0; j < n; ++j) {
-        if (!unidentified[j] || group[j] >= 0) continue;
-        std::vector<int> stack{j};
-        group[j] = groups;
-        while (!stack.empty()) {
-            const int a = stack.back();
-            stack.pop_back();
-            for (int b = 0; b < n; ++b)
-                if (unidentified[b] && group[b] < 0 && std::abs(P(a, b)) > kCoupled) {
-                    group[b] = groups;
-                    stack.push_back(b);
-                }
-        }
-        ++groups;
-    }
+    const std::vector<int> group = coupledGroups(P, unidentified, kCoupled, groups);
     for (int gi = 0; gi < groups; ++gi) {
         std::vector<int> idx;
         std::vector<std::string> names;

@@ -49,6 +49,28 @@ double normalQuantile(double p) {
     return x - u / (1 + x * u / 2);
 }
 
+std::vector<int> coupledGroups(const Eigen::MatrixXd& P, const std::vector<char>& unidentified, double coupled, int& groups) {
+    const int n = static_cast<int>(P.rows());
+    std::vector<int> group(static_cast<size_t>(n), -1);
+    groups = 0;
+    for (int i = 0; i < n; ++i) {
+        if (!unidentified[static_cast<size_t>(i)] || group[static_cast<size_t>(i)] >= 0) continue;
+        std::vector<int> stack{i};
+        group[static_cast<size_t>(i)] = groups;
+        while (!stack.empty()) {
+            const int a = stack.back();
+            stack.pop_back();
+            for (int b = 0; b < n; ++b)
+                if (unidentified[static_cast<size_t>(b)] && group[static_cast<size_t>(b)] < 0 && std::abs(P(a, b)) > coupled) {
+                    group[static_cast<size_t>(b)] = groups;
+                    stack.push_back(b);
+                }
+        }
+        ++groups;
+    }
+    return group;
+}
+
 double studentTQuantile(double p, int dof) {
     const double z = normalQuantile(p);
     if (dof <= 0) return kNaN;
@@ -193,23 +215,8 @@ void analyzeSolution(const LsqProblem& p, const ObservableSubspace& sub, const E
     // Confounded groups: connected components of the coupling graph of P.
     rep.identifiable.clear();
     rep.unobservable.clear();
-    std::vector<int> group(n, -1);
     int groups = 0;
-    for (int i = 0; i < n; ++i) {
-        if (!unidentified[i] || group[i] >= 0) continue;
-        std::vector<int> stack{i};
-        group[i] = groups;
-        while (!stack.empty()) {
-            const int a = stack.back();
-            stack.pop_back();
-            for (int b = 0; b < n; ++b)
-                if (unidentified[b] && group[b] < 0 && std::abs(P(a, b)) > kCoupled) {
-                    group[b] = groups;
-                    stack.push_back(b);
-                }
-        }
-        ++groups;
-    }
+    const std::vector<int> group = coupledGroups(P, unidentified, kCoupled, groups);
     for (int g = 0; g < groups; ++g) {
         std::vector<int> idx;
         for (int i = 0; i < n; ++i)

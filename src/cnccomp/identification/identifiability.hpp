@@ -24,6 +24,11 @@ void analyzeSolution(const LsqProblem& problem, const ObservableSubspace& subspa
 
 /// Quantile of Student's t distribution (Cornish–Fisher expansion around the normal; exact enough for dof ≥ 3,
 /// normal quantile for large dof). p in (0, 1).
+/// Confounded groups: the connected components of the coupling graph of the null-space projector P among the
+/// unidentified parameters (a and b are coupled when |P(a, b)| > coupled). Returns each parameter's group index, −1 for
+/// the identified ones; `groups` receives the number of groups.
+std::vector<int> coupledGroups(const Eigen::MatrixXd& P, const std::vector<char>& unidentified, double coupled, int& groups);
+
 double studentTQuantile(double p, int dof);
 /// Quantile of the standard normal distribution (Acklam's rational approximation refined by one Newton step).
 double normalQuantile(double p);

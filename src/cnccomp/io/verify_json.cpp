@@ -12,9 +12,9 @@ namespace {
 
 std::string str(std::string_view s) { return jsonString(s); }
 
-std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
+std::string jsonNumber(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
 
-std::string um(double mm) { return num(mm / kUm); }
+std::string um(double mm) { return jsonNumber(mm / kUm); }
 
 template <class F>
 std::string list(size_t n, F item) {
@@ -30,23 +30,23 @@ std::string iso(const CircularTestResult& r) {
                        um(r.center.y()));
 }
 
-std::string vec(const Vec3& v) { return fmt::format("[{}, {}, {}]", um(v.x()), um(v.y()), um(v.z())); }
+std::string jsonVecUm(const Vec3& v) { return fmt::format("[{}, {}, {}]", um(v.x()), um(v.y()), um(v.z())); }
 
 std::string pass(const VerifyPass& p) {
     std::string o = fmt::format("{{\"direction\": {}, \"span_before_um\": {}, \"span_after_um\": {}, \"outside_travel\": {}, ",
                                 str(p.label), um(p.spanBefore), um(p.spanAfter), p.outsideTravel.empty() ? "null" : str(p.outsideTravel));
-    o += fmt::format("\"angle_deg\": {}, ", list(p.before.angleDeg.size(), [&](size_t i) { return num(p.before.angleDeg[i]); }));
+    o += fmt::format("\"angle_deg\": {}, ", list(p.before.angleDeg.size(), [&](size_t i) { return jsonNumber(p.before.angleDeg[i]); }));
     if (!p.displacementBefore.empty()) {
         o += fmt::format("\"displacement_before_um\": {}, ",
-                         list(p.displacementBefore.size(), [&](size_t i) { return vec(p.displacementBefore[i]); }));
-        o += fmt::format("\"displacement_after_um\": {}", list(p.displacementAfter.size(), [&](size_t i) { return vec(p.displacementAfter[i]); }));
+                         list(p.displacementBefore.size(), [&](size_t i) { return jsonVecUm(p.displacementBefore[i]); }));
+        o += fmt::format("\"displacement_after_um\": {}", list(p.displacementAfter.size(), [&](size_t i) { return jsonVecUm(p.displacementAfter[i]); }));
     } else {
         o += fmt::format("\"dL_before_um\": {}, ", list(p.before.dL.size(), [&](size_t i) { return um(p.before.dL[i]); }));
         o += fmt::format("\"dL_after_um\": {}", list(p.after.dL.size(), [&](size_t i) { return um(p.after.dL[i]); }));
     }
     if (p.circular)
         o += fmt::format(", \"iso_before\": {}, \"iso_after\": {}, \"eccentricity_before_um\": {}, \"eccentricity_after_um\": {}",
-                         iso(p.isoBefore), iso(p.isoAfter), vec(p.eccentricityBefore), vec(p.eccentricityAfter));
+                         iso(p.isoBefore), iso(p.isoAfter), jsonVecUm(p.eccentricityBefore), jsonVecUm(p.eccentricityAfter));
     return o + "}";
 }
 
@@ -72,13 +72,13 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
                      um(r.worse.spanAllowance), r.volumetric.available ? um(r.worse.volumetricAllowance) : "null",
                      r.worse.any() ? str(worseBanner(r)) : "null");
     o += fmt::format("  \"max_residual_um\": {},\n  \"max_volumetric_um\": {},\n  \"passed\": {},\n",
-                     gateUm ? num(*gateUm) : "null", volumetricGateUm ? num(*volumetricGateUm) : "null", passed ? "true" : "false");
+                     gateUm ? jsonNumber(*gateUm) : "null", volumetricGateUm ? jsonNumber(*volumetricGateUm) : "null", passed ? "true" : "false");
     o += "  \"runs\": [\n";
     for (size_t i = 0; i < r.runs.size(); ++i) {
         const VerifyRun& run = r.runs[i];
         o += fmt::format("    {{\"name\": {}, \"type\": {}, \"kind\": {}, \"program\": {}, \"LB_mm\": {}, \"span_before_um\": {}, "
                          "\"span_after_um\": {},\n     \"passes\": {}}}{}\n",
-                         str(run.name), str(run.type), str(testprog::runKindName(run.kind)), str(run.program), num(run.LB),
+                         str(run.name), str(run.type), str(testprog::runKindName(run.kind)), str(run.program), jsonNumber(run.LB),
                          um(run.spanBefore()), um(run.spanAfter()),
                          list(run.passes.size(), [&](size_t k) { return pass(run.passes[k]); }), i + 1 < r.runs.size() ? "," : "");
     }
@@ -88,16 +88,16 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
                      "\"max_before_um\": {}, \"rms_before_um\": {}, \"max_after_um\": {}, \"rms_after_um\": {}, "
                      "\"tilt_before_arcsec\": {}, \"tilt_after_arcsec\": {}}},\n",
                      v.available ? "true" : "false", str(v.note), v.points,
-                     list(v.toolLengths.size(), [&](size_t i) { return num(v.toolLengths[i]); }), um(v.maxBefore), um(v.rmsBefore),
-                     um(v.maxAfter), um(v.rmsAfter), num(v.tiltBefore / kArcsec), num(v.tiltAfter / kArcsec));
+                     list(v.toolLengths.size(), [&](size_t i) { return jsonNumber(v.toolLengths[i]); }), um(v.maxBefore), um(v.rmsBefore),
+                     um(v.maxAfter), um(v.rmsAfter), jsonNumber(v.tiltBefore / kArcsec), jsonNumber(v.tiltAfter / kArcsec));
     o += fmt::format("  \"remaining\": {}\n}}\n", list(r.remaining.size(), [&](size_t i) {
                          const VerifyRemaining& x = r.remaining[i];
                          // The ISO value under the ISO name, the alias' own value under the alias (VerifyRemaining).
                          return fmt::format("{{\"deviation\": {}, \"reason\": {}, \"iso_name\": {}, \"value\": {}, \"unit\": {}, "
                                             "\"alias\": {}, \"alias_value\": {}}}",
                                             str(x.deviation), str(x.reason), x.valueKnown ? str(x.isoName) : "null",
-                                            x.valueKnown ? num(x.value) : "null", x.valueKnown ? str(x.unit) : "null",
-                                            x.alias.empty() ? "null" : str(x.alias), x.alias.empty() ? "null" : num(x.aliasValue));
+                                            x.valueKnown ? jsonNumber(x.value) : "null", x.valueKnown ? str(x.unit) : "null",
+                                            x.alias.empty() ? "null" : str(x.alias), x.alias.empty() ? "null" : jsonNumber(x.aliasValue));
                      }));
     return o;
 }
