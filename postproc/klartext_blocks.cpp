@@ -372,6 +372,8 @@ void KlartextInterpreter::cycle(const std::vector<std::string>& rest) {
         unsupported("CYCL CALL: machining cycles are not evaluated by cnccomp's Klartext reader (their moves are not known)", 3);
     if (rest[0] != "DEF" || rest.size() < 2) fail("expected CYCL DEF <number>");
     const double id = number(rest[1], "cycle number");
+    // A cycle number beyond any cycle would overflow the int below (fuzz finding, ReaderFuzz_klartext).
+    if (!(id >= 0 && id < 100000)) fail("expected a cycle number from 0 to 99999");
     const int cycle = static_cast<int>(std::floor(id + 1e-9));
     const int sub = static_cast<int>(std::lround((id - cycle) * 10));
     if (cycle == 8 || cycle == 10 || cycle == 11 || cycle == 19 || cycle == 26 || cycle == 247) {

@@ -40,4 +40,16 @@ TEST(FuzzFindings, KlartextToolCallNumberOutOfRange) {
 }
 
 }  // namespace
+TEST(FuzzFindings, KlartextCycleNumberOutOfRange) {
+    // ReaderFuzz_klartext: "CYCL DEF 4.44444e+39" overflowed the int cycle number (UBSan float-cast-overflow).
+    for (const char* number : {"4444444444444444444444444444444444444444", "100000", "-7"}) {
+        std::istringstream in(std::string("0 BEGIN PGM C MM\n1 CYCL DEF ") + number + " DATUM SHIFT\n2 END PGM C MM\n");
+        std::ostringstream csv;
+        pp::PosesOptions o;
+        o.inputName = "fuzz.h";
+        expectInputError([&] { pp::writeKlartextPoses(pp::AxisLayout::generic(), in, csv, o); },
+                         {"fuzz.h:2", "cycle number from 0 to 99999"});
+    }
+}
+
 }  // namespace cnccomp
