@@ -109,19 +109,22 @@ void CsvReader::split(std::string_view line, std::vector<std::string>& cells) co
     cells.resize(used);
 }
 
+bool CsvReader::skipBlankOrComment(std::string_view s) {
+    if (s.empty()) return true;
+    if (s.front() != '#') return false;
+    const std::string_view body = trim(s.substr(1));
+    const size_t colon = body.find(':');
+    if (colon != std::string_view::npos && colon > 0)
+        comments_.push_back({std::string(trim(body.substr(0, colon))), std::string(trim(body.substr(colon + 1))), line_});
+    return true;
+}
+
 const CsvRow& CsvReader::header() {
     if (haveHeader_) return header_;
     std::string_view raw;
     while (nextLine(raw)) {
         const std::string_view s = trim(raw);
-        if (s.empty()) continue;
-        if (s.front() == '#') {
-            const std::string_view body = trim(s.substr(1));
-            const size_t colon = body.find(':');
-            if (colon != std::string_view::npos && colon > 0)
-                comments_.push_back({std::string(trim(body.substr(0, colon))), std::string(trim(body.substr(colon + 1))), line_});
-            continue;
-        }
+        if (skipBlankOrComment(s)) continue;
         // The separator: ';' or a tab outside quotes, else ','.
         bool inQuote = false, semicolon = false, tab = false;
         for (const char c : s) {
@@ -143,14 +146,7 @@ bool CsvReader::next(CsvRow& row) {
     std::string_view raw;
     while (nextLine(raw)) {
         const std::string_view s = trim(raw);
-        if (s.empty()) continue;
-        if (s.front() == '#') {
-            const std::string_view body = trim(s.substr(1));
-            const size_t colon = body.find(':');
-            if (colon != std::string_view::npos && colon > 0)
-                comments_.push_back({std::string(trim(body.substr(0, colon))), std::string(trim(body.substr(colon + 1))), line_});
-            continue;
-        }
+        if (skipBlankOrComment(s)) continue;
         row.line = line_;
         split(s, row.cells);
         if (row.cells.size() > header_.cells.size()) {

@@ -63,6 +63,8 @@ public:
 
 private:
     bool nextLine(std::string_view& out);
+    /// A blank or '#' line: true, and a `# key: value` comment kept with its line.
+    bool skipBlankOrComment(std::string_view s);
     void split(std::string_view line, std::vector<std::string>& cells) const;
 
     std::string path_;
