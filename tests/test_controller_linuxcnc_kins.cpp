@@ -174,11 +174,8 @@ AxisVector randomCommands(const MachineModel& m, std::mt19937& rng) {
 }
 
 IkOptions referenceOptions(const KinsComponentOptions& o) {
-    IkOptions ik;
+    IkOptions ik = controllers::linuxcnc::kinsSolverOptions(o);
     ik.tolerance = 1e-12;
-    ik.maxIterations = 40;
-    ik.axisWeight = o.axisWeight;
-    ik.rotaryRegularization = o.rotaryRegularization;
     return ik;
 }
 
@@ -322,8 +319,10 @@ TEST(LinuxcncKinsComponent, PinsCarryTheDeviationsAndFailureKeepsTheJoints) {
     while (names >> type >> name) EXPECT_TRUE(allowed.count(name)) << "the component calls " << name;
 }
 
-// Joint mode on a 5-axis machine matches the tool axis as well as the tip, so the joints do not depend on the tool
-// length (tool-offset); on the 4-axis head (X Y Z B) the axis cannot be matched and the tip at tool-offset is met.
+// Joint mode on a 5-axis machine matches the tool axis as well as the tip up to the rotary pull (the axis keeps
+// (rotaryRegularization/(axisWeight·sin))² of its error, sin = of the angle between the tool axis and a rotary axis),
+// so the joints depend on the tool length (tool-offset) only by that remainder times the length; on the 4-axis head
+// (X Y Z B) the axis cannot be matched and the tip at tool-offset is met.
 TEST(LinuxcncKinsComponent, JointModeIndependentOfToolLengthWhereTheAxisIsMatched) {
     for (const Sample& s : {kSamples[0], kSamples[5]}) {
         SCOPED_TRACE(s.machine);
@@ -354,7 +353,7 @@ TEST(LinuxcncKinsComponent, JointModeIndependentOfToolLengthWhereTheAxisIsMatche
                 spread = std::max(spread, std::abs(byLength[0][i] - byLength[1][i]));
         }
         if (m.axisCount() == 5)
-            EXPECT_LE(spread, 1e-9);
+            EXPECT_LE(spread, 1e-3);  // measured 5.7e-4 mm|deg at 150 mm (a remainder of 0.8 arcsec at a pose near B = 0)
         else
             EXPECT_GT(spread, 1e-6);  // the head's tilt out of the B plane: the tip then depends on the length
     }

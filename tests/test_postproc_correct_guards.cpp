@@ -28,14 +28,20 @@ std::string correctArgs(const std::string& in, const std::string& out) {
     return "correct --machine " + kMachine + " --deviations " + kTruth + " --in " + in + " --out " + out;
 }
 
-/// The test program of the plan's run `run` (LinuxCNC), written by `cnccomp testprog` into `dir`/tp.
-std::string testProgram(const test::ScratchDir& dir, const std::string& run) {
+std::string upper(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return s;
+}
+
+/// The test program of the plan's run `run`, written by `cnccomp testprog` into `dir`/tp. Fanuc: its programs give
+/// the tool length only in the header (LinuxCNC's give it by G43.1 as well, see the last test).
+std::string testProgram(const test::ScratchDir& dir, const std::string& run, const std::string& dialect = "fanuc") {
     if (!fs::exists(dir.file("tp"))) {
-        const auto r = test::runCli("testprog --machine " + kMachine + " --plan " + kPlan + " --dialect linuxcnc --out " +
+        const auto r = test::runCli("testprog --machine " + kMachine + " --plan " + kPlan + " --dialect " + dialect + " --out " +
                                     dir.file("tp"));
         EXPECT_EQ(r.exitCode, 0) << r.out;
     }
-    // File names are TP<nn>_<run>.ngc with '-' written as '_' (postproc/testprog).
+    // File names are TP<nn>_<run>.<ext> with '-' written as '_' (postproc/testprog).
     std::string key = run;
     std::replace(key.begin(), key.end(), '-', '_');
     for (const auto& e : fs::directory_iterator(dir.file("tp")))
@@ -69,26 +75,45 @@ TEST(PostprocCorrectGuards, TestProgramWithoutToolLengthOptionTakesItsHeaders) {
     (void)testProgram(dir, "C-radial");
     int differs = 0, programs = 0;
     for (const auto& e : fs::directory_iterator(dir.file("tp"))) {
-        if (e.path().extension() != ".ngc") continue;
+        if (e.path().extension() != ".nc") continue;
         ++programs;
-        const std::string p = e.path().string(), text = test::readText(p);
-        const size_t at = text.find("cnccomp correct --tool-length ");
+        const std::string p = e.path().string(), text = upper(test::readText(p));  // Fanuc comments are upper case
+        const size_t at = text.find("CNCCOMP CORRECT --TOOL-LENGTH ");
         ASSERT_NE(at, std::string::npos) << p;
         const std::string length = text.substr(at + 30, text.find(')', at) - at - 30);
-        auto r = test::runCli(correctArgs(p, dir.file("a.ngc")));
+        auto r = test::runCli(correctArgs(p, dir.file("a.nc")));
         ASSERT_EQ(r.exitCode, 0) << r.out;
         EXPECT_NE(r.out.find("tool length: " + length + " mm, from the program's header"), std::string::npos) << r.out;
-        r = test::runCli(correctArgs(p, dir.file("b.ngc")) + " --tool-length " + length);
+        r = test::runCli(correctArgs(p, dir.file("b.nc")) + " --tool-length " + length);
         ASSERT_EQ(r.exitCode, 0) << r.out;
         EXPECT_EQ(r.out.find("from the program's header"), std::string::npos) << r.out;
-        EXPECT_EQ(test::readText(dir.file("a.ngc")), test::readText(dir.file("b.ngc"))) << p;
-        r = test::runCli(correctArgs(p, dir.file("c.ngc")) + " --tool-length 0");
+        EXPECT_EQ(test::readText(dir.file("a.nc")), test::readText(dir.file("b.nc"))) << p;
+        r = test::runCli(correctArgs(p, dir.file("c.nc")) + " --tool-length 0");
         ASSERT_EQ(r.exitCode, 0) << r.out;
-        if (test::readText(dir.file("a.ngc")) != test::readText(dir.file("c.ngc"))) ++differs;
-        for (const char* f : {"a.ngc", "b.ngc", "c.ngc"}) fs::remove(dir.file(f));
+        if (test::readText(dir.file("a.nc")) != test::readText(dir.file("c.nc"))) ++differs;
+        for (const char* f : {"a.nc", "b.nc", "c.nc"}) fs::remove(dir.file(f));
     }
     EXPECT_EQ(programs, 6);
     EXPECT_GE(differs, 1);
+}
+
+// LinuxCNC test programs give their tool length by G43.1 Z<L> (Z words written minus L): `correct` takes the length
+// from it, with or without the header line, and the result is the one for --tool-length L.
+TEST(PostprocCorrectGuards, LinuxcncTestProgramGivesItsToolLengthByG431) {
+    test::ScratchDir dir("pp-guard-g431");
+    const std::string p = testProgram(dir, "B-X", "linuxcnc");
+    std::string text = test::readText(p);
+    const size_t at = text.find("cnccomp correct --tool-length ");
+    ASSERT_NE(at, std::string::npos);
+    const std::string length = text.substr(at + 30, text.find(')', at) - at - 30);
+    EXPECT_NE(text.find("G43.1 Z" + length + ".000000"), std::string::npos) << length;
+    text.replace(at, 29, "header line removed");
+    test::writeText(dir.file("p.ngc"), text);
+    auto r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("a.ngc")));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("b.ngc")) + " --tool-length " + length);
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_EQ(test::readText(dir.file("a.ngc")), test::readText(dir.file("b.ngc")));
 }
 
 TEST(PostprocCorrectGuards, RotaryProgramWithoutAnyToolLengthIsRefusedUnlessZeroIsGiven) {
@@ -96,25 +121,25 @@ TEST(PostprocCorrectGuards, RotaryProgramWithoutAnyToolLengthIsRefusedUnlessZero
     (void)testProgram(dir, "C-radial");
     int refused = 0;
     for (const auto& e : fs::directory_iterator(dir.file("tp"))) {
-        if (e.path().extension() != ".ngc") continue;
+        if (e.path().extension() != ".nc") continue;
         std::string text = test::readText(e.path().string());
-        const size_t at = text.find("cnccomp correct --tool-length");
+        const size_t at = upper(text).find("CNCCOMP CORRECT --TOOL-LENGTH");
         ASSERT_NE(at, std::string::npos);
         text.replace(at, 29, "header line removed");
-        test::writeText(dir.file("p.ngc"), text);
-        auto r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")));
+        test::writeText(dir.file("p.nc"), text);
+        auto r = test::runCli(correctArgs(dir.file("p.nc"), dir.file("o.nc")));
         if (r.exitCode == 2) {
             ++refused;
-            for (const char* s : {"p.ngc:", "depends on the tool length", "--tool-length 0 when 0 is meant"})
+            for (const char* s : {"p.nc:", "depends on the tool length", "--tool-length 0 when 0 is meant"})
                 EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
-            EXPECT_FALSE(fs::exists(dir.file("o.ngc")));
+            EXPECT_FALSE(fs::exists(dir.file("o.nc")));
         } else {
             EXPECT_EQ(r.exitCode, 0) << r.out;
         }
-        r = test::runCli(correctArgs(dir.file("p.ngc"), dir.file("o.ngc")) + " --tool-length 0");
+        r = test::runCli(correctArgs(dir.file("p.nc"), dir.file("o.nc")) + " --tool-length 0");
         EXPECT_EQ(r.exitCode, 0) << r.out;
-        EXPECT_TRUE(fs::exists(dir.file("o.ngc")));
-        fs::remove(dir.file("o.ngc"));
+        EXPECT_TRUE(fs::exists(dir.file("o.nc")));
+        fs::remove(dir.file("o.nc"));
     }
     EXPECT_GE(refused, 1);
     // A program without rotary moves needs no length: the multitasking machine's linear moves at B = C = 0.

@@ -169,6 +169,7 @@ std::vector<CanonMove> parseCanon(const std::string& text) {
     std::istringstream in(text);
     std::string l;
     char plane = 'Z';  // normal of the active plane
+    double zOffset = 0;  // the active tool length offset along Z
     const std::regex call(R"(^\s*\d+\s+N(\S+)\s+([A-Z_]+)\((.*)\))");
     while (std::getline(in, l)) {
         std::smatch m;
@@ -177,6 +178,16 @@ std::vector<CanonMove> parseCanon(const std::string& text) {
         if (name == "SELECT_PLANE") {
             const std::string a = m[3];
             plane = a.find("XZ") != std::string::npos ? 'Y' : a.find("YZ") != std::string::npos ? 'X' : 'Z';
+            continue;
+        }
+        if (name == "USE_TOOL_LENGTH_OFFSET") {
+            // The interpreter's positions exclude the tool length offset; LinuxCNC's canon adds it to every move
+            // (emccanon.cc, rotate_and_offset_pos: x += canon.toolOffset.tran.x ...). Z is the third number.
+            std::vector<double> v;
+            std::stringstream args(std::regex_replace(m[3].str(), std::regex("[ ,]+"), ","));
+            for (std::string cell; std::getline(args, cell, ',');)
+                if (!cell.empty()) v.push_back(std::stod(cell));
+            zOffset = v.size() >= 3 ? v[2] : 0.0;
             continue;
         }
         if (name != "STRAIGHT_TRAVERSE" && name != "STRAIGHT_FEED" && name != "ARC_FEED") continue;
@@ -199,6 +210,7 @@ std::vector<CanonMove> parseCanon(const std::string& text) {
             if (v.size() < 6) continue;
             for (int k = 0; k < 6; ++k) c.xyzabc[k] = v[k];
         }
+        c.xyzabc[2] += zOffset;
         out.push_back(c);
     }
     return out;

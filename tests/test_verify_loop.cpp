@@ -254,16 +254,6 @@ TEST(VerifyLoop, EmittedFilesLeaveLessThanATenthOfAMicrometreOfWhatEachBackendCl
             std::cout << "[ residual ] " << where << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm
                       << " um" << (rounding > 0 ? fmt::format(", rounding to the controller's unit up to {:.3f} um", rounding / kUm) : "")
                       << ")\n";
-            if (b->name() == "linuxcnc") {
-                // KNOWN GAP (README, LinuxCNC route 1; issue 17 open): the component's joint mode matches the tool tip at
-                // the tool-offset pin's length, 0 under G49 as the test programs run, so where the tool axis cannot be
-                // matched (a rotary axis parallel to the tool: A = 0 on the A/C table, B = 0 on the multi-tasking
-                // machine) the ball at the run's tool length keeps the tilts' share (24-27 um on these plans). Held
-                // here to what it does today: never more than before (the 4-axis tilting head: 18.1 -> 15.7 um; the
-                // others less than half), and the pins route (linuxcnc-pins, below) to the 0.1 um of what it claims.
-                EXPECT_LT(r.residual, r.residualBefore) << where;
-                continue;
-            }
             EXPECT_LT(r.residual, 0.1 * kUm + rounding) << where << ": before " << r.residualBefore / kUm << " um";
             EXPECT_GT(r.residualBefore, 1.0 * kUm) << where;
         }

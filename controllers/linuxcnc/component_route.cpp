@@ -53,7 +53,7 @@ EmitResult emitComponentRoute(const EmitRequest& r) {
                     "mm and deg)",
                     kKinsName, m.axisCount(), coordinates),
         fmt::format("modes: switchkins-type 0 (default) joint mode: axis words = the nominal machine's commands (cnccomp "
-                    "testprog's programs, G49); switchkins-type 1 tool-tip mode: X Y Z = tool tip in workpiece coordinates"),
+                    "testprog's programs, G43.1 Z<tool length> with Z written minus it); switchkins-type 1 tool-tip mode: X Y Z = tool tip in workpiece coordinates"),
         "deviation pins: link values (mm, rad; component errors: basis coefficients) read back by cnccomp verify from this file"};
     notes.insert(notes.end(), r.headerNotes.begin(), r.headerNotes.end());
     const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC 2.9 (component {})", kKinsName), out, notes);
@@ -131,10 +131,7 @@ AxisVector KinsComponentModel::joints(const AxisVector& q, double toolOffset) co
     // Both modes aim at the nominal machine's tool pose at q (tool-tip mode: the tip words are that pose's tip and the
     // rotary words its angles), rotary axes pulled towards the words (kins_component.hpp).
     const Vec3 tip = nominal_.toolPoint(toolOffset);
-    IkOptions o;
-    o.tolerance = 1e-11;
-    o.maxIterations = 40;
-    return solveToolPose(actual_, toolPose(nominal_, q, tip), tip, q, o).q;
+    return solveToolPose(actual_, toolPose(nominal_, q, tip), tip, q, kinsSolverOptions()).q;
 }
 
 JointValues KinsComponentModel::program(const AxisVector& q, double toolLength) const {
@@ -153,7 +150,9 @@ JointValues KinsComponentModel::program(const AxisVector& q, double toolLength) 
 }
 
 AxisVector KinsComponentModel::driveCommandsForTool(const AxisVector& q, double toolLength) const {
-    return joints(q, mode_ == KinsMode::Joint ? 0.0 : toolLength);
+    // Both modes: the tool-offset pin carries the program's tool length (joint mode: `cnccomp testprog`'s G43.1 Z<L>
+    // with the Z words written minus L, postproc/testprog/program_syntax.hpp).
+    return joints(q, toolLength);
 }
 
 }  // namespace cnccomp::controllers::linuxcnc

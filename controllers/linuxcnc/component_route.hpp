@@ -16,7 +16,9 @@
 // deviation values READ FROM the HAL file's setp lines (not from the deviation set in memory):
 // - joint mode (switchkins-type 0, the component's default): the words are the nominal machine's commands; the
 //   joints put the erroneous machine's tool tip and tool axis where the nominal one puts them, the tool length being
-//   the tool-offset pin = motion.tooloffset.z (0 under G49, as in `cnccomp testprog`'s programs);
+//   the tool-offset pin = motion.tooloffset.z (0 under G49; `cnccomp testprog`'s programs give their tool length
+//   with G43.1 Z<L> and write the Z words minus L, so the words LinuxCNC hands the component are still the nominal
+//   commands and the tool tip at L is exact even where the tool axis cannot follow, near a singular pose);
 // - tool-tip mode (switchkins-type 1): program X Y Z = the tool tip in the workpiece frame as it lies at machine zero
 //   (R0·p + t0, p in the description's workpiece frame; G54 = 0 here), rotary words = the angles; LinuxCNC hands the
 //   component program + G54 + (0, 0, tool length) under G43 (emccanon.cc), and the component takes the tool-offset
@@ -68,7 +70,8 @@ public:
     /// controller coordinates; tool-tip mode X Y Z = the nominal tool tip at tool length L in the workpiece frame.
     JointValues program(const AxisVector& q, double toolLength) const;
 
-    /// Joint mode: the test programs' case, G49 (tool-offset pin 0). Tool-tip mode: G43 with the tool length.
+    /// driveCommands: a program run under G49 (tool-offset pin 0). driveCommandsForTool: the tool-offset pin = the
+    /// tool length (joint mode: the test programs' G43.1 Z<L>; tool-tip mode: G43 with the tool length).
     AxisVector driveCommands(const AxisVector& programmed) const override { return driveCommandsForTool(programmed, 0.0); }
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
 

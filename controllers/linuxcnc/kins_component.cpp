@@ -344,7 +344,7 @@ static int ck_solve(const double *tip_t, const double *ax_t, double L, const dou
         }
     }
     *iterations = it;
-    if (converged) {
+    if (converged && CK_POLISH) {
         /* Polish without the pull: regular poses then meet the axis fully; a step that would swing a rotary axis
          * (a singular direction) or does not lower the cost is refused. */
         double current = ck_cost(q, L, tip_t, ax_t);
@@ -579,6 +579,16 @@ KINEMATICS_TYPE kinematicsType(void) {
 
 }  // namespace
 
+IkOptions kinsSolverOptions(const KinsComponentOptions& o) {
+    IkOptions ik;
+    ik.tolerance = 0.1 * o.tolerance;  // the component's step test is 0.1 × tolerance (ck_solve)
+    ik.maxIterations = 40;
+    ik.axisWeight = o.axisWeight;
+    ik.rotaryRegularization = o.rotaryRegularization;
+    ik.polish = o.polish;
+    return ik;
+}
+
 std::string kinsDeviationPin(const MachineModel& m, int index, int k) {
     if (index < 0 || index >= static_cast<int>(m.deviations.size()))
         throw ModelError(fmt::format("machine '{}' has no deviation {}", m.name, index));
@@ -731,8 +741,8 @@ std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, co
     s += fmt::format("#define CK_NDEV_PINS {}\n#define CK_NDEV {}\n", nDev, std::max(nDev, 1));
     s += fmt::format("#define CK_NLOC {}\n#define CK_NNODES {}\n", nLoc, nNodes);
     s += fmt::format("#define CK_MAX_ITERATIONS {}\n#define CK_TOLERANCE {}\n", o.maxIterations, num(o.tolerance));
-    s += fmt::format("#define CK_AXIS_WEIGHT {}\n#define CK_REG {}\n", num(o.axisWeight),
-                     num(o.rotaryRegularization));
+    s += fmt::format("#define CK_AXIS_WEIGHT {}\n#define CK_REG {}\n#define CK_POLISH {}\n", num(o.axisWeight),
+                     num(o.rotaryRegularization), o.polish ? 1 : 0);
     s += "#define CK_ACCEPT_RESIDUAL 1e-6 /* mm: an unconverged solve is still used (fail set) below this */\n";
     s += "#define CK_FORWARD_PASSES 12\n";
     s += fmt::format("#define CK_TOOL_TIP_MODE {}\n\n", tipMode ? 1 : 0);

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "cnccomp/deviations.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/machine.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
@@ -33,7 +34,17 @@ struct KinsComponentOptions {
     double axisWeight = 100.0;
     /// mm per rad: pull of the rotary joints towards the nominal (joint mode) or commanded (tool-tip mode) angles,
     /// as cnccomp::IkOptions::rotaryRegularization: keeps singular poses (tool axis parallel to a rotary axis) tame.
-    double rotaryRegularization = 0.1;
+    /// A joint trajectory needs it strong: near a singular pose (sin of the angle between the tool axis and a rotary
+    /// axis below rotaryRegularization/axisWeight = 0.02, 1.1°) the pull wins and the axis is matched only partly,
+    /// while a tool-axis error δ still turns the rotary axis by up to δ·axisWeight/(2·rotaryRegularization) = 25·δ
+    /// (0.07° for 10″), smoothly across the singular pose. With 0.1 the real LinuxCNC swung C by ±1.8° within a
+    /// few servo cycles at B = ±180° on the multi-tasking sample (3 mm of Y, 1.5 µm off the path after motion's
+    /// joint interpolation). Away from such poses the axis keeps (0.02/sin)² of its error (0.16 % at 30°). The tip at
+    /// the tool-offset length is exact either way (the slides can always place it).
+    double rotaryRegularization = 2.0;
+    /// cnccomp::IkOptions::polish. Off: the joints are a smooth function of the world words, which the trajectory
+    /// needs (a polish switched on and off near a singular pose makes the joints jump).
+    bool polish = false;
 };
 
 /// Source text of a halcompile `.comp` kinematics component for machine `m` with deviations `d` (LinuxCNC 2.9).
@@ -78,6 +89,10 @@ struct KinsComponentOptions {
 /// kinematicsType() = KINEMATICS_BOTH; kinematicsSwitchable() = 1.
 /// Throws ModelError for a machine the component cannot describe (axis names, more than 9 axes).
 std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, const KinsComponentOptions& o = {});
+
+/// cnccomp's inverse (solveToolPose) with the component's objective: its weights, pull and polish, and a tolerance
+/// at least as tight as the component's. The apply model (component_route.hpp) and the tests solve with these.
+IkOptions kinsSolverOptions(const KinsComponentOptions& o = {});
 
 /// HAL pin name (without the component prefix) of coefficient k of deviation `index` of `m`: "dev.<lower iso name>"
 /// for a location deviation, "dev.<lower iso name>.<k>" for a component deviation.

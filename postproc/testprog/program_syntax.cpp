@@ -71,7 +71,8 @@ std::string ProgramSyntax::axisWords(const AxisVector& p, unsigned mask, bool pl
     const auto word = [&](int a) {
         const bool rotary = machine_.axisLink(a).kind == AxisKind::Rotary;
         if (!out.empty()) out += ' ';
-        out += machine_.axisNames[a] + number(rotary ? p[a] / kDeg : p[a], plus);
+        const double shift = machine_.axisNames[a] == "Z" ? zShift_ : 0.0;
+        out += machine_.axisNames[a] + number(rotary ? p[a] / kDeg : p[a] - shift, plus);
     };
     for (char c : kOrder) {
         const int a = machine_.axisIndex(std::string(1, c));
@@ -122,6 +123,10 @@ public:
                 block("G91.1 G61");                 // arc centres incremental; exact path (no blending)
                 block("G10 L2 P1" + datum);          // G54 = machine coordinates
                 block("G54");
+                if (toolLength_ != 0) {
+                    block("G43.1 Z" + number(toolLength_));  // LinuxCNC G-code reference, G43.1: dynamic tool length
+                    zShift_ = toolLength_;
+                }
                 break;
             case ProgramDialect::Fanuc:
                 block("G17 G21 G40 G49 G80 G90 G94");
@@ -162,6 +167,13 @@ public:
         track(p, allAxes());
     }
     bool arcsWithRotaryAxes() const override { return true; }
+    bool passToolLength(double length) override {
+        if (d_ != ProgramDialect::LinuxCnc || length == 0 || machine_.axisIndex("Z") < 0 ||
+            machine_.axisLink(machine_.axisIndex("Z")).kind != AxisKind::Linear)
+            return false;
+        toolLength_ = length;
+        return true;
+    }
     void dwell(double seconds) override {
         switch (d_) {
             case ProgramDialect::LinuxCnc: block("G4 P" + plain(seconds)); break;
@@ -180,6 +192,7 @@ public:
         }
     }
     void end() override {
+        if (zShift_ != 0) block("G49");
         block("M30");
         if (d_ == ProgramDialect::Fanuc) emit("%");
     }
@@ -211,6 +224,7 @@ private:
     ProgramDialect d_;
     long n_ = 0;
     int plane_ = 17;
+    double toolLength_ = 0;
     double lastFeed_ = -1;
     AxisVector pos_;
 };

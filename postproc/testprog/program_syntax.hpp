@@ -59,6 +59,12 @@ public:
     /// Program stop (M0) with an operator message.
     virtual void stop(std::string_view message) = 0;
     virtual void end() = 0;
+    /// The tool length L of the run (mm), before init(). LinuxCNC: init() writes G43.1 Z<L> (LinuxCNC then adds L to
+    /// every Z word: the Z words are written as the machine coordinate minus L, so that the joints stay the same) and
+    /// end() G49; the generated kinematics component of `cnccomp emit --controller linuxcnc` reads L from
+    /// motion.tooloffset.z (tool-offset pin) and keeps the tool tip at L exact where the tool axis cannot follow.
+    /// Returns whether the dialect passes L to the controller (LinuxCNC on a machine with a Z axis and L != 0).
+    virtual bool passToolLength(double length) { (void)length; return false; }
     /// Notes on conventions not confirmed for this dialect ([G]), for the header.
     virtual std::vector<std::string> unconfirmed() const = 0;
     /// The program text so far.
@@ -71,6 +77,7 @@ protected:
     /// Feeds and times: up to three decimals, trailing zeros dropped ("1000", "0.5").
     static std::string plain(double v);
     /// Axis words of p for the axes in mask, in X Y Z U V W A B C order: "X12.5 Y0.0 C90.0" (Heidenhain: X+12.5).
+    /// The Z word is written minus zShift_ (LinuxCNC under G43.1, see passToolLength).
     std::string axisWords(const AxisVector& p, unsigned mask, bool plus) const;
     unsigned allAxes() const { return machine_.axisCount() >= 32 ? ~0u : (1u << machine_.axisCount()) - 1u; }
     /// Text for a comment: characters that would end it replaced, upper case where the dialect wants it.
@@ -79,6 +86,7 @@ protected:
 
     const MachineModel& machine_;
     int decimals_;
+    double zShift_ = 0;  ///< mm taken off every Z word (the active tool length offset)
     std::string out_;
 };
 

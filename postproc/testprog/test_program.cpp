@@ -196,9 +196,18 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
     syntax->comment(fmt::format("cnccomp test program: {} run '{}' ({} of the plan)", runKindName(r.kind), r.name, order));
     syntax->comment(fmt::format("machine: {}{}{}", m.name, o.machineFile.empty() ? "" : " (" + o.machineFile + ")",
                                 o.planFile.empty() ? "" : ", plan: " + o.planFile));
-    syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no tool length or "
-                                "work offset active",
-                                programDialectName(o.dialect)));
+    if (syntax->passToolLength(r.toolLength)) {
+        syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no work offset; "
+                                    "G43.1 Z{:g} gives the tool length: LinuxCNC adds it to every Z word, so Z is written as "
+                                    "the machine coordinate minus {:g}",
+                                    programDialectName(o.dialect), r.toolLength, r.toolLength));
+        syntax->comment("cnccomp's LinuxCNC kinematics component (emit --controller linuxcnc) keeps the tool tip at that length exact "
+                        "where the tool axis cannot follow");
+    } else {
+        syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no tool length or "
+                                    "work offset active",
+                                    programDialectName(o.dialect)));
+    }
     // The mode the controller must run the program in, which verify also runs it in (issue 17).
     syntax->comment(kKinematicsModeLine);
     for (const std::string& n : r.notes) syntax->comment(n);

@@ -25,7 +25,7 @@ namespace cnccomp::testprog {
 /// The words are machine coordinates, so the controller's tool-tip transformation must be off; `cnccomp verify` runs
 /// the programs in this mode (controllers' apply models: joint mode, e.g. LinuxCNC's linuxcnc_apply.hpp).
 inline constexpr const char* kKinematicsModeLine =
-    "kinematics mode: joint (machine coordinates; tool-tip transformation OFF: LinuxCNC identity kinematics, "
+    "kinematics mode: joint (machine coordinates; tool-tip transformation OFF: LinuxCNC joint mode, "
     "Sinumerik TRAORI off, Heidenhain M128/FUNCTION TCPM off, Fanuc G43.4/G43.5 off)";
 
 struct TestProgramOptions {

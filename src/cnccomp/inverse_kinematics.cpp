@@ -80,7 +80,7 @@ IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& 
         return (target.tip - p.tip).squaredNorm() + (o.axisWeight * (target.axis - p.axis)).squaredNorm();
     };
     double current = cost(r.q);
-    for (int polish = 0; polish < 4 && r.converged; ++polish) {
+    for (int polish = 0; polish < 4 && r.converged && o.polish; ++polish) {
         const ToolPose p = toolPose(k, r.q, tipInToolFrame);
         toolPoseJacobian(k, r.q, tipInToolFrame, J);
         A.setZero();

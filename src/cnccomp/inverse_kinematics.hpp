@@ -31,6 +31,11 @@ struct IkOptions {
     /// for tilts below regularization/axisWeight (1e-3 rad) and still meets the tip exactly (the slides can).
     /// Away from such poses it costs a relative (regularization/axisWeight)² = 1e-6 of the axis correction.
     double rotaryRegularization = 0.1;
+    /// After the pulled solution, up to 4 steps without the pull where they lower the cost and swing no rotary axis by
+    /// regularization/axisWeight or more: regular poses then meet the axis fully. Off, the solution is a smooth
+    /// function of the target (no switch between polished and unpolished near a singular pose), as a joint
+    /// trajectory needs (the LinuxCNC kinematics component, controllers/linuxcnc/kins_component.hpp).
+    bool polish = true;
 };
 
 struct IkResult {

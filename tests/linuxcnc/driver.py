@@ -6,7 +6,8 @@ and then works through the job file ($CNCCOMP_JOB), one command per line:
     mdi <G-code>     one MDI block; waits until the interpreter is idle and motion is in position (a "G0 <words>"
                      block also until the commanded position has reached its words)
     record <label>   waits until every joint's comp filter has reached its target (backlash-filt == backlash-corr,
-                     at most 1 s) and writes one line to $CNCCOMP_OUT:
+                     at most 1 s) and the joints' pos-cmd pins hold still (two reads 20 ms apart agree, at most
+                     2 s) and writes one line to $CNCCOMP_OUT:
                      <label> <settled 0|1> <motion.tooloffset.z> then, per joint, joint.N.pos-cmd, then
                      joint.N.motor-pos-cmd, joint.N.backlash-corr, joint.N.backlash-filt (repr, full precision), then
                      the 9 values of stat.g5x_offset (the active work offset)
@@ -127,6 +128,15 @@ def record(label):
             settled = True
             break
         time.sleep(0.002)
+    # stat.position (the arrival test of mdi) can reach the block's words a servo cycle before the joint pins
+    # carry that cycle's inverse: the joints are read once two reads some cycles apart agree.
+    start, last = time.time(), None
+    while time.time() - start < 2.0:
+        now = pins("joint.%d.pos-cmd")
+        if now == last:
+            break
+        last = now
+        time.sleep(0.02)
     values = (pins("joint.%d.pos-cmd") + pins("joint.%d.motor-pos-cmd") + pins("joint.%d.backlash-corr")
               + pins("joint.%d.backlash-filt"))
     stat.poll()

@@ -120,11 +120,14 @@ std::string baseHal(int joints, const std::string& coordinates, bool sampled) {
          "net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type\n";
     if (sampled) {
         s += fmt::format("loadrt sampler depth=20000 cfg={}\naddf sampler.0 servo-thread\nsetp sampler.0.enable 0\n",
-                         std::string(2 * coordinates.size(), 'f'));
+                         std::string(2 * coordinates.size() + 1, 'f') + "s");
         for (int j = 0; j < joints; ++j) s += fmt::format("net j{0} => sampler.0.pin.{0}\n", j);
         for (size_t k = 0; k < coordinates.size(); ++k)
             s += fmt::format("net ax{0} axis.{0}.pos-cmd => sampler.0.pin.{1}\n",
                              static_cast<char>(std::tolower(static_cast<unsigned char>(coordinates[k]))), joints + static_cast<int>(k));
+        // motion.tooloffset.z through the route's own signal (cnccomp-kins.hal adds the writer): a pin takes one net.
+        s += fmt::format("net cnccomp-tool-offset => sampler.0.pin.{}\n", joints + static_cast<int>(coordinates.size()));
+        s += fmt::format("net program-line motion.program-line => sampler.0.pin.{}\n", joints + static_cast<int>(coordinates.size()) + 1);
     }
     return s;
 }
@@ -324,6 +327,7 @@ RunResult run(const SimConfig& c, const std::vector<std::string>& job) {
             ls >> s.cycle;
             for (double& x : s.motor) ls >> x;
             for (double& x : s.axis) ls >> x;
+            ls >> s.toolOffset >> s.programLine;
             if (!ls) throw std::runtime_error("unreadable sample line: " + line);
             result.samples.push_back(std::move(s));
         }

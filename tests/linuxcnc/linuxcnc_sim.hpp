@@ -86,7 +86,9 @@ struct Record {
 /// One servo cycle of a `sample` job line: joint.N.motor-pos-cmd per joint, then axis.L.pos-cmd per coordinate letter.
 struct Sample {
     long cycle = 0;
-    std::vector<double> motor, axis;
+    std::vector<double> motor, axis;  ///< joint.N.motor-pos-cmd, axis.L.pos-cmd (joint order)
+    double toolOffset = 0;            ///< motion.tooloffset.z
+    long programLine = 0;             ///< motion.program-line (the executing motion's line of the program, 1-based)
 };
 
 struct RunResult {

@@ -10,9 +10,10 @@
 // - the erroneous machine (the exact kinematics with the deviation set the files were made from) at LinuxCNC's
 //   joints puts the tool tip within 0.1 um of the nominal tip the words ask for (no cnccomp model in that loop);
 // - on the multi-tasking sample, one whole `cnccomp testprog` program (ball-bar run B-X: B from -180 to 180 deg at a
-//   tool length of 360 mm) runs through LinuxCNC's interpreter and trajectory planner in AUTO with joint and axis
-//   commands recorded every servo cycle (sampler + halsampler): the tool tip of the erroneous machine at the joints
-//   stays within 0.5 um of the nominal machine's tip at the same cycle's axis commands.
+//   tool length of 360 mm, given by G43.1) runs through LinuxCNC's interpreter and trajectory planner in AUTO with joint and axis
+//   commands and motion.tooloffset.z recorded every servo cycle (sampler + halsampler): over the measured passes the
+//   tool tip of the erroneous machine at each cycle's joints stays within 0.5 um of the nominal machine's tool-tip
+//   path (the nominal tips at the sampled axis commands); outside them (approach, rapids) within 10 um.
 // Skipped with the reason when LinuxCNC or halcompile (root) is not there; RESOURCE_LOCK linuxcnc, RUN_SERIAL.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -80,7 +81,10 @@ struct Figures {
     double axisJoint = 0, tipBefore = 0;          ///< rad; mm (no compensation)
     double program = 0;                           ///< whole program: tip error along the path, mm
     size_t samples = 0;
-    int lag = 0;                                  ///< servo cycles between the axis and the joint samples compared
+    size_t atProgramTool = 0;                     ///< samples compared at the program's tool length
+    long worstCycle = 0;                          ///< sampler cycle of the largest distance from the path
+    double programElsewhere = 0;                  ///< the same outside the measured passes (approach, rapids), mm
+    long worstCycleElsewhere = 0;
     double install = 0, seconds = 0;
     int poses = 0;
 };
@@ -121,6 +125,7 @@ Figures runComponentOracle(const std::string& machineName, const std::string& de
     std::vector<std::string> job{"mdi G90 G21 G94 G17 G40 G49 G54 G64"};
     // The whole program first (joint mode, as cnccomp testprog's programs state).
     double programTool = 0;
+    std::pair<long, long> passLines{0, 0};  ///< program lines of the first pass's start and the last pass's end marker
     if (!plan.empty()) {
         const CliResult tp = runCli(fmt::format("testprog --machine {} --plan {} --dialect linuxcnc --feed 20000 --approach-feed 20000 "
                                                 "--overshoot 4 --out {}",
@@ -134,7 +139,15 @@ Figures runComponentOracle(const std::string& machineName, const std::string& de
         const size_t at = text.find("cnccomp correct --tool-length ");
         EXPECT_NE(at, std::string::npos);
         programTool = std::stod(text.substr(at + 30));
+        EXPECT_NE(text.find(fmt::format("G43.1 Z{:.6f}", programTool)), std::string::npos) << "the program gives its tool length";
         fs::copy_file(program, dir.path / "sim" / "program.ngc");
+        // The measured passes: the lines between the capture's start stop and its end stop.
+        const auto lineOf = [&](const std::string& marker) {
+            const size_t at = text.find(marker);
+            EXPECT_NE(at, std::string::npos) << marker;
+            return static_cast<long>(std::count(text.begin(), text.begin() + static_cast<long>(std::min(at, text.size())), '\n')) + 1;
+        };
+        passLines = {lineOf("CNCCOMP PASS 1"), lineOf("CNCCOMP PASS 2 END")};
         job.push_back("sample " + (dir.path / "sim" / "program.ngc").string());
         job.push_back("mdi G90 G49 G54");
     }
@@ -182,7 +195,7 @@ Figures runComponentOracle(const std::string& machineName, const std::string& de
             const Vec3 tip = actual.toolPointInWorkpiece(j, actual.toolPoint(L));
             const double e = (tip - nominal.toolPointInWorkpiece(q, nominal.toolPoint(L))).norm();
             (mode == 0 ? f.tipJoint : f.tipToolTip) = std::max(mode == 0 ? f.tipJoint : f.tipToolTip, e);
-            EXPECT_LT(e, 1e-2) << (mode == 0 ? "joint" : "tool-tip") << " mode, pose " << k << ": tip off by " << e / kUm << " um";
+            EXPECT_LT(e, 0.1 * kUm) << (mode == 0 ? "joint" : "tool-tip") << " mode, pose " << k << ": tip off by " << e / kUm << " um";
             if (mode == 0) {
                 const ToolPose a = toolPose(actual, j, actual.toolPoint(100.0)), n = toolPose(nominal, q, nominal.toolPoint(100.0));
                 f.axisJoint = std::max(f.axisJoint, std::acos(std::clamp(a.axis.dot(n.axis), -1.0, 1.0)));
@@ -195,18 +208,34 @@ Figures runComponentOracle(const std::string& machineName, const std::string& de
     if (!plan.empty()) {
         EXPECT_EQ(run.overruns, 0);
         f.samples = run.samples.size();
-        // axis.L.pos-cmd and joint.N.motor-pos-cmd of one servo cycle may belong to neighbouring trajectory points (the
-        // pins are written at different places of motion-controller): the lag is the one of -1, 0, 1 cycles that fits.
-        f.program = 1e300;
-        for (int lag = -1; lag <= 1; ++lag) {
-            double worst = 0;
-            for (size_t k = 1; k + 1 < run.samples.size(); ++k) {
-                const AxisVector j = drive(run.samples[k].motor), w = drive(run.samples[k + lag].axis);  // joint i = axis letter i
-                worst = std::max(worst, (actual.toolPointInWorkpiece(j, actual.toolPoint(programTool)) -
-                                         nominal.toolPointInWorkpiece(w, nominal.toolPoint(programTool)))
-                                            .norm());
-            }
-            if (worst < f.program) f.program = worst, f.lag = lag;
+        // The tool tip of the erroneous machine at each cycle's joints against the nominal tool-tip PATH (the polyline of
+        // the nominal machine's tips at the sampled axis.L.pos-cmd of the neighbouring cycles). Not the same cycle's
+        // point: the sampler shows the axis pins about two servo cycles ahead of the joints, and motion's cubic joint
+        // interpolator smooths the joints so that while an axis accelerates the pairing of cycles is off along the path
+        // (measured: 8 um at the rapid moves; the component at a standing pose agrees to 1e-10).
+        // The component holds the tip at motion.tooloffset.z (0 before the program's G43.1 and after its G49); the
+        // cycles around a change of it are left out.
+        const size_t n = run.samples.size();
+        std::vector<Vec3> nominalTip(n);
+        for (size_t k = 0; k < n; ++k)
+            nominalTip[k] = nominal.toolPointInWorkpiece(drive(run.samples[k].axis), nominal.toolPoint(run.samples[k].toolOffset));
+        const auto toSegment = [](const Vec3& p, const Vec3& a, const Vec3& b) {
+            const Vec3 d = b - a;
+            const double t = d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+            return (p - (a + t * d)).norm();
+        };
+        f.program = 0;
+        for (size_t k = 8; k + 8 < n; ++k) {
+            const double L = run.samples[k].toolOffset;
+            if (run.samples[k - 8].toolOffset != L || run.samples[k + 8].toolOffset != L) continue;
+            const Vec3 tip = actual.toolPointInWorkpiece(drive(run.samples[k].motor), actual.toolPoint(L));
+            double d = 1e300;
+            for (size_t i = k - 6; i < k + 4; ++i) d = std::min(d, toSegment(tip, nominalTip[i], nominalTip[i + 1]));
+            const long line = run.samples[k].programLine;
+            const bool inPasses = line > passLines.first && line < passLines.second;
+            double& worst = inPasses ? f.program : f.programElsewhere;
+            if (d > worst) worst = d, (inPasses ? f.worstCycle : f.worstCycleElsewhere) = run.samples[k].cycle;
+            if (L == programTool) ++f.atProgramTool;
         }
     }
     std::cout << fmt::format(
@@ -216,8 +245,10 @@ Figures runComponentOracle(const std::string& machineName, const std::string& de
         machineName, f.poses, f.install, f.seconds, f.jointMode, f.toolTipMode, f.tipJoint / kUm, f.tipBefore / kUm,
         f.axisJoint / kArcsec, f.tipToolTip / kUm,
         plan.empty() ? std::string()
-                     : fmt::format("; whole program ({} servo cycles, tool {:g} mm, lag {}): tip within {:.4f} um of the nominal", f.samples,
-                                   programTool, f.lag, f.program / kUm));
+                     : fmt::format("; whole program ({} servo cycles, tool {:g} mm): tip within {:.4f} um of the nominal path "
+                                               "over the measured passes (largest at cycle {}), {:.4f} um elsewhere (cycle {})",
+                                               f.samples, programTool, f.program / kUm, f.worstCycle, f.programElsewhere / kUm,
+                                               f.worstCycleElsewhere));
     return f;
 }
 
@@ -226,20 +257,23 @@ void oracle(const std::string& machine, const std::string& deviations, const std
     if (const std::string why = sim::componentUnavailableReason(); !why.empty()) GTEST_SKIP() << why;
     const Figures f = runComponentOracle(machine, deviations, tag, plan);
     EXPECT_GE(f.poses, 20);
-    // KNOWN GAP (issue 17 open; README, LinuxCNC): the lcnc branch measured 4.9e-10 mm/deg and 0.0000 um here with the
-    // generator it merged; after the generator's last commits the real LinuxCNC differs from the apply model by up to
-    // 2.3e-3 mm/deg on table-table-bc-offsets and tilting-head-b (tip up to 5.3 um, from 61.9 um before), not yet
-    // understood. Held here to what was measured on the final commit, with margin, so that a worse regression fails.
-    EXPECT_LE(f.jointMode, 5e-3);
-    EXPECT_LE(f.toolTipMode, 5e-3);
-    EXPECT_LE(f.tipJoint, 1e-2);
-    EXPECT_LE(f.tipToolTip, 1e-2);
+    // Issue 17: joint commands agree with cnccomp's model to 1e-6 mm / 1e-6 deg; the tool tip on the erroneous machine is
+    // within 0.1 um of nominal. (The driver reads the joints once they hold still: the arrival test on stat.position
+    // can pass a servo cycle before the joint pins carry that cycle's inverse, which once looked like a 1e-3 gap.)
+    EXPECT_LE(f.jointMode, 1e-6);
+    EXPECT_LE(f.toolTipMode, 1e-6);
+    EXPECT_LE(f.tipJoint, 0.1 * kUm);
+    EXPECT_LE(f.tipToolTip, 0.1 * kUm);
     EXPECT_GT(f.tipBefore, 5 * kUm);  // the deviations matter (tilting head at tool length 0: 5.7 um)
     if (!plan.empty()) {
         EXPECT_GT(f.samples, 1000u);
-        // NOT YET ASSERTED (issue 17 asks for 0.5 um): measured 5.9 mm between the erroneous tip at the sampled joints and
-        // the nominal tip at the sampled axis.L.pos-cmd of the neighbouring cycle (11.8 mm at the same cycle), while every
-        // MDI pose agrees to 5e-10: the pairing of the two pins' samples is not understood yet (README, LinuxCNC).
+        EXPECT_GT(f.atProgramTool, f.samples / 2) << "most of the program runs at its G43.1 tool length";
+        // The whole program (G43.1 with its tool length, joint mode): the tip follows the nominal path to 0.5 um.
+        EXPECT_LE(f.program, 0.5 * kUm) << "at sampler cycle " << f.worstCycle;
+        // Outside the passes the program crosses the singular pose B = 180 deg in a rapid at about 0.3 deg per servo cycle
+        // (this simulation's rapid rate): C turns by up to 0.07 deg there and motion's joint interpolation cuts that
+        // corner (measured 3.4 um, nothing is measured then). Held so that a return of the old +-1.8 deg swing fails.
+        EXPECT_LE(f.programElsewhere, 10 * kUm) << "at sampler cycle " << f.worstCycleElsewhere;
         ::testing::Test::RecordProperty("whole_program_tip_error_um", std::to_string(f.program / kUm));
     }
 }
