@@ -283,11 +283,68 @@ static int ck_cholesky_solve(double N[CK_NAX][CK_NAX], const double *g, double *
     return 0;
 }
 
+/* Smallest singular value of the tool axis' derivative over the rotary joints (rows 3..5 of J), by cyclic Jacobi
+ * rotations of their Gram matrix (cnccomp::rotarySingularValue); 1 without rotary joints. */
+static double ck_rotary_sigma(double J[6][CK_NAX]) {
+    double G[CK_NAX][CK_NAX], lo;
+    int idx[CK_NAX], n = 0, a, b, k, sweep;
+    for (a = 0; a < CK_NAX; ++a)
+        if (ck_rotary[a]) idx[n++] = a;
+    if (n == 0) return 1.0;
+    for (a = 0; a < n; ++a)
+        for (b = 0; b < n; ++b) {
+            G[a][b] = 0.0;
+            for (k = 0; k < 3; ++k) G[a][b] += J[3 + k][idx[a]] * J[3 + k][idx[b]];
+        }
+    for (sweep = 0; sweep < 12; ++sweep) {
+        double off = 0.0;
+        for (a = 0; a < n; ++a)
+            for (b = a + 1; b < n; ++b) off += G[a][b] * G[a][b];
+        if (off < 1e-30) break;
+        for (a = 0; a < n; ++a)
+            for (b = a + 1; b < n; ++b) {
+                double theta, t, c, sn, tau;
+                if (G[a][b] == 0.0) continue;
+                theta = (G[b][b] - G[a][a]) / (2.0 * G[a][b]);
+                t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                c = 1.0 / sqrt(t * t + 1.0);
+                sn = t * c;
+                tau = sn / (1.0 + c);
+                G[a][a] -= t * G[a][b];
+                G[b][b] += t * G[a][b];
+                G[a][b] = G[b][a] = 0.0;
+                for (k = 0; k < n; ++k) {
+                    double gka, gkb;
+                    if (k == a || k == b) continue;
+                    gka = G[k][a];
+                    gkb = G[k][b];
+                    G[k][a] = G[a][k] = gka - sn * (gkb + tau * gka);
+                    G[k][b] = G[b][k] = gkb + sn * (gka - tau * gkb);
+                }
+            }
+    }
+    lo = G[0][0];
+    for (a = 1; a < n; ++a)
+        if (G[a][a] < lo) lo = G[a][a];
+    return lo > 0 ? sqrt(lo) : 0.0;
+}
+
+/* Weight of the rotary joints' pull at this Jacobian (cnccomp::IkOptions::singularZone): constant CK_REG without a
+ * zone, else CK_REG (1 - (sigma/zone)^2) inside it and CK_REG * 1e-4 outside (a floor that keeps the normal
+ * equations regular). */
+static double ck_pull(double J[6][CK_NAX]) {
+    double s;
+    if (!(CK_SINGULAR_ZONE > 0)) return CK_REG;
+    s = ck_rotary_sigma(J) / CK_SINGULAR_ZONE;
+    return CK_REG * (s >= 1.0 ? 1e-4 : (1.0 - s * s > 1e-4 ? 1.0 - s * s : 1e-4));
+}
+
 /* Normal equations of the weighted residual; reg != 0 adds the pull of the regularised joints towards anchor. */
 static void ck_normal(double J[6][CK_NAX], const double *tip_t, const double *ax_t, const double *tip,
                       const double *ax, const double *q, const double *anchor, int reg, double N[CK_NAX][CK_NAX],
                       double *g) {
     double r[6];
+    const double pull = reg ? ck_pull(J) : 0.0;
     int i, j, k;
     for (k = 0; k < 3; ++k) {
         r[k] = tip_t[k] - tip[k];
@@ -302,8 +359,9 @@ static void ck_normal(double J[6][CK_NAX], const double *tip_t, const double *ax
         g[i] = 0.0;
         for (k = 0; k < 3; ++k) g[i] += J[k][i] * r[k] + CK_AXIS_WEIGHT * J[3 + k][i] * r[3 + k];
         if (reg && ck_regularised[i]) {
-            N[i][i] += CK_REG * CK_REG;
-            g[i] += CK_REG * CK_REG * (anchor[i] - q[i]);
+            const double w = ck_rotary[i] ? pull : CK_REG; /* extra linear axes (tool-tip mode): constant */
+            N[i][i] += w * w;
+            g[i] += w * w * (anchor[i] - q[i]);
         }
     }
 }
@@ -585,6 +643,7 @@ IkOptions kinsSolverOptions(const KinsComponentOptions& o) {
     ik.maxIterations = 40;
     ik.axisWeight = o.axisWeight;
     ik.rotaryRegularization = o.rotaryRegularization;
+    ik.singularZone = o.singularZone;
     ik.polish = o.polish;
     return ik;
 }
@@ -609,7 +668,7 @@ std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, co
                                      o.name));
     if (&d.machine() != &m && d.machine().name != m.name)
         throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", d.machine().name, m.name));
-    if (!(o.maxIterations >= 1 && o.tolerance > 0 && o.axisWeight > 0 && o.rotaryRegularization > 0))
+    if (!(o.maxIterations >= 1 && o.tolerance > 0 && o.axisWeight > 0 && o.rotaryRegularization > 0 && o.singularZone >= 0))
         throw ModelError("kinematics component options: maxIterations >= 1, tolerance, axisWeight and "
                          "rotaryRegularization > 0 expected");
     const int n = m.axisCount();
@@ -741,8 +800,8 @@ std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, co
     s += fmt::format("#define CK_NDEV_PINS {}\n#define CK_NDEV {}\n", nDev, std::max(nDev, 1));
     s += fmt::format("#define CK_NLOC {}\n#define CK_NNODES {}\n", nLoc, nNodes);
     s += fmt::format("#define CK_MAX_ITERATIONS {}\n#define CK_TOLERANCE {}\n", o.maxIterations, num(o.tolerance));
-    s += fmt::format("#define CK_AXIS_WEIGHT {}\n#define CK_REG {}\n#define CK_POLISH {}\n", num(o.axisWeight),
-                     num(o.rotaryRegularization), o.polish ? 1 : 0);
+    s += fmt::format("#define CK_AXIS_WEIGHT {}\n#define CK_REG {}\n#define CK_SINGULAR_ZONE {}\n#define CK_POLISH {}\n",
+                     num(o.axisWeight), num(o.rotaryRegularization), num(o.singularZone), o.polish ? 1 : 0);
     s += "#define CK_ACCEPT_RESIDUAL 1e-6 /* mm: an unconverged solve is still used (fail set) below this */\n";
     s += "#define CK_FORWARD_PASSES 12\n";
     s += fmt::format("#define CK_TOOL_TIP_MODE {}\n\n", tipMode ? 1 : 0);

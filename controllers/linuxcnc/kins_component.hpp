@@ -33,15 +33,17 @@ struct KinsComponentOptions {
     /// mm per rad: weight of a tool-axis error against a tip error (as cnccomp::IkOptions::axisWeight).
     double axisWeight = 100.0;
     /// mm per rad: pull of the rotary joints towards the nominal (joint mode) or commanded (tool-tip mode) angles,
-    /// as cnccomp::IkOptions::rotaryRegularization: keeps singular poses (tool axis parallel to a rotary axis) tame.
-    /// A joint trajectory needs it strong: near a singular pose (sin of the angle between the tool axis and a rotary
-    /// axis below rotaryRegularization/axisWeight = 0.02, 1.1°) the pull wins and the axis is matched only partly,
-    /// while a tool-axis error δ still turns the rotary axis by up to δ·axisWeight/(2·rotaryRegularization) = 25·δ
-    /// (0.07° for 10″), smoothly across the singular pose. With 0.1 the real LinuxCNC swung C by ±1.8° within a
-    /// few servo cycles at B = ±180° on the multi-tasking sample (3 mm of Y, 1.5 µm off the path after motion's
-    /// joint interpolation). Away from such poses the axis keeps (0.02/sin)² of its error (0.16 % at 30°). The tip at
-    /// the tool-offset length is exact either way (the slides can always place it).
-    double rotaryRegularization = 2.0;
+    /// as cnccomp::IkOptions::rotaryRegularization, acting only near a singular pose (singularZone): there the tool
+    /// axis cannot be turned by the rotary axes without swinging them. Chosen as axisWeight · singularZone, so the
+    /// pull and the axis weigh alike where the pull fades out.
+    double rotaryRegularization = 10.0;
+    /// cnccomp::IkOptions::singularZone: the sine of the angle between the tool axis and a rotary axis below which
+    /// the pull acts (0.1: 5.7°). Outside it the axis is met exactly; inside, a tool-axis error δ turns the rotary
+    /// axes by at most about δ/0.1 = 10·δ (0.014° for 5″), smoothly across the singular pose, and the tip at the
+    /// tool-offset length is exact everywhere (the slides can always place it). With a constant pull of 0.1 mm/rad
+    /// the real LinuxCNC swung C by ±1.8° within a few servo cycles at B = ±180° on the multi-tasking sample (3 mm
+    /// of Y, 1.5 µm off the path after motion's joint interpolation).
+    double singularZone = 0.1;
     /// cnccomp::IkOptions::polish. Off: the joints are a smooth function of the world words, which the trajectory
     /// needs (a polish switched on and off near a singular pose makes the joints jump).
     bool polish = false;

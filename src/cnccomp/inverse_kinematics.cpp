@@ -39,6 +39,28 @@ void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipI
     }
 }
 
+double rotarySingularValue(const MachineModel& m, const PoseJacobian& J) {
+    Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxAxes> A(3, 0);
+    for (int i = 0; i < m.axisCount(); ++i)
+        if (m.axisLink(i).kind == AxisKind::Rotary) {
+            A.conservativeResize(3, A.cols() + 1);
+            A.col(A.cols() - 1) = J.block<3, 1>(3, i);
+        }
+    if (A.cols() == 0) return 1.0;
+    const Eigen::MatrixXd G = A.transpose() * A;
+    const double lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
+    return std::sqrt(std::max(lambda, 0.0));
+}
+
+/// The pull's weight at the current Jacobian (IkOptions::rotaryRegularization, singularZone).
+static double pullWeight(const MachineModel& m, const PoseJacobian& J, const IkOptions& o) {
+    if (o.singularZone <= 0) return o.rotaryRegularization;
+    // Outside the zone a floor of 1e-4 keeps the system regular (a redundant rotary axis); its share of the axis
+    // error is (1e-4 · rotaryRegularization / (axisWeight · σ))², below 1e-8 for the component's values.
+    const double s = rotarySingularValue(m, J) / o.singularZone;
+    return o.rotaryRegularization * (s >= 1.0 ? 1e-4 : std::max(1.0 - s * s, 1e-4));
+}
+
 IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& tipInToolFrame, const AxisVector& start,
                        const IkOptions& o) {
     using System = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6 + kMaxAxes, kMaxAxes>;
@@ -60,10 +82,11 @@ IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& 
         A.middleRows<3>(3) = J.bottomRows<3>() * o.axisWeight;
         b.head<3>() = target.tip - p.tip;
         b.segment<3>(3) = (target.axis - p.axis) * o.axisWeight;
+        const double pull = pullWeight(m, J, o);
         for (int i = 0; i < n; ++i) {
             const bool rotary = m.axisLink(i).kind == AxisKind::Rotary;
-            A(6 + i, i) = rotary ? o.rotaryRegularization : 0.0;
-            b[6 + i] = rotary ? o.rotaryRegularization * (start[i] - r.q[i]) : 0.0;
+            A(6 + i, i) = rotary ? pull : 0.0;
+            b[6 + i] = rotary ? pull * (start[i] - r.q[i]) : 0.0;
         }
         const AxisVector step = A.colPivHouseholderQr().solve(b);
         r.q += step;

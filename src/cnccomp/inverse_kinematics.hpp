@@ -21,6 +21,10 @@ ToolPose toolPose(const Kinematics& k, const AxisVector& q, const Vec3& tipInToo
 /// finite differences on machines without component errors).
 void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, PoseJacobian& J);
 
+/// σ of IkOptions::singularZone: the smallest singular value of J's axis rows over the rotary axes of m (1 when the
+/// machine has no rotary axis).
+double rotarySingularValue(const MachineModel& m, const PoseJacobian& J);
+
 struct IkOptions {
     double tolerance = 1e-9;     ///< mm on the tip, and rad × axisWeight on the axis
     int maxIterations = 30;
@@ -31,6 +35,13 @@ struct IkOptions {
     /// for tilts below regularization/axisWeight (1e-3 rad) and still meets the tip exactly (the slides can).
     /// Away from such poses it costs a relative (regularization/axisWeight)² = 1e-6 of the axis correction.
     double rotaryRegularization = 0.1;
+    /// With singularZone > 0 the pull acts only near a singular pose, as rotaryRegularization·(1 − (σ/singularZone)²)
+    /// where σ < singularZone, σ being the smallest singular value of the tool axis' derivative over the rotary axes
+    /// (the sine of the angle between the tool axis and the rotary axis that cannot turn it): damped least squares
+    /// with variable damping (Nakamura & Hanafusa 1986; Chiaverini, Siciliano & Egeland 1994). Away from singular
+    /// poses the axis is met exactly; across one the rotary axes turn by at most about δ/singularZone for a tool-axis
+    /// error δ, smoothly. 0: the constant pull above.
+    double singularZone = 0.0;
     /// After the pulled solution, up to 4 steps without the pull where they lower the cost and swing no rotary axis by
     /// regularization/axisWeight or more: regular poses then meet the axis fully. Off, the solution is a smooth
     /// function of the target (no switch between polished and unpolished near a singular pose), as a joint
