@@ -5,6 +5,7 @@
 // backend's own apply model), round trips (files byte for byte), and the issue's own figures for the Fanuc case.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <map>
 
@@ -79,7 +80,9 @@ TEST(ControllerFit, ChosenFilesNeverLeaveMoreThanNoneOnEverySampleMachineAndBack
                 continue;
             }
             SCOPED_TRACE(fmt::format("{} / {}", stem, b->name()));
+            const auto t0 = std::chrono::steady_clock::now();
             const controllers::FitOutcome o = controllers::fitControllerValues(*b, m, d, w);
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             const controllers::FitFigures chosen = controllers::fitFigures(*b, m, d, o.written, w);
             EXPECT_FALSE(controllers::leavesMore(chosen, none))
                 << fmt::format("chosen '{}' leaves max {:.4f} RMS {:.4f} um; none {:.4f} / {:.4f}", o.chosen, chosen.maxTip / kUm,
@@ -90,9 +93,9 @@ TEST(ControllerFit, ChosenFilesNeverLeaveMoreThanNoneOnEverySampleMachineAndBack
             EXPECT_NEAR(reported.rmsTip, chosen.rmsTip, 1e-9);
             // The fit never does worse (RMS) than the copy or none where it is chosen.
             EXPECT_LE(chosen.rmsTip, std::min(o.copied.rmsTip, o.none.rmsTip) + 1e-12);
-            std::printf("  %-34s %-16s none %7.3f/%7.3f  copied %7.3f/%7.3f  fitted %7.3f/%7.3f  -> %s (%d values)\n", stem.c_str(),
-                        std::string(b->name()).c_str(), o.none.maxTip / kUm, o.none.rmsTip / kUm, o.copied.maxTip / kUm,
-                        o.copied.rmsTip / kUm, o.fitted.maxTip / kUm, o.fitted.rmsTip / kUm, o.chosen.c_str(), o.heldValues);
+            std::printf("  %-34s %-16s none %7.3f/%7.3f  copied %7.3f/%7.3f  fitted %7.3f/%7.3f  -> %s (%d values, %.2f s)\n",
+                        stem.c_str(), std::string(b->name()).c_str(), o.none.maxTip / kUm, o.none.rmsTip / kUm, o.copied.maxTip / kUm,
+                        o.copied.rmsTip / kUm, o.fitted.maxTip / kUm, o.fitted.rmsTip / kUm, o.chosen.c_str(), o.heldValues, seconds);
             ++pairs;
         }
     }
