@@ -219,6 +219,19 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
         Eigen::VectorXd x = Eigen::VectorXd::Zero(p);
         Eigen::VectorXd r = r0;
         double cost = r.squaredNorm();
+        // Start from the identified values of the held entries where they leave less than zero: the chord steps
+        // (the Jacobian at zero) then improve on the copy instead of on nothing, which matters where the files answer
+        // non-linearly (measured: Siemens on the HEIDENHAIN component sample, Fanuc on the B/C table with offsets).
+        {
+            Eigen::VectorXd xi(p);
+            for (int k = 0; k < p; ++k) xi[k] = identified.values[free[static_cast<size_t>(k)]];
+            try {
+                const Eigen::VectorXd ri = residual(setFree(xi));
+                if (ri.squaredNorm() < cost) x = xi, r = ri, cost = ri.squaredNorm();
+            } catch (const ModelError&) {
+                // the controller refuses the identified values: start from zero
+            }
+        }
         for (int it = 0; it < kChordSteps; ++it) {
             const Eigen::VectorXd dx = -(svd.solve(r)).cwiseProduct(scale);
             double t = 1.0;
