@@ -224,7 +224,8 @@ private:
     ProgramDialect d_;
     long n_ = 0;
     int plane_ = 17;
-    double toolLength_ = 0;
+    double toolLength_ = 0;  ///< passToolLength's L; zShift_ takes it only once G43.1 is written (init's G10 datum
+                             ///< line, written before it, is in unshifted machine coordinates)
     double lastFeed_ = -1;
     AxisVector pos_;
 };

@@ -40,15 +40,16 @@ void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipI
 }
 
 double rotarySingularValue(const MachineModel& m, const PoseJacobian& J) {
-    Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxAxes> A(3, 0);
+    // Fixed-capacity storage: called once per Gauss–Newton iteration, no allocation.
+    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes>;
+    int rotary[kMaxAxes], k = 0;
     for (int i = 0; i < m.axisCount(); ++i)
-        if (m.axisLink(i).kind == AxisKind::Rotary) {
-            A.conservativeResize(3, A.cols() + 1);
-            A.col(A.cols() - 1) = J.block<3, 1>(3, i);
-        }
-    if (A.cols() == 0) return 1.0;
-    const Eigen::MatrixXd G = A.transpose() * A;
-    const double lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
+        if (m.axisLink(i).kind == AxisKind::Rotary) rotary[k++] = i;
+    if (k == 0) return 1.0;
+    Small G(k, k);
+    for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) G(a, b) = J.block<3, 1>(3, rotary[a]).dot(J.block<3, 1>(3, rotary[b]));
+    const double lambda = Eigen::SelfAdjointEigenSolver<Small>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
     return std::sqrt(std::max(lambda, 0.0));
 }
 
