@@ -20,41 +20,22 @@ static void *shim_new(const char *fmt, va_list ap) {
     return &shim_pins[shim_npins++].value;
 }
 
-int hal_pin_float_newf(hal_pin_dir_t dir, hal_float_t **p, int id, const char *fmt, ...) {
-    va_list ap;
-    void *v;
-    (void)dir; (void)id;
-    va_start(ap, fmt);
-    v = shim_new(fmt, ap);
-    va_end(ap);
-    if (!v) return -1;
-    *p = (hal_float_t *)v;
-    return 0;
-}
-
-int hal_pin_bit_newf(hal_pin_dir_t dir, hal_bit_t **p, int id, const char *fmt, ...) {
-    va_list ap;
-    void *v;
-    (void)dir; (void)id;
-    va_start(ap, fmt);
-    v = shim_new(fmt, ap);
-    va_end(ap);
-    if (!v) return -1;
-    *p = (hal_bit_t *)v;
-    return 0;
-}
-
-int hal_pin_s32_newf(hal_pin_dir_t dir, hal_s32_t **p, int id, const char *fmt, ...) {
-    va_list ap;
-    void *v;
-    (void)dir; (void)id;
-    va_start(ap, fmt);
-    v = shim_new(fmt, ap);
-    va_end(ap);
-    if (!v) return -1;
-    *p = (hal_s32_t *)v;
-    return 0;
-}
+/* hal_pin_<type>_newf: one definition per HAL pin type, all on shim_new. */
+#define SHIM_PIN_NEWF(type)                                                                   \
+    int hal_pin_##type##_newf(hal_pin_dir_t dir, hal_##type##_t **p, int id, const char *fmt, ...) { \
+        va_list ap;                                                                           \
+        void *v;                                                                              \
+        (void)dir; (void)id;                                                                  \
+        va_start(ap, fmt);                                                                    \
+        v = shim_new(fmt, ap);                                                                \
+        va_end(ap);                                                                           \
+        if (!v) return -1;                                                                    \
+        *p = (hal_##type##_t *)v;                                                             \
+        return 0;                                                                             \
+    }
+SHIM_PIN_NEWF(float)
+SHIM_PIN_NEWF(bit)
+SHIM_PIN_NEWF(s32)
 
 void *hal_malloc(long int size) {
     const long words = (size + (long)sizeof(double) - 1) / (long)sizeof(double);
