@@ -56,6 +56,18 @@ TEST(InputMeaning, PlanFeedOffTheRealOneIsRefused) {
         EXPECT_NE(bad.out.find("feed=\"1000.0\""), std::string::npos) << bad.out;
         EXPECT_FALSE(std::filesystem::exists(dir.file("d2.csv")));
     }
+    // A file whose own '# feed:' line agrees with the wrong plan (the programmed feed, while the override ran the
+    // machine at 1000) is refused by the data as well: the line is checked against the plan, the data against both.
+    std::filesystem::create_directory(dir.file("said"));
+    for (const auto& e : std::filesystem::directory_iterator(dir.file("t")))
+        test::writeText(dir.file("said/" + e.path().filename().string()),
+                        replaceAll(test::readText(e.path().string()), "# feed: 1000\n", "# feed: 1020\n"));
+    test::writeText(dir.file("p.xml"), replaceAll(test::readText(p), "feed=\"1000\"", "feed=\"1020\""));
+    const auto said = test::runCli(fmt::format("identify --machine {} --plan {} --traces {} --out {}", m, dir.file("p.xml"),
+                                               dir.file("said"), dir.file("d3.csv")));
+    EXPECT_EQ(said.exitCode, 2) << said.out;
+    EXPECT_NE(said.out.find("The data give a feed of 1000.0 mm/min"), std::string::npos) << said.out;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("d3.csv")));
 }
 
 // A 4-column, names-only file without the format line, on the B/C machine where EC0Y and EC0B changed meaning: refused

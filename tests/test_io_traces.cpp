@@ -72,6 +72,23 @@ TEST(TraceUnits, OneFileInMillimetresAmongMicrometresIsRefused) {
     EXPECT_FALSE(fs::exists(dir.file("d.csv")));
 }
 
+// The whole set exported in mm and read under the default µm (issue 18: every result 1000× too small): no run spans
+// what a ball bar resolves; refused naming mm. Oracle: the simulator's known truth (the same files in µm read).
+TEST(TraceUnits, EveryFileInMillimetresIsRefused) {
+    test::ScratchDir dir("io-traces-all-mm");
+    const std::string traces = simulateInto(dir);
+    const MeasurementPlan plan = readPlanXml(kPlan);
+    for (const BallbarRun& r : plan.runs) scaleTrace(traces + "/" + r.name + ".csv", 1e-3);
+    const std::string e = inputErrorOf([&] { importRunTraces(traces, plan.runs); });
+    EXPECT_NE(e.find("likely in mm while the plan reads them in um"), std::string::npos) << e;
+    EXPECT_NE(e.find("below the 0.1 um a ball bar resolves"), std::string::npos) << e;
+    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
+                                dir.file("d.csv"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("likely in mm"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir.file("d.csv")));
+}
+
 // µm data read under length-unit="mm": ΔL of millimetres, beyond any ball bar's travel; refused naming µm.
 TEST(TraceUnits, MicrometreDataUnderMillimetreUnitIsRefused) {
     test::ScratchDir dir("io-traces-um");

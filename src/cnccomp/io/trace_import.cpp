@@ -70,6 +70,9 @@ constexpr double kUmInMm = 1e-3;
 constexpr double kNumericalZero = 1e-8;
 /// A span this many times the other runs' (or less) is taken for a unit mistake.
 constexpr double kUnitRatio = 200.0;
+/// The smallest step a ball bar resolves, mm: 0.1 µm, the resolution quoted for the Renishaw QC20-W [G: not read from
+/// the vendor's data sheet here].
+constexpr double kBallbarResolution = 1e-4;
 /// The largest |ΔL| a ball bar records: ±1 mm (Renishaw QC20-W measuring range [G]) or 1% of a long bar's length.
 double maxBallbarTravel(double barLength) { return std::max(1.0, 0.01 * barLength); }
 
@@ -477,6 +480,24 @@ std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::ve
     std::vector<MeasuredTrace> out;
     out.reserve(runs.size());
     for (const BallbarRun& r : runs) out.push_back(importRunTrace(OutputSet::fileIn(dir, r.name + ".csv"), r, machine));
+    // The whole set in a unit 1000x larger than the plan says (an mm export read under the default µm): every run
+    // spans less than a ball bar resolves (kBallbarResolution); a real machine's run shows at least the instrument's
+    // noise. A set whose runs are all numerically zero (a simulated perfect machine) is left alone.
+    double largest = 0;
+    size_t largestAt = 0;
+    for (size_t i = 0; i < out.size(); ++i) {
+        const double s = peakToPeak(out[i].trace.dL);
+        if (s > largest) largest = s, largestAt = i;
+    }
+    if (!out.empty() && largest > kNumericalZero && largest < kBallbarResolution) {
+        const double unit = runs[largestAt].capture.lengthUnit;
+        throw InputError(out[largestAt].path, 0,
+                         fmt::format("ΔL spans at most {:.4g} um over all {} run(s) (largest in this file), below the {:g} um "
+                                     "a ball bar resolves: the files are likely in {} while the plan reads them in {} "
+                                     "(length-unit of <instrument> or of each run)",
+                                     largest / kUmInMm, out.size(), kBallbarResolution / kUmInMm,
+                                     unit == 1e-3 ? "mm" : unit == 1e-6 ? "um" : "a larger unit", lengthUnitText(unit)));
+    }
     // Against the other runs: one file in another unit than the plan says (an mm export under a dL_um header) spans
     // 1000x less (or more) than the rest. Runs of one machine differ by a few times, not by hundreds.
     if (out.size() >= 3) {
