@@ -8,7 +8,10 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/units.hpp"
 #include "cnccomp/io/trace_import.hpp"
 #include "test_support.hpp"
 
@@ -99,6 +102,59 @@ TEST(TraceUnits, MicrometreDataUnderMillimetreUnitIsRefused) {
     EXPECT_NE(e.find("B-X.csv:"), std::string::npos) << e;
     EXPECT_NE(e.find("likely in um"), std::string::npos) << e;
     EXPECT_NE(e.find("±1 mm"), std::string::npos) << e;
+}
+
+/// Rewrites an angle-sampled cnccomp trace (one pass) with `per` samples a step, linearly interpolated between the
+/// file's own samples.
+void densify(const std::string& path, int per) {
+    std::ifstream in(path);
+    std::string line, out;
+    std::vector<std::pair<double, double>> rows;
+    bool header = false;
+    while (std::getline(in, line)) {
+        if (line.empty() || line[0] == '#' || !header) {
+            header = header || (!line.empty() && line[0] != '#');
+            out += line + "\n";
+            continue;
+        }
+        const size_t comma = line.find(',');
+        rows.emplace_back(std::stod(line.substr(0, comma)), std::stod(line.substr(comma + 1)));
+    }
+    for (size_t i = 0; i + 1 < rows.size(); ++i)
+        for (int k = 0; k < per; ++k) {
+            const double f = static_cast<double>(k) / per;
+            out += fmt::format("{:.6f},{:.6f}\n", rows[i].first + f * (rows[i + 1].first - rows[i].first),
+                               rows[i].second + f * (rows[i + 1].second - rows[i].second));
+        }
+    out += fmt::format("{:.6f},{:.6f}\n", rows.back().first, rows.back().second);
+    test::writeText(path, out);
+}
+
+// A densely sampled file (issue 18: a 38 MB trace took 81 s and 1.24 GB in identify) is averaged into bins of the
+// plan's step: the same deviations as the file at the plan's step, the summary says so. Oracle: the plan-step files
+// of the same simulation (the bins of a linear interpolant hold the plan's samples up to the curvature over a step).
+// The speed is measured by BM_ImportDenseTrace (tests/bench), not here.
+TEST(TraceUnits, DenseFileIsAveragedIntoThePlansStep) {
+    test::ScratchDir dir("io-traces-dense");
+    const std::string traces = simulateInto(dir);
+    const auto plain = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces +
+                                    " --out " + dir.file("plain.csv"));
+    ASSERT_EQ(plain.exitCode, 0) << plain.out;
+    const MeasurementPlan plan = readPlanXml(kPlan);
+    densify(traces + "/B-X.csv", 40);
+    const MeasuredTrace t = importRunTrace(traces + "/B-X.csv", plan.runs.front());
+    EXPECT_EQ(t.summary.binnedFrom, 359 * 40 + 1);  // a whole turn: -180..179°, 360 samples
+    EXPECT_EQ(t.summary.binnedInto, 360);
+    ASSERT_EQ(t.trace.angleDeg.size(), 360u);
+    const auto dense = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces +
+                                    " --out " + dir.file("dense.csv"));
+    ASSERT_EQ(dense.exitCode, 0) << dense.out;
+    EXPECT_NE(dense.out.find("run B-X: 14361 samples averaged into 360 bins of the plan's 1° step"), std::string::npos)
+        << dense.out;
+    const MachineModel m = readMachineXml(kMachine);
+    const DeviationSet a = readDeviationCsv(dir.file("plain.csv"), m), b = readDeviationCsv(dir.file("dense.csv"), m);
+    for (size_t i = 0; i < m.deviations.size(); ++i)
+        EXPECT_NEAR(a.isoValue(static_cast<int>(i)), b.isoValue(static_cast<int>(i)), 0.02 * kUm) << m.deviations[i].name;
 }
 
 // A folder standing where a trace belongs is named as a folder (issue 18 called it an "empty file").

@@ -147,11 +147,16 @@ void run(Options o) {
     if (res.report) printReport(*res.report);
     printCircularTests(runs);
     if (res.measured)
-        for (size_t i = 0; i < res.measured->ballbar.size() && plan; ++i)
-            if (const TraceImportSummary& s = res.measured->ballbar[i].summary; s.feedEstimate > 0)
+        for (size_t i = 0; i < res.measured->ballbar.size() && plan; ++i) {
+            const TraceImportSummary& s = res.measured->ballbar[i].summary;
+            if (s.feedEstimate > 0)
                 fmt::print("feed from the data, run {}: {:.1f} mm/min (plan {:g}, {:+.2f} %, allowed ±{:.2f} %)\n",
                            plan->runs[i].name, s.feedEstimate, plan->runs[i].capture.feed,
                            100 * (s.feedEstimate / plan->runs[i].capture.feed - 1), 100 * s.feedTolerance);
+            if (s.binnedFrom > 0)
+                fmt::print("run {}: {} samples averaged into {} bins of the plan's {:g}° step\n", plan->runs[i].name,
+                           s.binnedFrom, s.binnedInto, std::abs(plan->runs[i].stepDeg));
+        }
     printDeviations(res.deviations, truth ? &*truth : nullptr);
 }
 

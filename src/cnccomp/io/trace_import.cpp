@@ -17,11 +17,12 @@
 namespace cnccomp {
 namespace {
 
+/// One sample (24 bytes: a 1 kHz file has millions of them).
 struct Row {
     int line = 0;
+    int label = -1;               ///< index of the pass label in the file's list of labels (-1 without a pass column)
     double x = 0;                 ///< angle (deg) or time (s)
-    std::optional<double> dL;     ///< mm; empty = missing sample
-    std::string pass;             ///< pass label ("" without a pass column)
+    double dL = 0;                ///< mm (rows without a value are counted missing and not kept)
 };
 
 std::string lower(std::string s) {
@@ -174,6 +175,39 @@ double linearPathRadius(const BallbarRun& r) {
 
 namespace {
 
+/// Samples per plan step above which a pass is averaged into bins of the step.
+constexpr double kBinFactor = 4.0;
+
+/// Mean angle and ΔL of the rows nearest each sweep angle origin + k·step (the rows in sweep order; a bin's line is
+/// its first row's). Adds the rows averaged to `sum.binnedFrom` and the bins to `sum.binnedInto`.
+std::vector<Row> binnedRows(const std::vector<Row>& rows, double origin, double step, TraceImportSummary& sum) {
+    std::vector<Row> out;
+    long current = 0;
+    double angle = 0, value = 0;
+    int n = 0, firstLine = 0;
+    const auto flush = [&] {
+        Row b;
+        b.line = firstLine;
+        b.x = angle / n;
+        b.dL = value / n;
+        out.push_back(std::move(b));
+        angle = value = 0;
+        n = 0;
+    };
+    for (const Row& r : rows) {
+        const long k = std::lround((r.x - origin) / step);
+        if (n > 0 && k != current) flush();
+        if (n == 0) current = k, firstLine = r.line;
+        angle += r.x;
+        value += r.dL;
+        ++n;
+    }
+    if (n > 0) flush();
+    sum.binnedFrom += static_cast<int>(rows.size());
+    sum.binnedInto += static_cast<int>(out.size());
+    return out;
+}
+
 MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const RunCapture& cap, const std::string& machine) {
     CsvReader reader(path);
     const CsvRow& header = reader.header();
@@ -203,6 +237,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
 
     // Rows → samples, one row at a time (a large file streams).
     std::vector<Row> rows;
+    std::vector<std::string> labels;  // pass labels, one entry per change of label down the file
     CsvRow csvRow;
     while (reader.next(csvRow)) {
         ++sum.rows;
@@ -221,8 +256,10 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         r.x = parseCell(path, line, nameX, cell(cX), separator, cap.decimal) * xUnit;
         r.dL = parseCell(path, line, nameL, cell(cL), separator, cap.decimal) * cap.lengthUnit;
         if (cP >= 0) {
-            r.pass = cell(cP);
-            if (r.pass.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", nameP));
+            const std::string& label = cell(cP);
+            if (label.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", nameP));
+            if (labels.empty() || labels.back() != label) labels.push_back(label);
+            r.label = static_cast<int>(labels.size()) - 1;
         }
         rows.push_back(std::move(r));
     }
@@ -234,11 +271,11 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         double lo = HUGE_VAL, hi = -HUGE_VAL;
         const Row* worst = &rows.front();
         for (const Row& r : rows) {
-            lo = std::min(lo, *r.dL);
-            hi = std::max(hi, *r.dL);
-            if (std::abs(*r.dL) > std::abs(*worst->dL)) worst = &r;
+            lo = std::min(lo, r.dL);
+            hi = std::max(hi, r.dL);
+            if (std::abs(r.dL) > std::abs(worst->dL)) worst = &r;
         }
-        const double size = cap.relativeLength ? hi - lo : std::abs(*worst->dL);
+        const double size = cap.relativeLength ? hi - lo : std::abs(worst->dL);
         const double limit = maxBallbarTravel(run->LB);
         if (size > limit)
             throw InputError(path, worst->line,
@@ -256,21 +293,22 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
     if (cP >= 0) {
         std::vector<std::string> seen;
         for (const Row& r : rows) {
-            if (passes.empty() || r.pass != seen.back()) {
-                if (std::find(seen.begin(), seen.end(), r.pass) != seen.end())
+            const std::string& label = labels[static_cast<size_t>(r.label)];
+            if (passes.empty() || label != seen.back()) {
+                if (std::find(seen.begin(), seen.end(), label) != seen.end())
                     throw InputError(path, r.line, fmt::format("pass '{}' starts again after another pass; the rows of a "
-                                                               "pass must follow each other", r.pass));
-                seen.push_back(r.pass);
+                                                               "pass must follow each other", label));
+                seen.push_back(label);
                 Pass p;
-                const int d = labelDirection(r.pass);
+                const int d = labelDirection(label);
                 if (d != 0) {
                     p.direction = d;
                 } else {
-                    const auto k = parseNumber(r.pass);
+                    const auto k = parseNumber(label);
                     if (!k || *k != std::floor(*k) || *k < 1 || *k > static_cast<double>(planned.size()))
                         throw InputError(path, r.line,
                                          fmt::format("pass '{}': expected ccw, cw, +, - or a pass number 1..{} (the "
-                                                     "plan's directions)", r.pass, planned.size()));
+                                                     "plan's directions)", label, planned.size()));
                     p.direction = planned[static_cast<size_t>(*k) - 1];
                 }
                 passes.push_back(std::move(p));
@@ -299,7 +337,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
             if (passes[1].rows.empty()) passes.pop_back();
         } else {
             passes.resize(1);
-            passes[0].rows = rows;
+            passes[0].rows = std::move(rows);
         }
         for (size_t i = 0; i < passes.size(); ++i) passes[i].direction = planned[std::min(i, planned.size() - 1)];
     }
@@ -370,7 +408,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         const bool fullTurn = hi - lo >= 360.0 - 1e-9;
         std::vector<std::vector<double>> ang(passes.size()), val(passes.size());
         for (size_t p = 0; p < passes.size(); ++p)
-            for (const Row& r : passes[p].rows) ang[p].push_back(r.x), val[p].push_back(*r.dL);
+            for (const Row& r : passes[p].rows) ang[p].push_back(r.x), val[p].push_back(r.dL);
         double v1 = 0, t1 = 0, v2 = 0, t2 = 0;
         if (passes.size() == 2) {
             // Both ends of the sweep are seen by both passes: at the first pass's start long apart, at its end just
@@ -398,7 +436,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         double tLast = tFirst;
         for (size_t p = 0; p < passes.size(); ++p)
             for (size_t i = 0; i < passes[p].rows.size(); ++i) {
-                *passes[p].rows[i].dL -= rate * (tau[p][i] - tFirst);
+                passes[p].rows[i].dL -= rate * (tau[p][i] - tFirst);
                 tLast = std::max(tLast, tau[p][i]);
             }
         sum.driftRemoved = rate * (tLast - tFirst);
@@ -456,13 +494,19 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
             throw InputError(path, kept.empty() ? headerLine : kept.back().line,
                              fmt::format("{} sample(s){}; at least {} are needed to fit the trace", kept.size(), which,
                                          minimum));
+        // A densely sampled file (a 1 kHz instrument: thousands of samples a degree) is averaged into bins of the plan's
+        // step, centred on its sweep angles: the fit sees the step the plan asked for, with each bin's mean angle and
+        // mean ΔL (the noise of a bin drops by √n; the harmonics a step can carry are unchanged). Only beyond
+        // kBinFactor samples a step, so files recorded at the plan's step are fitted sample by sample.
+        if (run && step > 0 && static_cast<double>(kept.size()) > kBinFactor * (std::floor((hi - lo) / step + 1e-9) + 1))
+            kept = binnedRows(kept, run->startDeg, step, sum);
         DirectedTrace dt;
         dt.direction = d;
         for (const Row& r : kept) {
             dt.trace.angleDeg.push_back(r.x);
-            dt.trace.dL.push_back(*r.dL);
+            dt.trace.dL.push_back(r.dL);
             out.trace.angleDeg.push_back(r.x);
-            out.trace.dL.push_back(*r.dL);
+            out.trace.dL.push_back(r.dL);
         }
         out.passes.push_back(std::move(dt));
     }

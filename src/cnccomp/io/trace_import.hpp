@@ -14,7 +14,8 @@
 //  - empty ΔL cells are missing samples (skipped and counted); any other text where a number belongs is an error.
 // Samples outside the sweep (feed-in / feed-out overshoot) are dropped. Each pass must then run in its direction,
 // cover the sweep without a gap wider than max(4 steps, 2°), and hold at least 3/4 of the samples the plan's step
-// gives (and at least five). Violations are InputErrors naming the file and line.
+// gives (and at least five). Violations are InputErrors naming the file and line. A pass with more than four samples a
+// step is then averaged into bins of the plan's step (mean angle, mean ΔL; TraceImportSummary::binnedFrom/binnedInto).
 #include <string>
 #include <vector>
 
@@ -33,6 +34,8 @@ struct TraceImportSummary {
     double driftRemoved = 0;  ///< ΔL drift removed between the first and the last sample, mm (0: not asked)
     double feedEstimate = 0;  ///< time-sampled: the feed the passes' durations give, mm/min (0: not estimated)
     double feedTolerance = 0; ///< relative deviation from the plan's feed allowed for that file (refused beyond)
+    int binnedFrom = 0;       ///< samples averaged into bins of the plan's step (0: the file was not denser than 4 a step)
+    int binnedInto = 0;       ///< the bins they gave
 };
 
 struct MeasuredTrace {

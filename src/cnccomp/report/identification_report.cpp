@@ -75,6 +75,9 @@ std::vector<RunSection> measuredRunSections(const MachineModel& m, const Measure
         const TraceImportSummary& sum = t.summary;
         s.notes.push_back(fmt::format("{}-sampled file: {} rows, {} kept, {} missing, {} outside the sweep (overshoot)", sum.layout,
                                       sum.rows, t.trace.dL.size(), sum.missing, sum.trimmed));
+        if (sum.binnedFrom > 0)
+            s.notes.push_back(fmt::format("{} samples in the sweep averaged into {} bins of the plan's {:g}° step (more than "
+                                          "four samples a step)", sum.binnedFrom, sum.binnedInto, std::abs(run.stepDeg)));
         if (sum.feedEstimate > 0)
             s.notes.push_back(fmt::format("feed from the passes' durations: {:.1f} mm/min (plan {:g}, within {:.2f} %)",
                                           sum.feedEstimate, run.capture.feed, 100 * sum.feedTolerance));
