@@ -26,20 +26,7 @@ const std::string kComponentsTruth = "samples/deviations/dbb5-table-table-bc-com
 
 DeviationSet componentsTruth() { return readDeviationCsv(test::sourcePath(kComponentsTruth), test::tableTableBc()); }
 
-Observations simulateBc(const DeviationSet& truth, double noiseUm, unsigned seed) {
-    const MachineModel& m = test::tableTableBc();
-    const Kinematics k(m, truth);
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> noise(0.0, noiseUm * kUm);
-    std::vector<BallbarTrace> traces;
-    for (const Dbb5Run& r : test::dbb5PlanBc().dbb5Runs) {
-        BallbarTrace t = simulateDbb5(k, r);
-        if (noiseUm > 0)
-            for (double& v : t.dL) v += noise(rng);
-        traces.push_back(t);
-    }
-    return dbb5Observations(m, test::dbb5PlanBc().dbb5Runs, traces);
-}
+using test::simulateBc;
 
 std::vector<int> eleven() {
     std::vector<int> d = dbb5LocationDeviations(test::tableTableBc(), {});

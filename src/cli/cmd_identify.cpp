@@ -122,6 +122,7 @@ void run(Options o) {
                    {"solver", fmt::format("{}: {} after {} iteration(s)", rep.solver, rep.termination, rep.iterations)},
                    {"fit", fmt::format("{} samples, rank {}/{}, condition number {:.4g}, sigma {:.4f} µm", rep.observations,
                                        rep.rank, rep.unknowns, rep.conditionNumber, rep.sigma / kUm)}};
+        if (!rep.stages.empty()) d.facts.push_back({"fitted in two stages", rep.stages});
         if (!rep.adequacy.fits) d.alarms.push_back("WARNING: " + rep.adequacy.message);
         for (const std::string& w : rep.warnings)
             if (rep.adequacy.fits || w != rep.adequacy.message) d.warnings.push_back(w);
@@ -185,6 +186,9 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--params", r.params,
                   "least squares: deviations to identify, ISO names or aliases (comma list) or all; default: all for "
                   "ball-bar and mixed plans, the eleven location and squareness errors for R-test location and DBB5");
+    c->add_flag("--one-stage", r.oneStage,
+                "least squares: fit every run at once (default: what the runs moving only linear axes determine, e.g. "
+                "the squareness from the DBB5 XY/YZ/ZX circles, is fitted from them first, then held)");
     c->add_option("--observe", r.observe,
                   "least squares on ball-bar runs: traces (every raw sample) or eccentricity (fitted circle centres)")
         ->capture_default_str();

@@ -13,6 +13,7 @@
 #include "cnccomp/identification/dbb5_observation.hpp"
 #include "cnccomp/identification/eccentricity_observation.hpp"
 #include "cnccomp/identification/lsq.hpp"
+#include "cnccomp/identification/staged_fit.hpp"
 #include "cnccomp/identification/parameters.hpp"
 #include "cnccomp/identification/plan_observations.hpp"
 #include "cnccomp/identification/rtest_axis_tables.hpp"
@@ -110,6 +111,7 @@ IdentifyOptions engineOptions(const IdentifyRequest& r, std::vector<int> default
     io.rankTolerance = r.rankTolerance;
     io.monteCarlo = r.monteCarlo;
     io.seed = r.seed;
+    io.staged = !r.oneStage;
     io.bounds = parseBounds(m, r.bounds);
     if (!r.start.empty()) io.start = readDeviationCsv(r.start, m);
     if (r.plan && std::isfinite(r.plan->noiseUm)) io.statedNoise = r.plan->noiseUm * kUm;
@@ -146,7 +148,7 @@ IdentifyOutcome generalLeastSquares(const IdentifyRequest& r, std::vector<int> d
         throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", r.observe));
     }
     const IdentifyOptions io = engineOptions(r, std::move(defaults));
-    IdentificationResult res = identify(m, obs, io);
+    IdentificationResult res = identifyStaged(m, obs, io);
     const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
                                           [&](int i) { return res.deviations.present[static_cast<size_t>(i)] != 0; });
     IdentifyOutcome out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};
@@ -489,6 +491,7 @@ void printReport(const IdentificationReport& r) {
     for (const RunResidual& rr : r.runs)
         fmt::print("{:<18} {:>8} {:>14.4f} {:>14.4f}\n", rr.run, rr.samples, rr.rmsBefore / kUm, rr.rmsAfter / kUm);
     printAdequacy(r.adequacy);
+    if (!r.stages.empty()) fmt::print("fitted in two stages: {}\n", r.stages);
     for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
 }
 

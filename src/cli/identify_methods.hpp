@@ -32,6 +32,7 @@ struct IdentifyRequest {
     std::string outer, inner;               ///< rotary axes of a cradle ("" = the machine's workpiece-side pair)
     std::string volumetricRun;              ///< R-test location: run to compare measured and modelled displacements
     bool components = false;                ///< DBB5: also the component errors of the table axis from its on-axis runs
+    bool oneStage = false;                  ///< least squares: one fit of every run (no stage for the linear-axis runs)
 };
 
 /// One extra output file (angles table, ISO 230-4 table, volumetric comparison, profiles), staged by the command.

@@ -24,6 +24,7 @@ public:
     std::vector<double> sweepAnglesDeg() const override { return anglesDeg_; }
     /// The turning axis of a rotary circle; every rotary axis the machine moves in a cone frustum; none for linear circles.
     std::vector<std::string> turningAxes() const override { return turning_; }
+    bool movesOnlyLinearAxes() const override { return run_.kind == Dbb5Run::Kind::LinearCircle; }
 
     const Dbb5Run& run() const { return run_; }
 

@@ -11,6 +11,12 @@ namespace cnccomp {
 JacobianSvd decomposeJacobian(const Eigen::MatrixXd& J, double rankTolerance, const Eigen::VectorXd* r) {
     const Eigen::Index m = J.rows(), n = J.cols();
     JacobianSvd out;
+    if (n == 0) {  // no unknown the measurements can see (an empty observable subspace): rank 0, nothing to decompose
+        out.singular = Eigen::VectorXd::Zero(0);
+        out.V = Eigen::MatrixXd::Zero(0, 0);
+        if (r) out.projected = Eigen::VectorXd::Zero(0);
+        return out;
+    }
     Eigen::MatrixXd R;
     Eigen::VectorXd g;
     if (m > n) {

@@ -33,6 +33,7 @@ struct IdentifyOptions {
     std::optional<DeviationSet> start;  ///< starting values; deviations not estimated keep these values
     double statedNoise = std::numeric_limits<double>::quiet_NaN();  ///< instrument noise, mm (plan noise-um)
     std::string componentOption = "--params all";  ///< the option named when component errors seem missing
+    bool staged = true;                 ///< identifyStaged(): fit what the linear-axis runs determine first
 };
 
 struct IdentificationResult {

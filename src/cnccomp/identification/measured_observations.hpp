@@ -31,6 +31,9 @@ public:
     void predict(const Kinematics& k, const double* nuisance, double* out) const override;
     bool jacobian(const DifferentiableMachine& m, const double* nuisance, const std::vector<int>& flat,
                   Eigen::Ref<Eigen::MatrixXd> J) const override;
+    std::vector<double> sweepAnglesDeg() const override { return inner_->sweepAnglesDeg(); }
+    std::vector<std::string> turningAxes() const override { return inner_->turningAxes(); }
+    bool movesOnlyLinearAxes() const override { return inner_->movesOnlyLinearAxes(); }
 
 private:
     std::unique_ptr<ObservationModel> inner_;

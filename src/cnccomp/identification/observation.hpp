@@ -112,6 +112,10 @@ public:
     /// Rotary axes that turn during the run (their component errors are what a residual pattern over the sweep
     /// angle points to); empty when only linear axes move.
     virtual std::vector<std::string> turningAxes() const { return {}; }
+    /// True only for a run known to move the linear axes alone, every rotary axis held (a circle in a plane of two
+    /// linear axes): what it determines is fitted from such runs first (identification/staged_fit.hpp). False when
+    /// not known.
+    virtual bool movesOnlyLinearAxes() const { return false; }
 };
 
 using Observations = std::vector<std::unique_ptr<ObservationModel>>;

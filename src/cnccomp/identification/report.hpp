@@ -97,6 +97,7 @@ struct IdentificationReport {
     Eigen::MatrixXd covariance;          ///< internal units, parameter order; NaN rows for unidentified ones
     std::vector<std::string> warnings;
     Adequacy adequacy;                   ///< the residual against the noise (warnings[0] when the model does not fit)
+    std::string stages;                  ///< how a staged fit went (staged_fit.hpp); empty for one fit of every run
 
     /// Index of a parameter by name or alias, or -1.
     int find(const std::string& nameOrAlias) const;

@@ -215,6 +215,7 @@ std::string formatReportJson(const IdentificationReport& r) {
         w.o << ']';
     }
     w.close(']');
+    if (!r.stages.empty()) w.field("stages", r.stages);
     w.strings("warnings", r.warnings);
     w.close('}');
     w.o << '\n';
