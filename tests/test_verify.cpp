@@ -18,6 +18,7 @@
 #include "cnccomp/verify_sources.hpp"
 #include "test_deviation_text.hpp"
 #include "test_support.hpp"
+#include "cnccomp/identification/dbb5_run.hpp"
 
 namespace cnccomp {
 namespace {

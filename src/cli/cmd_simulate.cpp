@@ -25,6 +25,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_csv.hpp"
 #include "cnccomp/io/trace_export.hpp"
+#include "cnccomp/identification/dbb5_run.hpp"
 
 namespace cnccomp::cli {
 namespace {

@@ -5,30 +5,11 @@
 //  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute (seed 002);
 //  <rtest>        R-test run (seed 001/004): ball on the table, nest on the spindle, rotary sweeps;
 //  <dbb5>         DBB5 run (ball bar held at 45°): linear circle in a plane, rotary-axis circle, or cone frustum.
-#include <limits>
 #include <string>
-#include <vector>
 
-#include "cnccomp/ballbar.hpp"
-#include "cnccomp/identification/dbb5_run.hpp"
-#include "cnccomp/identification/rtest_run.hpp"
+#include "cnccomp/measurement/plan.hpp"
 
 namespace cnccomp {
-
-struct MeasurementPlan {
-    std::string machine;      ///< machine name the plan was made for (may be empty)
-    int line = 0;             ///< line of <plan> in the file it was read from (0 when not read from a file)
-    std::string description;
-    /// Stated noise of the instrument (one sample's standard deviation), µm: <plan noise-um="0.2">; NaN = not stated.
-    /// The model-adequacy test (identification/adequacy.hpp) uses it for runs without repeated passes.
-    double noiseUm = std::numeric_limits<double>::quiet_NaN();
-    std::vector<BallbarRun> runs;          ///< <run>
-    std::vector<BallbarRun> absoluteRuns;  ///< <absolute-run>
-    std::vector<RtestRun> rtestRuns;       ///< <rtest>
-    std::vector<Dbb5Run> dbb5Runs;         ///< <dbb5>
-    /// Total number of runs of every kind.
-    size_t runCount() const { return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size(); }
-};
 
 /// Attributes of <run> and <absolute-run>: name (a plain file name: DIR/<name>.csv), test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
 /// tool-ball-offset / work-ball-offset ("x y z" mm), estimate-mounting (none|tool|work|both: mounting offsets as
