@@ -18,6 +18,7 @@
 #include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/eccentricity_csv.hpp"
+#include "cnccomp/io/linear_circle_trace.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -50,7 +51,7 @@ void run(const Options& o) {
     if (plan.runCount() == 0) throw ModelError(fmt::format("plan '{}' has no runs", o.plan));
     if (!o.instrument.empty() && o.instrument != "time" && o.instrument != "angle")
         throw InputError("--instrument", 0, fmt::format("'{}' is not time or angle", o.instrument));
-    if (!o.instrument.empty() && plan.runs.empty())
+    if (!o.instrument.empty() && plan.runs.empty() && plan.circleRuns.empty())
         throw ModelError(fmt::format("--instrument: plan '{}' has no ball-bar runs", o.plan));
     const Kinematics k(m, d);
     std::mt19937_64 rng(o.seed);
@@ -82,6 +83,20 @@ void run(const Options& o) {
             pending.push_back({r.name + ".csv", r.name, o.instrument + "-sampled", n,
                                [text = std::move(text)](std::ostream& out) { out << text; }});
         }
+    }
+    // Circles of the linear axes: always as the instrument records them (both passes with their feed-in and feed-out
+    // arcs), angle-sampled unless --instrument time.
+    for (const LinearCircleRun& r : plan.circleRuns) {
+        std::vector<DirectedTrace> passes = simulateLinearCircle(k, r);
+        size_t n = 0;
+        for (DirectedTrace& p : passes) {
+            if (o.noiseUm > 0)
+                for (double& v : p.trace.dL) v += noise(rng);
+            n += p.trace.dL.size();
+        }
+        std::string text = formatLinearCircleTrace(r, passes, o.instrument == "time", m.name);
+        pending.push_back({r.name + ".csv", r.name, "circle " + std::string(linearPlaneName(r.plane)), n,
+                           [text = std::move(text)](std::ostream& out) { out << text; }});
     }
     for (const BallbarRun& r : plan.absoluteRuns) addTrace(r.name, simulateAbsoluteRun(k, r), "absolute bar", &r);
     for (const Dbb5Run& r : plan.dbb5Runs) addTrace(r.name, simulateDbb5(k, r), "DBB5", nullptr);

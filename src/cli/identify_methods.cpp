@@ -1,5 +1,7 @@
 #include "cli/identify_methods.hpp"
 
+#include "cli/identify_circle.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -431,6 +433,7 @@ IdentifyOutcome runIdentification(const IdentifyRequest& r) {
         case PlanMethod::RtestLocation: return rtestLocation(r);
         case PlanMethod::RtestTables: return rtestTables(r);
         case PlanMethod::Dbb5: return dbb5(r);
+        case PlanMethod::LinearCircle: return identifyLinearCircles(r);
     }
     throw ModelError("unknown plan method");
 }
