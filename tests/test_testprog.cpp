@@ -60,6 +60,7 @@ void expectSamePose(const MachineModel& m, const AxisVector& got, const AxisVect
 /// The commands the simulation uses, straight from the simulation's own functions (not from RunMotion).
 AxisVector simulationCommands(const MachineModel& m, const testprog::RunMotion& r, double t) {
     if (r.ballbar) return runCommands(m, *r.ballbar, t * kDeg);
+    if (r.circle) return linearCircleCommands(m, *r.circle, t);
     if (r.dbb5) return dbb5Commands(m, *r.dbb5, t);
     static std::map<const RtestRun*, std::vector<AxisVector>> cache;
     auto it = cache.find(r.rtest);
@@ -69,11 +70,13 @@ AxisVector simulationCommands(const MachineModel& m, const testprog::RunMotion& 
 AxisVector simulationSetup(const MachineModel& m, const testprog::RunMotion& r) {
     if (r.ballbar) return setupCommands(m, *r.ballbar);
     if (r.dbb5) return dbb5SetupCommands(m, *r.dbb5);
+    if (r.circle) return linearCircleCentreCommands(m, *r.circle);
     return rtestCommands(m, *r.rtest).front();
 }
 std::vector<double> simulationSamples(const testprog::RunMotion& r) {
     if (r.ballbar) return r.ballbar->anglesDeg();
     if (r.dbb5) return r.dbb5->anglesDeg();
+    if (r.circle) return r.circle->dataAnglesDeg();
     std::vector<double> t;
     for (int i = 0; i < r.rtest->sampleCount(); ++i) t.push_back(i);
     return t;
