@@ -258,5 +258,40 @@ TEST(LinearCircleCli, CirclesMixedWithOtherRunsAreRefused) {
     EXPECT_NE(r.out.find("put the <circle> runs in a plan of their own"), std::string::npos) << r.out;
 }
 
+
+namespace table_xy {
+
+TEST(LinearCircleCli, TableMovingXYRoundTripAndTheGantrysProgram) {
+    // A knee mill whose table carries X and Y (described ISO 841 way: the table moves -X for +X): its squareness X-Y is
+    // the rotation of the X table, EC0X, recovered through the same route; its test programs are the gantry's (the
+    // circle is given in axis commands: nothing is mirrored).
+    const std::string machine = test::sourcePath("samples/machines/mill-3axis-table-xy.xml");
+    const std::string plan = test::sourcePath("samples/plans/mill-3axis-table-xy-circles.xml");
+    const std::string truthPath = test::sourcePath("samples/deviations/mill-3axis-table-xy-truth.csv");
+    test::ScratchDir dir("circle-cli-table");
+    ASSERT_EQ(test::runCli("simulate --machine " + machine + " --plan " + plan + " --deviations " + truthPath + " --out " +
+                           dir.file("traces")).exitCode, 0);
+    const auto r = test::runCli("identify --machine " + machine + " --plan " + plan + " --traces " + dir.file("traces") +
+                                " --out " + dir.file("d.csv"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const MachineModel& m = test::sampleMachine("mill-3axis-table-xy");
+    const DeviationSet got = readDeviationCsv(dir.file("d.csv"), m), truth = readDeviationCsv(truthPath, m);
+    for (const char* name : {"EC0X", "EA0Z", "EB0Z"})
+        EXPECT_NEAR(got.get(name), truth.get(name), 0.01 * std::abs(truth.get(name))) << name;
+    const auto programLines = [&](const std::string& mach, const std::string& pl, const std::string& out) {
+        EXPECT_EQ(test::runCli("testprog --machine " + mach + " --plan " + pl + " --out " + out).exitCode, 0);
+        std::string arcs;
+        std::ifstream in(out + "/TP01_xy.ngc");
+        for (std::string line; std::getline(in, line);)
+            if (std::regex_search(line, std::regex("^N[0-9]+ G[23] "))) arcs += line + "\n";
+        return arcs;
+    };
+    const std::string table = programLines(machine, plan, dir.file("tp-table"));
+    EXPECT_GT(table.size(), 1000u);
+    EXPECT_EQ(table, programLines(kMachine, kPlan, dir.file("tp-gantry")));
+}
+
+}  // namespace table_xy
+
 }  // namespace
 }  // namespace cnccomp

@@ -1,5 +1,6 @@
 #include "cnccomp/linear_circle_identify.hpp"
 
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -30,14 +31,16 @@ std::vector<LinearCirclePass> modelPasses(const LinearCircleRun& run, const std:
     return out;
 }
 
-/// ISO 230-1 name of the squareness of a plane's axes.
-const char* squarenessName(LinearPlane p) {
-    switch (p) {
-        case LinearPlane::XY: return "EC0Y";
-        case LinearPlane::YZ: return "EA0Z";
-        case LinearPlane::ZX: return "EB0Z";
-    }
-    return "?";
+/// ISO 230-1 name of the squareness of a plane's axes in the machine: the rotation of the downstream slide of the two,
+/// EC0Y / EA0Z / EB0Z for slides stacked X → Y → Z, EC0X / EA0Y / EB0X where the chain stacks them the other way (a
+/// table X on a saddle Y). The first the machine has; the preferred name when it has none.
+std::string squarenessName(const MachineModel& m, LinearPlane p) {
+    const std::array<const char*, 2> names = p == LinearPlane::XY   ? std::array<const char*, 2>{"EC0Y", "EC0X"}
+                                             : p == LinearPlane::YZ ? std::array<const char*, 2>{"EA0Z", "EA0Y"}
+                                                                    : std::array<const char*, 2>{"EB0Z", "EB0X"};
+    for (const char* n : names)
+        if (m.deviationIndex(n) >= 0) return n;
+    return names[0];
 }
 
 const LinearCircleParameter* parameter(const LinearCircleFit& fit, const std::string& name) {
@@ -111,7 +114,7 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
     for (size_t i = 0; i < runs.size(); ++i) {
         const LinearCircleRun& run = runs[i];
         const LinearCircleRunResult& r = out.runs[i];
-        const std::string iso = squarenessName(run.plane);
+        const std::string iso = squarenessName(m, run.plane);
         const std::string pname = fmt::format("squareness {}", linearPlaneName(run.plane));
         const LinearCircleParameter* p = parameter(r.fit, pname);
         if (m.deviationIndex(iso) < 0) {

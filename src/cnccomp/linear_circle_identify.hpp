@@ -4,7 +4,8 @@
 // G per pass, F, hysteresis H) and its diagnostics identified on the exact model (linear_circle_model.hpp: value,
 // 95 % interval, share of the circularity, ranked; unidentified ones with their confounded groups), headed by the
 // test conditions. The squareness of each plane is also written into the machine's deviation set under its ISO
-// 230-1 name (XY → EC0Y, YZ → EA0Z, ZX → EB0Z) when the machine has it: value = squareness / s, with s the
+// 230-1 name when the machine has it (XY → EC0Y or EC0X, YZ → EA0Z or EA0Y, ZX → EB0Z or EB0X: the rotation of the
+// downstream slide of the pair in the machine's chain): value = squareness / s, with s the
 // squareness the same circle identifies on the nominal machine with that deviation at 1″ (the machine's own
 // kinematics give the sign and the scale, table-moving axes included). Several circles of one plane are combined
 // by inverse variance. Nothing else of the diagnostics has a place in the deviation set yet: they are reported.
@@ -47,7 +48,7 @@ struct LinearCircleRunResult {
 
 /// A deviation of the set written from the circles.
 struct LinearCircleDeviation {
-    std::string name;          ///< ISO name (EC0Y, EA0Z, EB0Z)
+    std::string name;          ///< ISO name (EC0Y, EA0Z, EB0Z, or EC0X, EA0Y, EB0X)
     double value = 0, stddev = 0, lower95 = 0, upper95 = 0;  ///< arcsec (ISO value)
     double perArcsec = 0;      ///< squareness (µm/m) the circle sees per arcsec of the deviation
     std::vector<std::string> runs;
