@@ -259,6 +259,17 @@ TEST(LinearCircleCli, CirclesMixedWithOtherRunsAreRefused) {
 }
 
 
+TEST(LinearCircleCli, Dbb5LinearCirclesOnAThreeAxisMachinePointToCircleRuns) {
+    // Issue 20: a 3-axis mill's XY circle written as a DBB5 run exited 2 "needs a tilting rotary table"; it still
+    // cannot take the DBB5 method, but the message names the route that fits.
+    test::ScratchDir dir("circle-cli-dbb5");
+    test::writeText(dir.file("p.xml"), "<plan>\n  <dbb5 name=\"a\" kind=\"linear\" LB=\"100\" ball=\"0 0 -350\" plane=\"XY\"/>\n</plan>\n");
+    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + dir.file("p.xml") + " --traces " +
+                                dir.path.string() + " --out " + dir.file("d.csv"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("write them as <circle> runs"), std::string::npos) << r.out;
+}
+
 namespace table_xy {
 
 TEST(LinearCircleCli, TableMovingXYRoundTripAndTheGantrysProgram) {
