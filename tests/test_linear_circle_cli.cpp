@@ -270,6 +270,15 @@ TEST(LinearCircleCli, Dbb5LinearCirclesOnAThreeAxisMachinePointToCircleRuns) {
     EXPECT_NE(r.out.find("write them as <circle> runs"), std::string::npos) << r.out;
 }
 
+TEST(LinearCircleCli, VerifySaysItDoesNotReSimulateCirclesYet) {
+    test::ScratchDir dir("circle-cli-verify");
+    const auto r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --truth " + kTruth +
+                                " --compensation " + kTruth + " --json " + dir.file("v.json"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("verify does not re-simulate circles of the linear axes"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("v.json")));
+}
+
 namespace table_xy {
 
 TEST(LinearCircleCli, TableMovingXYRoundTripAndTheGantrysProgram) {
