@@ -176,7 +176,8 @@ const RegisterCommand reg([](CLI::App& app) {
     auto* c = app.add_subcommand(
         "identify",
         "Identify the machine's deviations from the runs of a plan. The plan's runs choose what is measured: ball-bar "
-        "circles, head patterns (absolute ball bar, two tool lengths), R-test location or tables, DBB5 circles");
+        "circles, head patterns (absolute ball bar, two tool lengths), R-test location or tables, DBB5 circles, ball-bar circles of "
+        "the linear axes (<circle>, ISO 230-4: diagnostics ranked by their share of the circularity)");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->check(CLI::ExistingFile);
     c->add_option("--traces", r.traces, "folder of the measured runs, one <run>.csv per run")->check(CLI::ExistingDirectory);
@@ -186,7 +187,7 @@ const RegisterCommand reg([](CLI::App& app) {
                   "measurement, e.g. the ball-bar eccentricity formulas; closed-form is the same)")
         ->capture_default_str();
     c->add_option("--measure", o->measure,
-                  "override what the plan measures: ball-bar, head-patterns, rtest-location, rtest-tables, dbb5, mixed");
+                  "override what the plan measures: ball-bar, head-patterns, rtest-location, rtest-tables, dbb5, mixed, circle");
     c->add_option("--eccentricities", r.eccentricities, "ball-bar formulas: eccentricity CSV instead of --traces/--plan")
         ->check(CLI::ExistingFile);
     c->add_option("--refine", r.refine,

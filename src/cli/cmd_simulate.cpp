@@ -1,4 +1,4 @@
-// cnccomp simulate: every run of a plan, of every kind (ball bar, absolute ball bar, R-test, DBB5), on a machine with
+// cnccomp simulate: every run of a plan, of every kind (ball bar, absolute ball bar, R-test, DBB5, linear-axis circle), on a machine with
 // known deviations; one CSV per run (ball-bar runs with their metadata, which the import checks), and eccentricities.csv
 // for the ball-bar runs. Everything is computed, then every file is staged and committed together (io/output_set.hpp):
 // a failing run leaves no output.
@@ -134,7 +134,7 @@ void run(const Options& o) {
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
     auto* c = app.add_subcommand("simulate",
-                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5): one CSV per run "
+                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5, linear-axis circle): one CSV per run "
                                  "and eccentricities.csv for ball-bar runs; nothing is written unless every run succeeds");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->required()->check(CLI::ExistingFile);
