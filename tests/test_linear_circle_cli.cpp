@@ -11,6 +11,8 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
+#include "cnccomp/report/polar_plot.hpp"
+#include "test_browser.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
@@ -225,6 +227,18 @@ TEST(LinearCircleCli, HtmlReportHasPolarPlotsIsoTableAndRankedDiagnostics) {
     const JsonValue summary = readJsonFile(dir.file("r.summary.json"));
     EXPECT_EQ(summary["runs"].array.size(), 3u);
     EXPECT_EQ(summary["tables"].array.size(), 5u);  // conditions, per pass, three runs' diagnostics
+
+    // A real browser shows it (headless Chromium): no console message, the polar plots' traces on the page.
+    if (!test::chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium): the browser check is skipped";
+    const std::string log = test::screenshot(dir.file("r.html"), dir.file("page.png"), 1400, 2600, dir);
+    EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
+    std::string why;
+    const auto pic = test::readPng(dir.file("page.png"), why);
+    if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
+    // Three plots of two passes, before and after (CW drawn wide underneath, CCW narrow on top: where they coincide, as
+    // here without hysteresis, only the CW's edges show).
+    for (const char* colour : {report::kCwBefore, report::kCcwBefore, report::kCwAfter, report::kCcwAfter})
+        EXPECT_GT(test::countColour(*pic, colour), 500) << colour;
 }
 
 TEST(LinearCircleCli, OneDirectionSaysSquarenessAndServoMismatchAreConfounded) {
