@@ -5,10 +5,14 @@
 
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <regex>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/linear_circle_trace.hpp"
+#include "cnccomp/kinematics.hpp"
+#include "cnccomp/linear_circle_identify.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/report/polar_plot.hpp"
@@ -340,6 +344,39 @@ TEST(LinearCircleCli, TheFilesOwnDateInstrumentAndOperatorHeadTheRun) {
                                   " --out " + dir.file("d2.csv"));
     EXPECT_EQ(bad.exitCode, 2) << bad.out;
     EXPECT_NE(bad.out.find(yz + ":1: the file says radius '150'"), std::string::npos) << bad.out;
+}
+
+TEST(LinearCircleRoute, NoisyTracesKeepTheTruthInsideTheIntervals) {
+    // σ = 0.5 µm on every sample, 100 seeded trials of the sample XY circle (with the pivot set-up error) on the sample
+    // mill: the 95 % intervals the route reports for EC0Y (the deviation set's) and for the centring of pass 1 hold the
+    // truth in at least 90 of them (binomial(100, 0.95): fewer than 90 has probability < 3 %).
+    const MachineModel& m = test::sampleMachine("mill-3axis");
+    const DeviationSet truth = readDeviationCsv(kTruth, m);
+    const Kinematics k(m, truth);
+    LinearCircleRun run = readPlanXml(kPlan).circleRuns[0];
+    run.pivotOffset = Vec3(0.005, -0.003, 0);
+    const std::vector<DirectedTrace> clean = simulateLinearCircle(k, run);
+    test::ScratchDir dir("circle-noise");
+    std::mt19937_64 rng(20);
+    std::normal_distribution<double> noise(0.0, 0.5 * kUm);
+    int inSquareness = 0, inCentring = 0;
+    const int trials = 100;
+    for (int t = 0; t < trials; ++t) {
+        std::vector<DirectedTrace> passes = clean;
+        for (DirectedTrace& p : passes)
+            for (double& v : p.trace.dL) v += noise(rng);
+        test::writeText(dir.file("xy.csv"), formatLinearCircleTrace(run, passes, false, m.name));
+        const LinearCircleIdentification id = identifyLinearCircleRuns(m, {run}, dir.path.string());
+        ASSERT_EQ(id.written.size(), 1u);
+        const LinearCircleDeviation& d = id.written[0];
+        const double ec0y = truth.get("EC0Y") / kArcsec;
+        inSquareness += d.lower95 <= ec0y && ec0y <= d.upper95;
+        for (const LinearCircleParameter& p : id.runs[0].fit.parameters)
+            if (p.name == "centring X (pass 1)") inCentring += p.lower95 <= 5.0 && 5.0 <= p.upper95;
+    }
+    EXPECT_GE(inSquareness, 90);
+    EXPECT_GE(inCentring, 90);
+    std::printf("EC0Y inside its 95 %% interval in %d / %d trials, centring X (pass 1) in %d\n", inSquareness, trials, inCentring);
 }
 
 namespace table_xy {
