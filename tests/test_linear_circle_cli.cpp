@@ -3,10 +3,13 @@
 // simulate the traces, with known squareness and a known pivot set-up error; identify must give them back).
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <fstream>
 #include <random>
 #include <regex>
+#include <sstream>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
@@ -377,6 +380,38 @@ TEST(LinearCircleRoute, NoisyTracesKeepTheTruthInsideTheIntervals) {
     EXPECT_GE(inSquareness, 90);
     EXPECT_GE(inCentring, 90);
     std::printf("EC0Y inside its 95 %% interval in %d / %d trials, centring X (pass 1) in %d\n", inSquareness, trials, inCentring);
+}
+
+TEST(LinearCircleCli, RelativeLengthInstrumentLeavesTheDiagnostics) {
+    // An instrument that does not know its absolute length (length="relative") reads ΔL + an unknown zero: the radius
+    // offset takes it up; squareness and centring are the same, and the output says what F means then.
+    test::ScratchDir dir("circle-cli-relative");
+    std::string text = test::readText(planWithSetupErrors(dir));
+    text = std::regex_replace(text, std::regex("<plan ([^>]*)>"), "<plan $1>\n  <instrument length=\"relative\"/>");
+    test::writeText(dir.file("rel.xml"), text);
+    ASSERT_EQ(test::runCli("simulate --machine " + kMachine + " --plan " + dir.file("rel.xml") + " --deviations " + kTruth +
+                           " --out " + dir.file("traces")).exitCode, 0);
+    // The instrument's zero: +30 µm on every reading of xy.
+    const std::string path = dir.file("traces/xy.csv");
+    std::istringstream in(test::readText(path));
+    std::string out, line;
+    while (std::getline(in, line)) {
+        std::smatch mt;
+        if (std::regex_match(line, mt, std::regex("([-0-9.]+),([-0-9.]+),(c?cw)")))
+            line = mt[1].str() + "," + fmt::format("{:.7f}", std::stod(mt[2].str()) + 30.0) + "," + mt[3].str();
+        out += line + "\n";
+    }
+    test::writeText(path, out);
+    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + dir.file("rel.xml") + " --traces " +
+                                dir.file("traces") + " --out " + dir.file("d.csv") + " --report " + dir.file("r.json"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("relative length: the radius offset takes up the instrument's zero"), std::string::npos) << r.out;
+    const JsonValue j = readJsonFile(dir.file("r.json"));
+    EXPECT_EQ(j["runs"][0]["conditions"]["length"].string, "relative");
+    EXPECT_NEAR(j["runs"][0]["radius_offset_um"].num(), 30.5, 0.01);
+    EXPECT_NEAR(j["runs"][0]["centring_um"][0][0].num(), 5.0, 0.01);
+    const DeviationSet d = readDeviationCsv(dir.file("d.csv"), test::sampleMachine("mill-3axis"));
+    EXPECT_NEAR(d.get("EC0Y") / kArcsec, 5.0, 0.05);
 }
 
 namespace table_xy {

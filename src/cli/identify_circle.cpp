@@ -67,6 +67,9 @@ void printLinearCircles(const LinearCircleIdentification& id) {
                    samples, c.spacingDeg, c.layout,
                    std::isfinite(c.sampleRateHz) ? fmt::format(" at {:.1f} Hz", c.sampleRateHz) : "", orDash(c.date),
                    orDash(c.instrument), orDash(c.operatorName), c.file);
+        if (c.relativeLength)
+            fmt::print("  relative length: the radius offset takes up the instrument's zero; F max, F min and the mean "
+                       "radius are relative to it (G and H are not)\n");
         fmt::print("  ISO 230-4 (um):");
         for (size_t k = 0; k < r.iso.passes.size(); ++k) {
             const CircularTestResult& p = r.iso.passes[k];

@@ -102,6 +102,7 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
         if (c.layout == "time" && c.spacingDeg > 0)
             c.sampleRateHz = run.capture.feed / 60.0 / run.radius / kDeg / c.spacingDeg;
         c.feedFromData = r.summary.feedEstimate;
+        c.relativeLength = run.capture.relativeLength;
         c.date = !file.date.empty() ? file.date : run.date;
         c.instrument = !file.instrument.empty() ? file.instrument : run.instrument;
         c.operatorName = !file.operatorName.empty() ? file.operatorName : run.operatorName;

@@ -33,6 +33,9 @@ struct LinearCircleConditions {
     double sampleRateHz = std::numeric_limits<double>::quiet_NaN();  ///< time-sampled files: samples per second
     double feedFromData = 0;           ///< time-sampled files: the feed the passes' durations give (0: not known)
     std::string date, instrument, operatorName;  ///< the file's own lines first, else the plan's
+    /// The instrument reads the length relative to an unknown zero (length="relative"): the radius offset takes the
+    /// zero up, G and H keep their meaning, F max / F min and the mean radius are relative to that zero.
+    bool relativeLength = false;
 };
 
 struct LinearCircleRunResult {

@@ -28,12 +28,13 @@ std::string conditions(const LinearCircleConditions& c) {
         "{{\"file\": {}, \"layout\": {}, \"plane\": {}, \"centre_mm\": [{}, {}, {}], \"radius_mm\": {}, \"start_deg\": {}, "
         "\"arc_deg\": {}, \"feed_mm_min\": {}, \"overshoot_deg\": {}, \"tool_length_mm\": {}, \"directions\": {}, "
         "\"samples\": {}, \"spacing_deg\": {}, \"sample_rate_hz\": {}, \"feed_from_data_mm_min\": {}, \"date\": {}, "
-        "\"instrument\": {}, \"operator\": {}}}",
+        "\"instrument\": {}, \"operator\": {}, \"length\": {}}}",
         str(c.file), str(c.layout), str(linearPlaneName(c.plane)), num(c.centre.x()), num(c.centre.y()), num(c.centre.z()),
         num(c.radius), num(c.startDeg), num(c.arcDeg), num(c.feed), num(c.overshootDeg), num(c.toolLength),
         array(c.directions, direction), array(c.samples, [](int n) { return std::to_string(n); }), num(c.spacingDeg),
         num(c.sampleRateHz), c.feedFromData > 0 ? num(c.feedFromData) : "null", c.date.empty() ? "null" : str(c.date),
-        c.instrument.empty() ? "null" : str(c.instrument), c.operatorName.empty() ? "null" : str(c.operatorName));
+        c.instrument.empty() ? "null" : str(c.instrument), c.operatorName.empty() ? "null" : str(c.operatorName),
+        c.relativeLength ? "\"relative\"" : "\"absolute\"");
 }
 
 std::string iso(const CircularRunResult& r) {

@@ -55,6 +55,8 @@ ReportData linearCircleReportData(const std::string& machine, const LinearCircle
         s.notes.push_back(fmt::format("{} {:g}° from {:g}°, R {:g} mm, F {:g} mm/min, {} ({}-sampled)",
                                       linearPlaneName(c.plane), c.arcDeg, c.startDeg, c.radius, c.feed,
                                       directions(c.directions), c.layout));
+        if (c.relativeLength)
+            s.notes.push_back("relative length: F and the mean radius are relative to the instrument's zero (G and H are not)");
         d.runs.push_back(std::move(s));
 
         std::string samples;
