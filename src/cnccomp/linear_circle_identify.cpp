@@ -13,10 +13,11 @@
 
 namespace cnccomp {
 
-namespace {
+// Internals in a named namespace (not anonymous): the core may be compiled as unity units.
+namespace linear_circle_identify_detail {
 
 /// The recorded passes as the model's passes (angles already inside the data arc).
-std::vector<LinearCirclePass> modelPasses(const LinearCircleRun& run, const std::vector<DirectedTrace>& traces) {
+std::vector<LinearCirclePass> lcModelPasses(const LinearCircleRun& run, const std::vector<DirectedTrace>& traces) {
     std::vector<LinearCirclePass> out;
     for (const DirectedTrace& t : traces) {
         LinearCirclePass p;
@@ -34,7 +35,7 @@ std::vector<LinearCirclePass> modelPasses(const LinearCircleRun& run, const std:
 /// ISO 230-1 name of the squareness of a plane's axes in the machine: the rotation of the downstream slide of the two,
 /// EC0Y / EA0Z / EB0Z for slides stacked X → Y → Z, EC0X / EA0Y / EB0X where the chain stacks them the other way (a
 /// table X on a saddle Y). The first the machine has; the preferred name when it has none.
-std::string squarenessName(const MachineModel& m, LinearPlane p) {
+std::string lcSquarenessName(const MachineModel& m, LinearPlane p) {
     const std::array<const char*, 2> names = p == LinearPlane::XY   ? std::array<const char*, 2>{"EC0Y", "EC0X"}
                                              : p == LinearPlane::YZ ? std::array<const char*, 2>{"EA0Z", "EA0Y"}
                                                                     : std::array<const char*, 2>{"EB0Z", "EB0X"};
@@ -43,16 +44,17 @@ std::string squarenessName(const MachineModel& m, LinearPlane p) {
     return names[0];
 }
 
-const LinearCircleParameter* parameter(const LinearCircleFit& fit, const std::string& name) {
+const LinearCircleParameter* lcParameter(const LinearCircleFit& fit, const std::string& name) {
     for (const LinearCircleParameter& p : fit.parameters)
         if (p.name == name) return &p;
     return nullptr;
 }
 
-}  // namespace
+}  // namespace linear_circle_identify_detail
 
 LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const std::vector<LinearCircleRun>& runs,
                                                     const std::string& dir, const LinearCircleSettings& base) {
+    using namespace linear_circle_identify_detail;
     if (runs.empty()) throw ModelError("the plan has no circle runs (<circle>)");
     LinearCircleIdentification out{{}, DeviationSet(m), {}, {}};
     for (const LinearCircleRun& run : runs) {
@@ -64,7 +66,7 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
         r.run = run.name;
         r.summary = file.measured.summary;
         r.circle = run.circle();
-        r.passes = modelPasses(run, file.measured.passes);
+        r.passes = lcModelPasses(run, file.measured.passes);
         LinearCircleSettings settings = base;
         settings.cyclicPitch = run.cyclicPitch;
         try {
@@ -115,9 +117,9 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
     for (size_t i = 0; i < runs.size(); ++i) {
         const LinearCircleRun& run = runs[i];
         const LinearCircleRunResult& r = out.runs[i];
-        const std::string iso = squarenessName(m, run.plane);
+        const std::string iso = lcSquarenessName(m, run.plane);
         const std::string pname = fmt::format("squareness {}", linearPlaneName(run.plane));
-        const LinearCircleParameter* p = parameter(r.fit, pname);
+        const LinearCircleParameter* p = lcParameter(r.fit, pname);
         if (m.deviationIndex(iso) < 0) {
             out.notes.push_back(fmt::format("run '{}': machine '{}' has no deviation {}: the {} is reported only", run.name,
                                             m.name, iso, pname));
@@ -135,7 +137,7 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
         nominal.capture.overshootDeg = 0;
         LinearCircleSettings settings = base;
         settings.cyclicPitch = run.cyclicPitch;
-        const std::vector<LinearCirclePass> sim = modelPasses(nominal, simulateLinearCircle(Kinematics(m, unit), nominal));
+        const std::vector<LinearCirclePass> sim = lcModelPasses(nominal, simulateLinearCircle(Kinematics(m, unit), nominal));
         const LinearCircleFit f = identifyLinearCircle(run.circle(), sim, settings);
         const double s = f.values.squareness;  // µm/m per arcsec
         if (!(std::abs(s) > 1e-3)) {

@@ -11,20 +11,21 @@
 
 namespace cnccomp {
 
-namespace {
+// Internals in a named namespace (not anonymous): the core may be compiled as unity units.
+namespace linear_circle_trace_detail {
 
-std::string oneLine(std::string s) {
+std::string lcOneLine(std::string s) {
     for (char& c : s)
         if (c == '\n' || c == '\r') c = ' ';
     return s;
 }
 
-std::string lower(std::string s) {
+std::string lcLower(std::string s) {
     for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return s;
 }
 
-}  // namespace
+}  // namespace linear_circle_trace_detail
 
 BallbarRun linearCircleImportRun(const LinearCircleRun& run) {
     BallbarRun b;
@@ -44,6 +45,7 @@ BallbarRun linearCircleImportRun(const LinearCircleRun& run) {
 }
 
 LinearCircleTrace importLinearCircleTrace(const std::string& path, const LinearCircleRun& run, const std::string& machine) {
+    using namespace linear_circle_trace_detail;
     LinearCircleTrace out;
     // The circle's own metadata first (a file of another circle is named as such before its samples are judged).
     {
@@ -53,7 +55,7 @@ LinearCircleTrace importLinearCircleTrace(const std::string& path, const LinearC
         while (reader.next(row)) {
         }
         for (const CsvComment& c : reader.comments()) {
-            const std::string key = lower(c.key);
+            const std::string key = lcLower(c.key);
             const auto mismatch = [&](const std::string& planned) {
                 throw InputError(path, c.line, fmt::format("the file says {} '{}', but circle run '{}' of the plan has {}: "
                                                            "this file belongs to another run or setup",
@@ -86,6 +88,7 @@ LinearCircleTrace importLinearCircleTrace(const std::string& path, const LinearC
 
 std::string formatLinearCircleTrace(const LinearCircleRun& run, const std::vector<DirectedTrace>& passes, bool timeSampled,
                                     const std::string& machine) {
+    using namespace linear_circle_trace_detail;
     const RunCapture& c = run.capture;
     const char sep = c.decimal == ',' ? ';' : ',';
     const auto number = [&](double v, int decimals) {
@@ -96,13 +99,13 @@ std::string formatLinearCircleTrace(const LinearCircleRun& run, const std::vecto
     const double omegaDeg = c.feed / 60.0 / run.radius * 180.0 / kPi;  // deg/s
     if (timeSampled && !(omegaDeg > 0)) throw ModelError(fmt::format("circle run '{}': a time-sampled file needs the feed", run.name));
     std::string o = "# cnccomp ball-bar circle of the linear axes (ISO 230-4)\n";
-    o += fmt::format("# run: {}\n", oneLine(run.name));
-    if (!machine.empty()) o += fmt::format("# machine: {}\n", oneLine(machine));
+    o += fmt::format("# run: {}\n", lcOneLine(run.name));
+    if (!machine.empty()) o += fmt::format("# machine: {}\n", lcOneLine(machine));
     o += fmt::format("# plane: {}\n# radius: {:g}\n# start: {:g}\n# arc: {:g}\n# end: {:g}\n# step: {:g}\n# feed: {:g}\n",
                      linearPlaneName(run.plane), run.radius, run.startDeg, run.arcDeg, run.endDeg(), run.stepDeg, c.feed);
     for (const auto& [key, value] : {std::pair<const char*, const std::string*>{"date", &run.date},
                                      {"instrument", &run.instrument}, {"operator", &run.operatorName}})
-        if (!value->empty()) o += fmt::format("# {}: {}\n", key, oneLine(*value));
+        if (!value->empty()) o += fmt::format("# {}: {}\n", key, lcOneLine(*value));
     o += fmt::format("{}{}{}", timeSampled ? c.timeColumn : c.angleColumn, sep, c.lengthColumn);
     if (passes.size() > 1) o += fmt::format("{}{}", sep, c.passColumn);
     o += "\n";

@@ -8,20 +8,22 @@
 
 namespace cnccomp::report {
 
-namespace {
+// Internals in a named namespace (not anonymous): the core may be compiled as unity units.
+namespace linear_circle_report_detail {
 
-std::string orDash(const std::string& s) { return s.empty() ? "–" : s; }
+std::string lcOrDash(const std::string& s) { return s.empty() ? "–" : s; }
 
-std::string directions(const std::vector<int>& d) {
+std::string lcDirections(const std::vector<int>& d) {
     std::string o;
     for (int x : d) o += std::string(o.empty() ? "" : " then ") + (x > 0 ? "CCW" : "CW");
     return o;
 }
 
-}  // namespace
+}  // namespace linear_circle_report_detail
 
 ReportData linearCircleReportData(const std::string& machine, const LinearCircleIdentification& id,
                                   std::vector<std::pair<std::string, std::string>> facts) {
+    using namespace linear_circle_report_detail;
     ReportData d;
     d.title = fmt::format("Ball-bar circles of the linear axes (ISO 230-4): {}", machine);
     d.machine = machine;
@@ -54,7 +56,7 @@ ReportData linearCircleReportData(const std::string& machine, const LinearCircle
         s.rmsAfter = r.fit.sigma * kUm;
         s.notes.push_back(fmt::format("{} {:g}° from {:g}°, R {:g} mm, F {:g} mm/min, {} ({}-sampled)",
                                       linearPlaneName(c.plane), c.arcDeg, c.startDeg, c.radius, c.feed,
-                                      directions(c.directions), c.layout));
+                                      lcDirections(c.directions), c.layout));
         if (c.relativeLength)
             s.notes.push_back("relative length: F and the mean radius are relative to the instrument's zero (G and H are not)");
         d.runs.push_back(std::move(s));
@@ -67,9 +69,9 @@ ReportData linearCircleReportData(const std::string& machine, const LinearCircle
                                    fmt::format("{:g}° from {:g}° to {:g}°", c.arcDeg, c.startDeg, c.startDeg + c.arcDeg),
                                    c.feedFromData > 0 ? fmt::format("{:g} (data: {:.1f})", c.feed, c.feedFromData)
                                                       : fmt::format("{:g}", c.feed),
-                                   fmt::format("{:g}", c.overshootDeg), directions(c.directions), samples,
-                                   fixed(c.spacingDeg, 4), fixed(c.sampleRateHz, 1), c.layout, orDash(c.date),
-                                   orDash(c.instrument), orDash(c.operatorName), c.file});
+                                   fmt::format("{:g}", c.overshootDeg), lcDirections(c.directions), samples,
+                                   fixed(c.spacingDeg, 4), fixed(c.sampleRateHz, 1), c.layout, lcOrDash(c.date),
+                                   lcOrDash(c.instrument), lcOrDash(c.operatorName), c.file});
         for (size_t k = 0; k < r.iso.passes.size(); ++k) {
             const CircularTestResult& p = r.iso.passes[k];
             perPass.rows.push_back({r.run, fmt::format("{} ({})", k + 1, r.iso.directions[k] > 0 ? "CCW" : "CW"),
