@@ -3,12 +3,16 @@
 // RS274NGC programs and its canonical moves agree; travel limits; all-or-nothing writing.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
 #include <sstream>
+
+#include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_run.hpp"
@@ -60,6 +64,7 @@ void expectSamePose(const MachineModel& m, const AxisVector& got, const AxisVect
 /// The commands the simulation uses, straight from the simulation's own functions (not from RunMotion).
 AxisVector simulationCommands(const MachineModel& m, const testprog::RunMotion& r, double t) {
     if (r.ballbar) return runCommands(m, *r.ballbar, t * kDeg);
+    if (r.circle) return linearCircleCommands(m, *r.circle, t);
     if (r.dbb5) return dbb5Commands(m, *r.dbb5, t);
     static std::map<const RtestRun*, std::vector<AxisVector>> cache;
     auto it = cache.find(r.rtest);
@@ -69,11 +74,13 @@ AxisVector simulationCommands(const MachineModel& m, const testprog::RunMotion& 
 AxisVector simulationSetup(const MachineModel& m, const testprog::RunMotion& r) {
     if (r.ballbar) return setupCommands(m, *r.ballbar);
     if (r.dbb5) return dbb5SetupCommands(m, *r.dbb5);
+    if (r.circle) return linearCircleCentreCommands(m, *r.circle);
     return rtestCommands(m, *r.rtest).front();
 }
 std::vector<double> simulationSamples(const testprog::RunMotion& r) {
     if (r.ballbar) return r.ballbar->anglesDeg();
     if (r.dbb5) return r.dbb5->anglesDeg();
+    if (r.circle) return r.circle->dataAnglesDeg();
     std::vector<double> t;
     for (int i = 0; i < r.rtest->sampleCount(); ++i) t.push_back(i);
     return t;
@@ -352,6 +359,97 @@ TEST(TestPrograms, ProgramsStartAndEndInTheirDialectsFrame) {
             EXPECT_NE(p.text.find(" CC X+0.000000 Y+0.000000"), std::string::npos);
             EXPECT_NE(p.text.find(" DR- R0"), std::string::npos);
         }
+}
+
+
+// ---- Circles of the linear axes (<circle>, ISO 230-4) ----------------------------------------------------------------
+
+namespace circle_programs {
+
+const char* kCirclePlan = R"(<plan machine="mill-3axis">
+  <circle name="xy" plane="XY" centre="10 -20 -250" radius="100" start="30" arc="360" step="2" tool-length="50" feed="1500" overshoot="5" directions="ccw cw"/>
+  <circle name="yz" plane="YZ" centre="0 0 -250" radius="80" start="-20" arc="220" step="1" feed="800" overshoot="10"/>
+</plan>
+)";
+
+}  // namespace circle_programs
+
+TEST(TestPrograms, LinearCircleEveryDialectReadsBackThePlansCircleFeedAndDirection) {
+    // Round trip: program text → cnccomp's reader (`poses`, Klartext reader) → commands, against the commands the circle's
+    // simulation uses (linearCircleCommands); the plan's feed, overshoot and first direction are the program's.
+    const MachineModel& m = test::sampleMachine("mill-3axis");
+    test::ScratchDir dir("testprog-circle");
+    test::writeText(dir.file("p.xml"), circle_programs::kCirclePlan);
+    const MeasurementPlan plan = readPlanXml(dir.file("p.xml"));
+    const auto motions = testprog::planMotions(m, plan);
+    ASSERT_EQ(motions.size(), 2u);
+    for (ProgramDialect d : kDialects) {
+        testprog::TestProgramOptions o;
+        o.dialect = d;
+        o.feed = 333;          // the plan's feed wins for circles
+        o.overshootDeg = 20;   // and its overshoot
+        const auto set = testprog::makeTestPrograms(m, plan, o);
+        ASSERT_EQ(set.programs.size(), 2u);
+        for (size_t i = 0; i < 2; ++i) {
+            const testprog::TestProgram& p = set.programs[i];
+            const LinearCircleRun& c = plan.circleRuns[i];
+            const std::string where = std::string(testprog::programDialectName(d)) + " " + c.name;
+            EXPECT_TRUE(p.arcs) << where;
+            EXPECT_EQ(p.kind, testprog::RunKind::LinearCircle);
+            EXPECT_EQ(p.firstPass, i == 0 ? "CCW" : "CW") << where;
+            EXPECT_DOUBLE_EQ(p.overshootStart, c.capture.overshootDeg) << where;
+            EXPECT_EQ(p.samples, c.dataAnglesDeg().size());
+            EXPECT_NE(p.text.find(fmt::format("F{:g}", c.capture.feed)), std::string::npos) << where;
+            EXPECT_EQ(p.text.find("F333"), std::string::npos) << where;
+            const auto back = testprog::readTestProgram(m, motions[i], p.text, testprog::readerDialect(d), where);
+            expectSamePose(m, back.setup, linearCircleCentreCommands(m, c), where + " setup");
+            ASSERT_EQ(back.passes.size(), 2u);
+            EXPECT_EQ(back.passes[0].label, i == 0 ? "CCW" : "CW") << where;
+            for (const auto& pass : back.passes) {
+                ASSERT_EQ(pass.t.size(), c.dataAnglesDeg().size()) << where;
+                for (size_t k = 0; k < pass.t.size(); ++k)
+                    expectSamePose(m, pass.q[k], linearCircleCommands(m, c, pass.t[k]),
+                                   where + " " + pass.label + " t=" + std::to_string(pass.t[k]));
+            }
+        }
+    }
+}
+
+TEST(TestPrograms, LinearCircleLinuxCncInterpreterMakesTheCircle) {
+    // Oracle: LinuxCNC's own interpreter (rs274) reads the program; every arc ends on the commanded circle, turns the
+    // plan's way (ARC_FEED rotation +1 = G3 = CCW), and the plane's third axis stays at the centre.
+    const std::string rs274 = rs274Path();
+    if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace";
+    const MachineModel& m = test::sampleMachine("mill-3axis");
+    test::ScratchDir dir("testprog-circle-rs274");
+    test::writeText(dir.file("p.xml"), circle_programs::kCirclePlan);
+    const MeasurementPlan plan = readPlanXml(dir.file("p.xml"));
+    const auto set = testprog::makeTestPrograms(m, plan, {});
+    const std::string tbl = dir.file("tool.tbl");
+    test::writeText(tbl, "");
+    for (size_t i = 0; i < set.programs.size(); ++i) {
+        const auto& p = set.programs[i];
+        const LinearCircleRun& c = plan.circleRuns[i];
+        const std::string ngc = dir.file(p.file), out = dir.file(p.file + ".canon"), log = dir.file(p.file + ".log");
+        test::writeText(ngc, p.text);
+        const std::string cmd = rs274 + " -t " + tbl + " -g " + ngc + " " + out + " < /dev/null > " + log + " 2>&1";
+        ASSERT_EQ(std::system(cmd.c_str()), 0) << p.file << ": rs274 failed:\n" << test::readText(log);
+        const std::vector<CanonMove> canon = parseCanon(test::readText(out));
+        const std::array<char, 2> ax = linearPlaneAxes(c.plane);
+        const int u = ax[0] - 'X', v = ax[1] - 'X', n = 3 - u - v;
+        int arcs = 0, first = 0;
+        for (const CanonMove& mv : canon) {
+            if (mv.kind != "ARC_FEED") continue;
+            ++arcs;
+            const double du = mv.xyzabc[u] - c.centre[u], dv = mv.xyzabc[v] - c.centre[v];
+            EXPECT_NEAR(std::hypot(du, dv), c.radius, 2e-4) << p.file << " arc " << arcs;  // rs274 prints 4 decimals
+            EXPECT_NEAR(mv.xyzabc[n], c.centre[n], 1e-4) << p.file << " arc " << arcs;
+            if (first == 0) first = mv.rotation;
+        }
+        // Both passes: data arc / step blocks each, plus the overshoot arcs.
+        EXPECT_GE(arcs, static_cast<int>(2 * std::floor(c.arcDeg / c.stepDeg))) << p.file;
+        EXPECT_EQ(first, c.directions().front()) << p.file;  // ARC_FEED rotation: +1 CCW (G3), −1 CW (G2)
+    }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "postproc/testprog/run_motion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -19,6 +20,7 @@ const char* runKindName(RunKind k) {
         case RunKind::AbsoluteBallbar: return "absolute ball bar";
         case RunKind::Rtest: return "R-test";
         case RunKind::Dbb5: return "DBB5";
+        case RunKind::LinearCircle: return "linear circle";
     }
     return "?";
 }
@@ -138,6 +140,36 @@ RunMotion rtestMotion(const MachineModel& m, const Kinematics& k, const RtestRun
     return r;
 }
 
+RunMotion circleMotion(const MachineModel& m, const Kinematics& k, const LinearCircleRun& run) {
+    RunMotion r;
+    r.name = run.name;
+    r.kind = RunKind::LinearCircle;
+    r.circle = &run;
+    r.setup = linearCircleCentreCommands(m, run);
+    r.at = [&m, &run](double t) { return linearCircleCommands(m, run, t); };
+    r.points = run.dataAnglesDeg();
+    r.sampleCount = r.points.size();
+    r.toolLength = run.toolLength;
+    const char* plane = linearPlaneName(run.plane);
+    const std::array<char, 2> ax = linearPlaneAxes(run.plane);
+    r.parameter = fmt::format("{} circle angle (deg, from +{} towards +{})", plane, ax[0], ax[1]);
+    r.notes.push_back(fmt::format("run type ball-bar circle of the linear axes in {} (ISO 230-4), radius {:g} mm = bar length",
+                                  plane, run.radius));
+    r.notes.push_back(fmt::format("circle centre (commands X Y Z): {} mm; tool ball {:g} mm along the tool direction", vec(run.centre),
+                                  run.toolLength));
+    r.notes.push_back(fmt::format("data arc: {:g} deg from {:g} to {:g} deg, samples every {:g} deg, feed {:g} mm/min, overshoot "
+                                  "{:g} deg at each end",
+                                  run.arcDeg, run.startDeg, run.endDeg(), run.stepDeg, run.capture.feed, run.capture.overshootDeg));
+    std::string hold;
+    for (const auto& [axis, deg] : run.hold) hold += fmt::format(" {}={:g}", axis, deg);
+    if (!hold.empty()) r.notes.push_back("held:" + hold);
+    r.notes.push_back(fmt::format("pivot (centre) ball at the setup pose, bed frame: {} mm",
+                                  vec(k.baseToWorkpiece(r.setup) * k.toolPointInWorkpiece(r.setup, k.toolPoint(run.toolLength)))));
+    r.setupAction = "SET THE PIVOT (CENTRE) BALL UNDER THE TOOL BALL HERE AND FIX IT";
+    r.captureAction = "MOUNT THE BAR, START THE BALL-BAR DATA CAPTURE, THEN CYCLE START";
+    return r;
+}
+
 }  // namespace
 
 std::vector<RunMotion> planMotions(const MachineModel& m, const MeasurementPlan& plan) {
@@ -147,6 +179,7 @@ std::vector<RunMotion> planMotions(const MachineModel& m, const MeasurementPlan&
     for (const BallbarRun& r : plan.absoluteRuns) out.push_back(ballbarMotion(m, k, r, true));
     for (const Dbb5Run& r : plan.dbb5Runs) out.push_back(dbb5Motion(m, k, r));
     for (const RtestRun& r : plan.rtestRuns) out.push_back(rtestMotion(m, k, r));
+    for (const LinearCircleRun& r : plan.circleRuns) out.push_back(circleMotion(m, k, r));
     return out;
 }
 

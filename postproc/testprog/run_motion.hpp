@@ -6,7 +6,8 @@
 //  <run>          seed 000 Table 2 commands (runCommands), W-side ball set at setupCommands (eq. (11)–(13));
 //  <absolute-run> the same commands, Ball 2 at its nominal position (seed 002 section 3.1);
 //  <dbb5>         dbb5Commands / dbb5SetupCommands (seed 003);
-//  <rtest>        rtestCommands, stop-and-go poses, the ball centred in the nest at the first pose (seed 001/004).
+//  <rtest>        rtestCommands, stop-and-go poses, the ball centred in the nest at the first pose (seed 001/004);
+//  <circle>       linearCircleCommands, the pivot ball set under the tool ball at the centre (ISO 230-4).
 #include <functional>
 #include <string>
 #include <vector>
@@ -15,8 +16,8 @@
 
 namespace cnccomp::testprog {
 
-enum class RunKind { Ballbar, AbsoluteBallbar, Rtest, Dbb5 };
-/// "ball bar", "absolute ball bar", "R-test", "DBB5".
+enum class RunKind { Ballbar, AbsoluteBallbar, Rtest, Dbb5, LinearCircle };
+/// "ball bar", "absolute ball bar", "R-test", "DBB5", "linear circle".
 const char* runKindName(RunKind k);
 
 struct RunMotion {
@@ -42,9 +43,10 @@ struct RunMotion {
     const BallbarRun* ballbar = nullptr;  ///< the plan's run (ball bar, absolute ball bar), else null
     const Dbb5Run* dbb5 = nullptr;
     const RtestRun* rtest = nullptr;
+    const LinearCircleRun* circle = nullptr;  ///< <circle>: its feed, overshoot and first direction drive the program
 };
 
-/// Every run of the plan in plan order: <run>, <absolute-run>, <dbb5>, <rtest>. The plan must outlive the result.
+/// Every run of the plan in plan order: <run>, <absolute-run>, <dbb5>, <rtest>, <circle>. The plan must outlive the result.
 /// Throws ModelError for a run the machine cannot make (unknown axes, impossible geometry).
 std::vector<RunMotion> planMotions(const MachineModel& machine, const MeasurementPlan& plan);
 

@@ -124,6 +124,9 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
         if (!(v > 0) || !std::isfinite(v)) throw ModelError(fmt::format("feeds must be positive, not {}", v));
     if (!(o.overshootDeg >= 0) || !(o.clearance >= 0) || !(o.dwellSeconds >= 0))
         throw ModelError("overshoot, clearance and dwell must be zero or positive");
+    // A circle of the linear axes carries its own feed and overshoot in the plan (what its data import assumes).
+    const double feed = r.circle ? r.circle->capture.feed : o.feed;
+    const double overshoot = r.circle ? r.circle->capture.overshootDeg : o.overshootDeg;
     const Kinematics nominal(m);
     TestProgram tp;
     tp.run = r.name;
@@ -145,8 +148,8 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
     double oS = 0, oE = 0;
     PathShape shape;
     if (r.continuous && P.size() > 1) {
-        oS = fitOvershoot(m, r, P.front(), -dirF, o.overshootDeg, step);
-        oE = fitOvershoot(m, r, P.back(), dirF, o.overshootDeg, step);
+        oS = fitOvershoot(m, r, P.front(), -dirF, overshoot, step);
+        oE = fitOvershoot(m, r, P.back(), dirF, overshoot, step);
         shape = analysePath(m, r, P.front() - dirF * oS, P.back() + dirF * oE, step);
         if (shape.circle) {
             // One circular block per step / overshoot: keep each well below half a turn.
@@ -163,10 +166,13 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
     // Passes: CW first for circles, forward first otherwise.
     const bool forwardCcw = shape.circle && shape.rate * dirF > 0;
     Pass forward{P, oS, oE, ""}, backward{std::vector<double>(P.rbegin(), P.rend()), oE, oS, ""};
-    std::array<Pass, 2> passes = forwardCcw ? std::array<Pass, 2>{backward, forward} : std::array<Pass, 2>{forward, backward};
+    // A circle of the linear axes: the plan's first direction first (CCW first when it says so).
+    const bool ccwFirst = r.circle && r.circle->directions().front() > 0;
+    std::array<Pass, 2> passes = forwardCcw != ccwFirst ? std::array<Pass, 2>{backward, forward}
+                                                        : std::array<Pass, 2>{forward, backward};
     if (shape.circle) {
-        passes[0].label = "CW";
-        passes[1].label = "CCW";
+        passes[0].label = ccwFirst ? "CCW" : "CW";
+        passes[1].label = ccwFirst ? "CW" : "CCW";
     } else {
         passes[0].label = "forward";
         passes[1].label = "reverse";
@@ -184,11 +190,11 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
             a.c0 = shape.c0;
             a.c1 = shape.c1;
             a.ccw = shape.rate * (t1 - t0) > 0;
-            syntax->arc(C(r.at(t1)), a, o.feed);
+            syntax->arc(C(r.at(t1)), a, feed);
             return;
         }
         const long n = split ? std::max(1L, static_cast<long>(std::ceil(std::abs(t1 - t0) / step - 1e-9))) : 1;
-        for (long i = 1; i <= n; ++i) syntax->line(C(r.at(t0 + (t1 - t0) * static_cast<double>(i) / n)), o.feed);
+        for (long i = 1; i <= n; ++i) syntax->line(C(r.at(t0 + (t1 - t0) * static_cast<double>(i) / n)), feed);
     };
 
     // Header.
@@ -214,7 +220,7 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
     syntax->comment("setup pose: " + describePose(m, C(r.setup)));
     syntax->comment(fmt::format("sweep parameter: {}, {} samples{}", r.parameter, r.sampleCount,
                                 r.continuous ? "" : fmt::format(", dwell {:g} s at each pose", o.dwellSeconds)));
-    syntax->comment(fmt::format("feed: {:g} mm/min on the sweep, {:g} mm/min onto the setup and start poses", o.feed, o.approachFeed));
+    syntax->comment(fmt::format("feed: {:g} mm/min on the sweep, {:g} mm/min onto the setup and start poses", feed, o.approachFeed));
     if (shape.circle)
         syntax->comment(fmt::format("path: circle of radius {:.4f} mm in the {} plane about ({:.4f}, {:.4f}){}, {}", shape.radius,
                                     shape.plane == 17 ? "XY" : shape.plane == 18 ? "ZX" : "YZ", shape.c0, shape.c1,
@@ -224,8 +230,8 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
                                 passes[0].points.front(), passes[0].points.back(), passes[1].label));
     if (r.continuous)
         syntax->comment(fmt::format("overshoot: {:g} deg before {:g} and {:g} deg after {:g}{}", oS, P.front(), oE, P.back(),
-                                    oS < o.overshootDeg || oE < o.overshootDeg
-                                        ? fmt::format(" (requested {:g}: shortened by the travel or the block length)", o.overshootDeg)
+                                    oS < overshoot || oE < overshoot
+                                        ? fmt::format(" (requested {:g}: shortened by the travel or the block length)", overshoot)
                                         : ""));
     syntax->comment("instrument: set it at the first stop, start the data capture at the second stop, stop it at the last "
                     "stop");

@@ -8,10 +8,12 @@
 #include <fmt/format.h>
 
 #include "cli/command.hpp"
+#include "cli/identify_circle.hpp"
 #include "cli/identify_methods.hpp"
 #include "cli/print.hpp"
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/linear_circle_json.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -19,6 +21,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/report/html_report.hpp"
 #include "cnccomp/report/identification_report.hpp"
+#include "cnccomp/report/linear_circle_report.hpp"
 
 namespace cnccomp::cli {
 namespace {
@@ -95,7 +98,7 @@ void run(Options o) {
         o.truth.empty() ? std::nullopt : std::optional<DeviationSet>(readDeviationCsv(o.truth, m));
 
     IdentifyOutcome res = runIdentification(r);
-    if (!o.report.empty() && !res.report)
+    if (!o.report.empty() && !res.report && !res.circles)
         throw ModelError(fmt::format("--report: the {} of '{}' writes no least-squares report",
                                      r.formulas ? "formulas" : "method", planMethodName(r.kind)));
     std::vector<std::pair<std::string, const ExtraOutput*>> extras;
@@ -113,7 +116,18 @@ void run(Options o) {
     // Everything is computed: stage every output, then commit them together (all or nothing).
     OutputSet staged({o.machine, o.plan, o.truth, r.start, r.eccentricities});
     staged.add(o.out, formatDeviationCsv(res.deviations));
-    if (html) {
+    if (res.circles && html) {
+        if (!o.reportControllers.empty() || !o.reportGrid.empty())
+            throw ModelError("--report-controllers and --report-grid: the circles of the linear axes write no maps or "
+                             "controller sections yet");
+        report::stageHtmlReport(staged, o.report,
+                                report::linearCircleReportData(m.name, *res.circles,
+                                                               {{"machine file", o.machine}, {"plan", o.plan},
+                                                                {"traces", r.traces}, {"deviations written", o.out},
+                                                                {"identification", res.summary}}));
+    } else if (res.circles && !o.report.empty()) {
+        staged.add(o.report, formatLinearCircleJson(m.name, *res.circles));
+    } else if (html) {
         const IdentificationReport& rep = *res.report;
         report::ReportData d;
         d.title = fmt::format("Identification of {}", m.name);
@@ -146,6 +160,7 @@ void run(Options o) {
     if (res.report && !res.report->adequacy.fits) fmt::print("WARNING: {}\n", res.report->adequacy.message);
     fmt::print("{} -> {}{}\n", res.summary, o.out, o.report.empty() ? "" : ", report -> " + o.report);
     if (res.report) printReport(*res.report);
+    if (res.circles) printLinearCircles(*res.circles);
     printCircularTests(runs);
     if (res.measured)
         for (size_t i = 0; i < res.measured->ballbar.size() && plan; ++i) {
@@ -167,7 +182,8 @@ const RegisterCommand reg([](CLI::App& app) {
     auto* c = app.add_subcommand(
         "identify",
         "Identify the machine's deviations from the runs of a plan. The plan's runs choose what is measured: ball-bar "
-        "circles, head patterns (absolute ball bar, two tool lengths), R-test location or tables, DBB5 circles");
+        "circles, head patterns (absolute ball bar, two tool lengths), R-test location or tables, DBB5 circles, ball-bar circles of "
+        "the linear axes (<circle>, ISO 230-4: diagnostics ranked by their share of the circularity)");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->check(CLI::ExistingFile);
     c->add_option("--traces", r.traces, "folder of the measured runs, one <run>.csv per run")->check(CLI::ExistingDirectory);
@@ -177,7 +193,7 @@ const RegisterCommand reg([](CLI::App& app) {
                   "measurement, e.g. the ball-bar eccentricity formulas; closed-form is the same)")
         ->capture_default_str();
     c->add_option("--measure", o->measure,
-                  "override what the plan measures: ball-bar, head-patterns, rtest-location, rtest-tables, dbb5, mixed");
+                  "override what the plan measures: ball-bar, head-patterns, rtest-location, rtest-tables, dbb5, mixed, circle");
     c->add_option("--eccentricities", r.eccentricities, "ball-bar formulas: eccentricity CSV instead of --traces/--plan")
         ->check(CLI::ExistingFile);
     c->add_option("--refine", r.refine,

@@ -1,4 +1,4 @@
-// cnccomp simulate: every run of a plan, of every kind (ball bar, absolute ball bar, R-test, DBB5), on a machine with
+// cnccomp simulate: every run of a plan, of every kind (ball bar, absolute ball bar, R-test, DBB5, linear-axis circle), on a machine with
 // known deviations; one CSV per run (ball-bar runs with their metadata, which the import checks), and eccentricities.csv
 // for the ball-bar runs. Everything is computed, then every file is staged and committed together (io/output_set.hpp):
 // a failing run leaves no output.
@@ -18,6 +18,7 @@
 #include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/eccentricity_csv.hpp"
+#include "cnccomp/io/linear_circle_trace.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -51,7 +52,7 @@ void run(const Options& o) {
     if (plan.runCount() == 0) throw ModelError(fmt::format("plan '{}' has no runs", o.plan));
     if (!o.instrument.empty() && o.instrument != "time" && o.instrument != "angle")
         throw InputError("--instrument", 0, fmt::format("'{}' is not time or angle", o.instrument));
-    if (!o.instrument.empty() && plan.runs.empty())
+    if (!o.instrument.empty() && plan.runs.empty() && plan.circleRuns.empty())
         throw ModelError(fmt::format("--instrument: plan '{}' has no ball-bar runs", o.plan));
     const Kinematics k(m, d);
     std::mt19937_64 rng(o.seed);
@@ -83,6 +84,20 @@ void run(const Options& o) {
             pending.push_back({r.name + ".csv", r.name, o.instrument + "-sampled", n,
                                [text = std::move(text)](std::ostream& out) { out << text; }});
         }
+    }
+    // Circles of the linear axes: always as the instrument records them (both passes with their feed-in and feed-out
+    // arcs), angle-sampled unless --instrument time.
+    for (const LinearCircleRun& r : plan.circleRuns) {
+        std::vector<DirectedTrace> passes = simulateLinearCircle(k, r);
+        size_t n = 0;
+        for (DirectedTrace& p : passes) {
+            if (o.noiseUm > 0)
+                for (double& v : p.trace.dL) v += noise(rng);
+            n += p.trace.dL.size();
+        }
+        std::string text = formatLinearCircleTrace(r, passes, o.instrument == "time", m.name);
+        pending.push_back({r.name + ".csv", r.name, "circle " + std::string(linearPlaneName(r.plane)), n,
+                           [text = std::move(text)](std::ostream& out) { out << text; }});
     }
     for (const BallbarRun& r : plan.absoluteRuns) addTrace(r.name, simulateAbsoluteRun(k, r), "absolute bar", &r);
     for (const Dbb5Run& r : plan.dbb5Runs) addTrace(r.name, simulateDbb5(k, r), "DBB5", nullptr);
@@ -120,7 +135,7 @@ void run(const Options& o) {
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
     auto* c = app.add_subcommand("simulate",
-                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5): one CSV per run "
+                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5, linear-axis circle): one CSV per run "
                                  "and eccentricities.csv for ball-bar runs; nothing is written unless every run succeeds");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->required()->check(CLI::ExistingFile);

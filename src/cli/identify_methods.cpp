@@ -1,5 +1,7 @@
 #include "cli/identify_methods.hpp"
 
+#include "cli/identify_circle.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -334,6 +336,14 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
     requireTraces(r);
     const MachineModel& m = *r.machine;
     const std::vector<Dbb5Run>& runs = r.plan->dbb5Runs;
+    // Only circles of the linear axes on a machine without a pair of table axes: the route of <circle> runs fits them.
+    if (tableRotaryAxes(m).first.empty() && r.outer.empty() &&
+        std::all_of(runs.begin(), runs.end(), [](const Dbb5Run& x) { return x.kind == Dbb5Run::Kind::LinearCircle; }))
+        throw ModelError(fmt::format("the plan's DBB5 runs are circles of the linear axes, and machine '{}' has no tilting "
+                                     "rotary table for the DBB5 method: write them as <circle> runs (plane, centre, radius, "
+                                     "arc; README \"Linear-axis circles (ISO 230-4)\"), whose identification needs no rotary "
+                                     "axis and estimates the bar's centring offset",
+                                     m.name));
     const std::vector<BallbarTrace> traces = readTraces(r.traces, runs);
     fmt::print("{:<14} {:>8} {:>16} {:>18} {:>10}  (ISO 230-4)\n", "run", "samples", "circularity um",
                "mean radial err um", "b2 um");
@@ -433,6 +443,7 @@ IdentifyOutcome runIdentification(const IdentifyRequest& r) {
         case PlanMethod::RtestLocation: return rtestLocation(r);
         case PlanMethod::RtestTables: return rtestTables(r);
         case PlanMethod::Dbb5: return dbb5(r);
+        case PlanMethod::LinearCircle: return identifyLinearCircles(r);
     }
     throw ModelError("unknown plan method");
 }

@@ -14,6 +14,7 @@
 #include "cnccomp/identification/plan_method.hpp"
 #include "cnccomp/identification/report.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/linear_circle_identify.hpp"
 
 namespace cnccomp::cli {
 
@@ -50,6 +51,8 @@ struct IdentifyOutcome {
     /// and the HTML report's polar plots).
     std::optional<MeasuredRuns> measured;
     std::optional<IdentificationResult> result;
+    /// Circles of the linear axes (<circle> runs): their diagnostics and ISO 230-4 figures (the reports take them).
+    std::optional<LinearCircleIdentification> circles{};
 };
 
 /// Runs the method of `r.kind`. Throws ModelError / InputError naming what does not fit.

@@ -231,6 +231,9 @@ std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const 
 }
 
 PlanWorkspace planWorkspace(const MachineModel& m, const MeasurementPlan& plan, const VerifyOptions& options) {
+    if (!plan.circleRuns.empty())
+        throw ModelError("verify does not re-simulate circles of the linear axes (<circle>) yet (issue 20): verify a plan "
+                         "without them");
     const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
     testprog::TestProgramOptions po;
     po.dialect = options.dialect;
@@ -254,6 +257,9 @@ double VerifyRun::spanAfter() const {
 VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const DeviationSet& simulated,
                     const std::string& simulatedName, const VerifyCompensation& comp, const VerifyOptions& options) {
     if (comp.kind == VerifyCompensation::Kind::None) throw ModelError("verify: no compensation given");
+    if (!plan.circleRuns.empty())
+        throw ModelError("verify does not re-simulate circles of the linear axes (<circle>) yet (issue 20): verify a plan "
+                         "without them");
     if ((comp.kind == VerifyCompensation::Kind::Deviations || comp.kind == VerifyCompensation::Kind::ControllerFiles) && !comp.model)
         throw ModelError("verify: the compensation has no controller model");
     const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);

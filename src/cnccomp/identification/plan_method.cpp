@@ -19,6 +19,7 @@ const char* planMethodName(PlanMethod m) {
         case PlanMethod::RtestTables: return "rtest-tables";
         case PlanMethod::Dbb5: return "dbb5";
         case PlanMethod::Mixed: return "mixed";
+        case PlanMethod::LinearCircle: return "circle";
     }
     return "?";
 }
@@ -31,6 +32,9 @@ const char* planMethodMeasures(PlanMethod m) {
         case PlanMethod::RtestTables: return "six errors of each rotary axis of a cradle over its angle (R-test, three balls)";
         case PlanMethod::Dbb5: return "location errors of the rotary axes and squareness of the slides (DBB5 circles), ISO 230-4 figures";
         case PlanMethod::Mixed: return "any subset of the deviations from runs of several kinds";
+        case PlanMethod::LinearCircle:
+            return "diagnostics of the linear axes (centring, squareness, scale mismatch, straightness, backlash, reversal "
+                   "spikes, lateral play, cyclic error, servo mismatch) from ball-bar circles, ISO 230-4 figures";
     }
     return "?";
 }
@@ -54,6 +58,7 @@ const char* planMethodFormulas(PlanMethod m) {
                    "& Yamaji, 'Identification of motion error sources on five-axis machine tools by ball-bar "
                    "measurements (1st report)' (DBB5)";
         case PlanMethod::Mixed: return "none (runs of several kinds)";
+        case PlanMethod::LinearCircle: return "none (the diagnostics are least-squares parameters of the exact model)";
     }
     return "?";
 }
@@ -83,6 +88,7 @@ std::string kindsOf(const MeasurementPlan& plan) {
     add(plan.absoluteRuns.size(), "<absolute-run>");
     add(plan.rtestRuns.size(), "<rtest>");
     add(plan.dbb5Runs.size(), "<dbb5>");
+    add(plan.circleRuns.size(), "<circle>");
     return s;
 }
 
@@ -90,8 +96,14 @@ std::string kindsOf(const MeasurementPlan& plan) {
 
 PlanMethod classifyPlan(const MeasurementPlan& plan) {
     if (plan.runCount() == 0) throw ModelError("the plan has no runs");
-    const int kinds = !plan.runs.empty() + !plan.absoluteRuns.empty() + !plan.rtestRuns.empty() + !plan.dbb5Runs.empty();
+    const int kinds = !plan.runs.empty() + !plan.absoluteRuns.empty() + !plan.rtestRuns.empty() + !plan.dbb5Runs.empty() +
+                      !plan.circleRuns.empty();
+    if (kinds > 1 && !plan.circleRuns.empty())
+        throw ModelError(fmt::format("the plan has circles of the linear axes (<circle>) and other runs ({}): the circles' "
+                                     "diagnostics are identified on their own; put the <circle> runs in a plan of their own",
+                                     kindsOf(plan)));
     if (kinds > 1) return PlanMethod::Mixed;
+    if (!plan.circleRuns.empty()) return PlanMethod::LinearCircle;
     if (!plan.runs.empty()) return PlanMethod::Ballbar;
     if (!plan.absoluteRuns.empty()) return PlanMethod::HeadPatterns;
     if (!plan.dbb5Runs.empty()) return PlanMethod::Dbb5;
@@ -104,13 +116,13 @@ PlanMethod choosePlanMethod(const MeasurementPlan& plan, const std::string& name
     PlanMethod want = PlanMethod::Mixed;
     bool known = false;
     for (PlanMethod m : {PlanMethod::Ballbar, PlanMethod::HeadPatterns, PlanMethod::RtestLocation, PlanMethod::RtestTables,
-                         PlanMethod::Dbb5, PlanMethod::Mixed})
+                         PlanMethod::Dbb5, PlanMethod::Mixed, PlanMethod::LinearCircle})
         if (name == planMethodName(m)) want = m, known = true;
     if (!known)
         throw ModelError(fmt::format("unknown measurement '{}' (ball-bar, head-patterns, rtest-location, rtest-tables, "
-                                     "dbb5, mixed)",
+                                     "dbb5, mixed, circle)",
                                      name));
-    if (want == fits || want == PlanMethod::Mixed) return want;
+    if (want == fits || (want == PlanMethod::Mixed && fits != PlanMethod::LinearCircle)) return want;
     // The two R-test methods read the same kind of run.
     if (fits == PlanMethod::RtestTables && want == PlanMethod::RtestLocation) return want;
     if (fits == PlanMethod::RtestLocation && want == PlanMethod::RtestTables)

@@ -16,6 +16,7 @@ enum class PlanMethod {
     RtestTables,    ///< R-test, ≥ 3 balls per swept axis (<rtest>): six errors of each rotary axis over angle
     Dbb5,           ///< DBB5 circles (<dbb5>): location errors of the rotary axes and squareness, ISO 230-4 figures
     Mixed,          ///< runs of several kinds: least squares only
+    LinearCircle,   ///< ball-bar circles of the linear axes (<circle>, ISO 230-4): their diagnostics, any machine
 };
 
 /// Short name used on the command line and in messages ("ball-bar", "head-patterns", "rtest-location", …).

@@ -292,6 +292,55 @@ Dbb5Run readDbb5Run(const XMLElement& e, const std::string& path) {
     return r;
 }
 
+LinearCircleRun readCircleRun(const XMLElement& e, const std::string& path, const RunCapture& instrument) {
+    xml::allowAttributes(e, path, {"name", "plane", "centre", "radius", "start", "arc", "step", "tool-length", "pivot-offset", "pitch",
+                                   "date", "instrument", "operator", "feed", "overshoot", "directions", "angle-column",
+                                   "time-column", "length-column", "pass-column", "length-unit", "angle-unit", "time-unit",
+                                   "decimal", "length", "drift"});
+    LinearCircleRun r;
+    r.name = runName(e, path);
+    r.line = e.GetLineNum();
+    const std::string plane = xml::text(e, path, "plane");
+    if (plane == "XY") r.plane = LinearPlane::XY;
+    else if (plane == "YZ") r.plane = LinearPlane::YZ;
+    else if (plane == "ZX") r.plane = LinearPlane::ZX;
+    else
+        xml::fail(e, path, fmt::format("plane '{}' is not XY, YZ or ZX (the first axis is u, θ = 0 along it; YX, ZY and XZ "
+                                       "are the same planes written the other way: use XY, YZ, ZX)",
+                                       plane));
+    if (!xml::has(e, "radius")) xml::fail(e, path, "missing attribute 'radius' (mm, the ball-bar length)");
+    r.radius = xml::number(e, path, "radius");
+    r.centre = xml::vec3(e, path, "centre", Vec3::Zero());
+    r.startDeg = xml::number(e, path, "start", 0.0);
+    r.arcDeg = xml::number(e, path, "arc", 360.0);
+    r.stepDeg = xml::number(e, path, "step", 1.0);
+    r.toolLength = xml::number(e, path, "tool-length", 0.0);
+    r.pivotOffset = xml::vec3(e, path, "pivot-offset", Vec3::Zero());
+    if (xml::has(e, "pitch")) {
+        std::istringstream in(xml::text(e, path, "pitch"));
+        double a = 0, b = 0;
+        std::string rest;
+        if (!(in >> a >> b) || (in >> rest))
+            xml::fail(e, path, "pitch must be two numbers \"pu pv\" (mm; 0 = no cyclic error estimated for that axis)");
+        r.cyclicPitch = {a, b};
+    }
+    r.date = xml::textOr(e, "date", "");
+    r.instrument = xml::textOr(e, "instrument", "");
+    r.operatorName = xml::textOr(e, "operator", "");
+    readCapture(e, path, instrument, r.capture);
+    if (!xml::has(e, "feed")) r.capture.feed = 1000.0;
+    if (r.capture.passes.empty()) r.capture.passes = {-1, +1};
+    std::vector<RotarySweep> holds;
+    readAxisChildren(e, path, false, holds);
+    for (const RotarySweep& h : holds) r.hold.emplace_back(h.axis, h.startDeg);
+    try {
+        r.validate();
+    } catch (const ModelError& ex) {
+        xml::fail(e, path, ex.what());
+    }
+    return r;
+}
+
 std::string vec(const Vec3& v) {  // + 0.0 prints −0 as 0
     return fmt::format("{:g} {:g} {:g}", v.x() + 0.0, v.y() + 0.0, v.z() + 0.0);
 }
@@ -357,14 +406,18 @@ MeasurementPlan readPlanXml(const std::string& path) {
         } else if (kind == "dbb5") {
             plan.dbb5Runs.push_back(readDbb5Run(*e, path));
             name = plan.dbb5Runs.back().name;
+        } else if (kind == "circle") {
+            plan.circleRuns.push_back(readCircleRun(*e, path, instrument));
+            name = plan.circleRuns.back().name;
         } else {
-            xml::fail(*e, path, fmt::format("expected <run>, <absolute-run>, <rtest> or <dbb5> (or one <instrument>); did you "
-                                            "mean <{}>?",
-                                            xml::nearestName(kind, {"run", "absolute-run", "rtest", "dbb5", "instrument"})));
+            xml::fail(*e, path, fmt::format("expected <run>, <absolute-run>, <rtest>, <dbb5> or <circle> (or one <instrument>); "
+                                            "did you mean <{}>?",
+                                            xml::nearestName(kind, {"run", "absolute-run", "rtest", "dbb5", "circle", "instrument"})));
         }
         if (!names.insert(name).second) xml::fail(*e, path, fmt::format("run name '{}' is used twice", name));
     }
-    if (plan.runCount() == 0) xml::fail(root, path, "a plan needs at least one run (<run>, <absolute-run>, <rtest> or <dbb5>)");
+    if (plan.runCount() == 0)
+        xml::fail(root, path, "a plan needs at least one run (<run>, <absolute-run>, <rtest>, <dbb5> or <circle>)");
     return plan;
 }
 
@@ -375,14 +428,15 @@ std::string formatPlanXml(const MeasurementPlan& plan) {
                      esc(plan.description),
                      std::isfinite(plan.noiseUm) ? fmt::format(" noise-um=\"{:g}\"", plan.noiseUm) : "");
     // One <instrument> when every ball-bar run shares its settings; runs write what differs from it.
-    std::vector<const BallbarRun*> ballbar;
-    for (const auto& r : plan.runs) ballbar.push_back(&r);
-    for (const auto& r : plan.absoluteRuns) ballbar.push_back(&r);
+    std::vector<const RunCapture*> captures;
+    for (const auto& r : plan.runs) captures.push_back(&r.capture);
+    for (const auto& r : plan.absoluteRuns) captures.push_back(&r.capture);
+    for (const auto& r : plan.circleRuns) captures.push_back(&r.capture);
     RunCapture instrument;
-    if (!ballbar.empty()) {
-        const RunCapture first = instrumentPart(ballbar.front()->capture);
+    if (!captures.empty()) {
+        const RunCapture first = instrumentPart(*captures.front());
         bool shared = true;
-        for (const BallbarRun* r : ballbar) shared = shared && instrumentPart(r->capture) == first;
+        for (const RunCapture* c : captures) shared = shared && instrumentPart(*c) == first;
         if (shared) instrument = first;
     }
     if (const std::string attrs = instrumentAttributes(instrument, RunCapture{}); !attrs.empty())
@@ -419,6 +473,26 @@ std::string formatPlanXml(const MeasurementPlan& plan) {
         o << ">\n";
         for (const auto& [axis, deg] : r.hold) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", esc(axis), deg);
         o << "  </dbb5>\n";
+    }
+    for (const auto& r : plan.circleRuns) {
+        o << fmt::format("  <circle name=\"{}\" plane=\"{}\" centre=\"{}\" radius=\"{:g}\" start=\"{:g}\" arc=\"{:g}\" "
+                         "step=\"{:g}\"",
+                         esc(r.name), linearPlaneName(r.plane), vec(r.centre), r.radius, r.startDeg, r.arcDeg, r.stepDeg);
+        if (r.toolLength != 0) o << fmt::format(" tool-length=\"{:g}\"", r.toolLength);
+        if (!r.pivotOffset.isZero()) o << fmt::format(" pivot-offset=\"{}\"", vec(r.pivotOffset));
+        if (r.cyclicPitch[0] != 0 || r.cyclicPitch[1] != 0)
+            o << fmt::format(" pitch=\"{:g} {:g}\"", r.cyclicPitch[0], r.cyclicPitch[1]);
+        for (const auto& [attr, value] : {std::pair<const char*, const std::string*>{"date", &r.date},
+                                          {"instrument", &r.instrument}, {"operator", &r.operatorName}})
+            if (!value->empty()) o << fmt::format(" {}=\"{}\"", attr, esc(*value));
+        o << captureAttributes(r.capture, instrument);
+        if (r.hold.empty()) {
+            o << "/>\n";
+            continue;
+        }
+        o << ">\n";
+        for (const auto& [axis, deg] : r.hold) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", esc(axis), deg);
+        o << "  </circle>\n";
     }
     o << "</plan>\n";
     return o.str();

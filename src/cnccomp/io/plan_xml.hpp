@@ -5,6 +5,7 @@
 //  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute (seed 002);
 //  <rtest>        R-test run (seed 001/004): ball on the table, nest on the spindle, rotary sweeps;
 //  <dbb5>         DBB5 run (ball bar held at 45°): linear circle in a plane, rotary-axis circle, or cone frustum.
+//  <circle>       ball-bar circle of two linear axes (ISO 230-4), any machine (linear_circle_run.hpp).
 #include <string>
 
 #include "cnccomp/measurement/plan.hpp"
@@ -24,6 +25,10 @@ namespace cnccomp {
 /// <dbb5 name kind="linear|rotary|cone" LB [tool-length=100] ball="x y z" [start=0 end=360 step=5] (linear:
 /// plane="XY|YZ|ZX"; rotary: axis direction="x y z" [setup=0]; cone: [cone-tilt=10 tool-angle=15 bar-angle=45 setup=0],
 /// deg) > with children <hold axis deg/>.
+/// <circle name plane="XY|YZ|ZX" radius [centre="x y z"=0 start=0 arc=360 step=1 tool-length=0 pivot-offset="x y z"=0 pitch="pu pv"=0
+/// feed=1000 overshoot=0 directions="cw ccw" date instrument operator, the instrument attributes]> with children
+/// <hold axis deg/> (rotary axes): a ball-bar circle of the linear axes (linear_circle_run.hpp), centre in axis
+/// commands, arc in (0, 360]°.
 MeasurementPlan readPlanXml(const std::string& path);
 /// Throws InputError naming the plan file and the line of <plan> when the plan names another machine than `machine`.
 void checkPlanMachine(const MeasurementPlan& plan, const std::string& planPath, const std::string& machine);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cnccomp/ballbar.hpp"
+#include "cnccomp/linear_circle_run.hpp"
 #include "cnccomp/measurement/dbb5_run.hpp"
 #include "cnccomp/measurement/rtest_run.hpp"
 
@@ -22,8 +23,11 @@ struct MeasurementPlan {
     std::vector<BallbarRun> absoluteRuns;  ///< <absolute-run>
     std::vector<RtestRun> rtestRuns;       ///< <rtest>
     std::vector<Dbb5Run> dbb5Runs;         ///< <dbb5>
+    std::vector<LinearCircleRun> circleRuns;  ///< <circle>
     /// Total number of runs of every kind.
-    size_t runCount() const { return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size(); }
+    size_t runCount() const {
+        return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size() + circleRuns.size();
+    }
 };
 
 }  // namespace cnccomp

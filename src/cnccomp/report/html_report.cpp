@@ -125,6 +125,11 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
                            isoJson(r.before), isoJson(r.after), jsonNumber(r.rmsBefore / kUm), jsonNumber(r.rmsAfter / kUm),
                            jsonString(i < files.plots.size() ? fileName(files.plots[i]) : ""));
     });
+    appendRows(o, "tables", d.tables, [](const TableSection& t, size_t) {
+        const auto cells = [](const std::vector<std::string>& v) { return jsonArray(v, [](const std::string& c) { return jsonString(c); }); };
+        return fmt::format("{{\"title\": {}, \"header\": {}, \"rows\": {}, \"notes\": {}}}", jsonString(t.title), cells(t.header),
+                           jsonArray(t.rows, cells), cells(t.notes));
+    });
     appendRows(o, "spans", d.spans, [](const PassSpan& p, size_t) {
         return fmt::format("{{\"run\": {}, \"type\": {}, \"pass\": {}, \"quantity\": {}, \"before_um\": {}, \"after_um\": {}, "
                            "\"warning\": {}}}",
@@ -215,6 +220,19 @@ std::string formatHtmlReport(const ReportData& d, const ReportFiles& files, cons
             h += fmt::format("<figcaption>{}</figcaption>\n</figure>\n", caption);
         }
         h += "</div>\n";
+    }
+
+    for (const TableSection& t : d.tables) {
+        h += fmt::format("<h2>{}</h2>\n<table>\n<tr>", esc(t.title));
+        for (const std::string& c : t.header) h += "<th class=\"l\">" + esc(c) + "</th>";
+        h += "</tr>\n";
+        for (const auto& row : t.rows) {
+            h += "<tr>";
+            for (const std::string& c : row) h += "<td class=\"l\">" + esc(c) + "</td>";
+            h += "</tr>\n";
+        }
+        h += "</table>\n";
+        for (const std::string& n : t.notes) h += "<p style=\"font-size:12px\">" + esc(n) + "</p>\n";
     }
 
     if (!d.spans.empty()) {

@@ -106,6 +106,15 @@ struct ControllerSection {
     std::string basis;                ///< what the figures are ("predicted on the identified machine", …)
 };
 
+/// A table of text cells shown after the runs (e.g. the ranked diagnostics of a linear-axis circle), also in the JSON
+/// summary under "tables". Cells are plain text (escaped when written).
+struct TableSection {
+    std::string title;
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    std::vector<std::string> notes;  ///< paragraphs under the table
+};
+
 struct ReportData {
     std::string title;                 ///< page title
     std::string machine;               ///< machine name
@@ -116,6 +125,7 @@ struct ReportData {
     std::vector<std::string> alarms;
     std::string afterNote;             ///< what "after" means in the runs' figures (shown under their table)
     std::vector<RunSection> runs;
+    std::vector<TableSection> tables;  ///< shown after the runs
     std::vector<PassSpan> spans;       ///< verify: every pass of every run, ball bar and R-test
     std::vector<DeviationRow> deviations;
     std::vector<std::string> combinations;  ///< identifiable combinations of unidentified deviations, as text
