@@ -15,24 +15,6 @@
 
 namespace cnccomp {
 
-const char* linearPlaneName(LinearPlane p) {
-    switch (p) {
-        case LinearPlane::XY: return "XY";
-        case LinearPlane::YZ: return "YZ";
-        case LinearPlane::ZX: return "ZX";
-    }
-    return "?";
-}
-
-std::array<char, 2> linearPlaneAxes(LinearPlane p) {
-    switch (p) {
-        case LinearPlane::XY: return {'X', 'Y'};
-        case LinearPlane::YZ: return {'Y', 'Z'};
-        case LinearPlane::ZX: return {'Z', 'X'};
-    }
-    return {'?', '?'};
-}
-
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_detail {
 

@@ -73,10 +73,24 @@
 namespace cnccomp {
 
 enum class LinearPlane { XY, YZ, ZX };
-/// "XY" / "YZ" / "ZX".
-const char* linearPlaneName(LinearPlane p);
+/// "XY" / "YZ" / "ZX" (inline: the plan reader names planes without the model's fitting code).
+inline const char* linearPlaneName(LinearPlane p) {
+    switch (p) {
+        case LinearPlane::XY: return "XY";
+        case LinearPlane::YZ: return "YZ";
+        case LinearPlane::ZX: return "ZX";
+    }
+    return "?";
+}
 /// Axis letters (u, v) of the plane: XY → X, Y; YZ → Y, Z; ZX → Z, X.
-std::array<char, 2> linearPlaneAxes(LinearPlane p);
+inline std::array<char, 2> linearPlaneAxes(LinearPlane p) {
+    switch (p) {
+        case LinearPlane::XY: return {'X', 'Y'};
+        case LinearPlane::YZ: return {'Y', 'Z'};
+        case LinearPlane::ZX: return {'Z', 'X'};
+    }
+    return {'?', '?'};
+}
 
 /// The nominal circle: plane, centre (u, v) and radius, mm.
 struct LinearCircle {
