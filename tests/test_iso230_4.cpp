@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <random>
 
 #include "cnccomp/circular_test.hpp"
 #include "cnccomp/error.hpp"
@@ -33,6 +34,126 @@ BallbarTrace shape(double R, double b, Eigen::Vector2d c, double stepDeg, int di
         t.dL.push_back(p.norm() - LB);
     }
     return t;
+}
+
+// ---- An independent transcription of the ISO 230-4:2005 evaluation (clause 3 definitions), written from the standard,
+// not from circular_test.cpp: the polar plot's points p_k = (LB + ΔL_k)(cos θ_k, sin θ_k); the least-squares circle
+// (minimum Σ (|p_k − c| − r)², solved here by Gauss–Newton on (c_x, c_y, r) from the centroid); circular deviation
+// G = max |p_k − c| − min |p_k − c|; radial deviation F = max / min ΔL (about the nominal centre); circular hysteresis
+// H = the largest radial difference between the two directions, each pass's sample against the other pass linearly
+// interpolated at its angle (within the angles both cover).
+struct IsoFigures {
+    double G = 0, Fmax = 0, Fmin = 0, radius = 0;
+};
+
+IsoFigures isoTranscription(const BallbarTrace& t, double lb) {
+    const size_t n = t.dL.size();
+    std::vector<double> x(n), y(n);
+    double cx = 0, cy = 0;
+    for (size_t k = 0; k < n; ++k) {
+        const double a = t.angleDeg[k] * M_PI / 180.0, rho = lb + t.dL[k];
+        x[k] = rho * std::cos(a);
+        y[k] = rho * std::sin(a);
+        cx += x[k] / n;
+        cy += y[k] / n;
+    }
+    double r = 0;
+    for (size_t k = 0; k < n; ++k) r += std::hypot(x[k] - cx, y[k] - cy) / n;
+    for (int it = 0; it < 50; ++it) {  // Gauss–Newton: residual e_k = |p_k − c| − r
+        double JtJ[3][3] = {}, Jte[3] = {};
+        for (size_t k = 0; k < n; ++k) {
+            const double dx = x[k] - cx, dy = y[k] - cy, d = std::hypot(dx, dy);
+            const double J[3] = {-dx / d, -dy / d, -1.0}, e = d - r;
+            for (int i = 0; i < 3; ++i) {
+                Jte[i] += J[i] * e;
+                for (int j = 0; j < 3; ++j) JtJ[i][j] += J[i] * J[j];
+            }
+        }
+        // Solve JtJ·δ = −Jte by Cramer's rule.
+        const auto det3 = [](double m[3][3]) {
+            return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                   m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        };
+        const double D = det3(JtJ);
+        double step[3];
+        for (int c = 0; c < 3; ++c) {
+            double m[3][3];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) m[i][j] = j == c ? -Jte[i] : JtJ[i][j];
+            step[c] = det3(m) / D;
+        }
+        cx += step[0];
+        cy += step[1];
+        r += step[2];
+        if (std::abs(step[0]) + std::abs(step[1]) + std::abs(step[2]) < 1e-15) break;
+    }
+    IsoFigures f;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    f.Fmin = HUGE_VAL;
+    f.Fmax = -HUGE_VAL;
+    for (size_t k = 0; k < n; ++k) {
+        const double d = std::hypot(x[k] - cx, y[k] - cy);
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+        f.Fmax = std::max(f.Fmax, t.dL[k]);
+        f.Fmin = std::min(f.Fmin, t.dL[k]);
+    }
+    f.G = hi - lo;
+    f.radius = r;
+    return f;
+}
+
+double hysteresisTranscription(const BallbarTrace& a, const BallbarTrace& b) {
+    const auto at = [](const BallbarTrace& t, double angle, double& v) {  // linear interpolation, t in any order
+        for (size_t i = 0; i + 1 < t.dL.size(); ++i) {
+            const double a0 = t.angleDeg[i], a1 = t.angleDeg[i + 1];
+            if (a0 == a1 || angle < std::min(a0, a1) || angle > std::max(a0, a1)) continue;
+            v = t.dL[i] + (angle - a0) / (a1 - a0) * (t.dL[i + 1] - t.dL[i]);
+            return true;
+        }
+        return false;
+    };
+    double h = 0;
+    for (const auto& [p, q] : {std::pair{&a, &b}, std::pair{&b, &a}})
+        for (size_t k = 0; k < p->dL.size(); ++k) {
+            double v = 0;
+            if (at(*q, p->angleDeg[k], v)) h = std::max(h, std::abs(p->dL[k] - v));
+        }
+    return h;
+}
+
+// Oracle: the transcription above, on traces with an off-centre pivot, harmonics of orders 2–5, random noise and a
+// CCW/CW difference, over whole turns and the 220° arcs of the vertical planes.
+TEST(Iso230_4, AgreesWithAnIndependentTranscriptionOfTheStandard) {
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> noise(0.0, 0.3e-3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int trial = 0; trial < 20; ++trial) {
+        const double arc = trial % 2 ? 220.0 : 360.0, start = trial % 2 ? -20.0 : 0.0, step = 1.0;
+        const double ex = 5e-3 * u(rng), ey = 5e-3 * u(rng);
+        double c[6];
+        for (double& v : c) v = 4e-3 * u(rng);
+        BallbarTrace ccw, cw;
+        const int n = static_cast<int>(arc / step) + (arc < 360 ? 1 : 0);
+        for (int k = 0; k < n; ++k) {
+            const double a = start + k * step, t = a * kDeg;
+            const double shape = ex * std::cos(t) + ey * std::sin(t) + c[0] * std::cos(2 * t) + c[1] * std::sin(3 * t) +
+                                 c[2] * std::cos(5 * t);
+            ccw.angleDeg.push_back(a);
+            ccw.dL.push_back(shape + noise(rng));
+            cw.angleDeg.insert(cw.angleDeg.begin(), a);
+            cw.dL.insert(cw.dL.begin(), shape + c[3] + c[4] * std::sin(t) + noise(rng));
+        }
+        for (const BallbarTrace* t : {&ccw, &cw}) {
+            const CircularTestResult ours = evaluateCircularTest(*t, LB);
+            const IsoFigures iso = isoTranscription(*t, LB);
+            EXPECT_NEAR(ours.circularity, iso.G, 1e-9) << trial;
+            EXPECT_NEAR(ours.radialMax, iso.Fmax, 1e-12) << trial;
+            EXPECT_NEAR(ours.radialMin, iso.Fmin, 1e-12) << trial;
+            EXPECT_NEAR(ours.meanRadius, iso.radius, 1e-9) << trial;
+        }
+        EXPECT_NEAR(circularHysteresis(ccw, cw), hysteresisTranscription(ccw, cw), 1e-12) << trial;
+    }
 }
 
 TEST(Iso230_4, CircularDeviationRadialDeviationAndMeanRadiusOfAKnownShape) {
