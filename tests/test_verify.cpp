@@ -14,8 +14,8 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
-#include "cnccomp/verify.hpp"
-#include "cnccomp/verify_sources.hpp"
+#include "app/verify.hpp"
+#include "app/verify_sources.hpp"
 #include "test_deviation_text.hpp"
 #include "test_support.hpp"
 

@@ -1,4 +1,4 @@
-#include "cli/identify_methods.hpp"
+#include "app/identify_methods.hpp"
 
 #include <algorithm>
 #include <cmath>
