@@ -14,7 +14,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 #include "controllers/common/evaluate.hpp"
 #include "controllers/common/fit.hpp"
 #include "controller_test_util.hpp"

@@ -13,7 +13,7 @@
 #include "controllers/heidenhain/kinematics_table.hpp"
 #include "controllers/heidenhain/tnc_table.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::controllers {

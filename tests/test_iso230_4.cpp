@@ -11,7 +11,7 @@
 #include "cnccomp/circular_test.hpp"
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/report_json.hpp"
-#include "cnccomp/report/html_report.hpp"
+#include "app/report/html_report.hpp"
 
 namespace cnccomp {
 namespace {

@@ -18,7 +18,7 @@
 #include "cnccomp/linear_circle_identify.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
-#include "cnccomp/report/polar_plot.hpp"
+#include "app/report/polar_plot.hpp"
 #include "test_browser.hpp"
 #include "test_support.hpp"
 

@@ -16,10 +16,10 @@
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/svg_map.hpp"
 #include "cnccomp/map_grid.hpp"
-#include "cnccomp/report/html_report.hpp"
+#include "app/report/html_report.hpp"
 #include "cnccomp/error.hpp"
-#include "cnccomp/report/polar_plot.hpp"
-#include "cnccomp/report/report_format.hpp"
+#include "app/report/polar_plot.hpp"
+#include "app/report/report_format.hpp"
 #include "test_browser.hpp"
 #include "test_support.hpp"
 

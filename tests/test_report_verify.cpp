@@ -13,7 +13,7 @@
 
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/report_json.hpp"
-#include "cnccomp/report/polar_plot.hpp"
+#include "app/report/polar_plot.hpp"
 #include "test_browser.hpp"
 #include "test_deviation_text.hpp"
 #include "test_support.hpp"

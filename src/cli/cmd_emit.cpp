@@ -17,7 +17,7 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "controllers/backend.hpp"
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 #include "controllers/common/evaluate.hpp"
 #include "controllers/common/fit.hpp"
 #include "controllers/common/header.hpp"

@@ -8,8 +8,8 @@
 #include <fmt/format.h>
 
 #include "cli/command.hpp"
-#include "cli/identify_circle.hpp"
-#include "cli/identify_methods.hpp"
+#include "app/identify_circle.hpp"
+#include "app/identify_methods.hpp"
 #include "cli/print.hpp"
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
@@ -19,9 +19,9 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/text_util.hpp"
-#include "cnccomp/report/html_report.hpp"
-#include "cnccomp/report/identification_report.hpp"
-#include "cnccomp/report/linear_circle_report.hpp"
+#include "app/report/html_report.hpp"
+#include "app/report/identification_report.hpp"
+#include "app/report/linear_circle_report.hpp"
 
 namespace cnccomp::cli {
 namespace {

@@ -18,11 +18,11 @@
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
-#include "cnccomp/io/verify_json.hpp"
-#include "cnccomp/report/html_report.hpp"
-#include "cnccomp/report/verification_report.hpp"
-#include "cnccomp/verify.hpp"
-#include "cnccomp/verify_sources.hpp"
+#include "app/verify_json.hpp"
+#include "app/report/html_report.hpp"
+#include "app/report/verification_report.hpp"
+#include "app/verify.hpp"
+#include "app/verify_sources.hpp"
 
 namespace cnccomp::cli {
 namespace {

@@ -7,7 +7,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 #include "controllers/backend.hpp"
 
 namespace {

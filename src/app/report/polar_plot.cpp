@@ -1,4 +1,4 @@
-#include "cnccomp/report/polar_plot.hpp"
+#include "app/report/polar_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/markup.hpp"
-#include "cnccomp/report/report_format.hpp"
+#include "app/report/report_format.hpp"
 
 namespace cnccomp::report {
 

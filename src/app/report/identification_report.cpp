@@ -1,4 +1,4 @@
-#include "cnccomp/report/identification_report.hpp"
+#include "app/report/identification_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/map_grid.hpp"
-#include "cnccomp/report/compensation_map.hpp"
+#include "app/report/compensation_map.hpp"
 #include "cnccomp/volumetric_map.hpp"
 #include "controllers/backend.hpp"
 #include "controllers/common/evaluate.hpp"

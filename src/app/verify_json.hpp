@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 
 namespace cnccomp {
 

@@ -1,4 +1,4 @@
-#include "cnccomp/report/report_data.hpp"
+#include "app/report/report_data.hpp"
 
 namespace cnccomp::report {
 

@@ -1,4 +1,4 @@
-#include "cnccomp/report/compensation_map.hpp"
+#include "app/report/compensation_map.hpp"
 
 #include <algorithm>
 #include <cmath>

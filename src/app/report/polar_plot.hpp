@@ -5,7 +5,7 @@
 // figures underneath.
 #include <string>
 
-#include "cnccomp/report/report_data.hpp"
+#include "app/report/report_data.hpp"
 
 namespace cnccomp::report {
 

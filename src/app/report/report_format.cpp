@@ -1,4 +1,4 @@
-#include "cnccomp/report/report_format.hpp"
+#include "app/report/report_format.hpp"
 
 #include <cmath>
 

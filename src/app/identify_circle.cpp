@@ -1,4 +1,4 @@
-#include "cli/identify_circle.hpp"
+#include "app/identify_circle.hpp"
 
 #include <cmath>
 

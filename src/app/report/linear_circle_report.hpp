@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cnccomp/linear_circle_identify.hpp"
-#include "cnccomp/report/report_data.hpp"
+#include "app/report/report_data.hpp"
 
 namespace cnccomp::report {
 

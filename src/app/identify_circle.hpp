@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "cli/identify_methods.hpp"
+#include "app/identify_methods.hpp"
 
 namespace cnccomp::cli {
 

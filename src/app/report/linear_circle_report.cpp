@@ -1,10 +1,10 @@
-#include "cnccomp/report/linear_circle_report.hpp"
+#include "app/report/linear_circle_report.hpp"
 
 #include <cmath>
 
 #include <fmt/format.h>
 
-#include "cnccomp/report/report_format.hpp"
+#include "app/report/report_format.hpp"
 
 namespace cnccomp::report {
 

@@ -1,6 +1,6 @@
-#include "cnccomp/report/verification_report.hpp"
+#include "app/report/verification_report.hpp"
 
-#include "cnccomp/io/verify_json.hpp"
+#include "app/verify_json.hpp"
 
 #include <cmath>
 

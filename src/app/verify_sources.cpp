@@ -1,4 +1,4 @@
-#include "cnccomp/verify_sources.hpp"
+#include "app/verify_sources.hpp"
 
 #include <algorithm>
 #include <filesystem>

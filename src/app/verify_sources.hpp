@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 
 namespace cnccomp {
 

@@ -1,4 +1,4 @@
-#include "cnccomp/io/verify_json.hpp"
+#include "app/verify_json.hpp"
 
 #include <cmath>
 

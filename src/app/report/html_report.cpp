@@ -1,4 +1,4 @@
-#include "cnccomp/report/html_report.hpp"
+#include "app/report/html_report.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -9,8 +9,8 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/markup.hpp"
-#include "cnccomp/report/polar_plot.hpp"
-#include "cnccomp/report/report_format.hpp"
+#include "app/report/polar_plot.hpp"
+#include "app/report/report_format.hpp"
 
 namespace cnccomp::report {
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-#include "cnccomp/verify.hpp"
+#include "app/verify.hpp"
 
 #include <algorithm>
 #include <cmath>

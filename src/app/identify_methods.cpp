@@ -1,6 +1,6 @@
-#include "cli/identify_methods.hpp"
+#include "app/identify_methods.hpp"
 
-#include "cli/identify_circle.hpp"
+#include "app/identify_circle.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -13,8 +13,8 @@
 
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/measured_observations.hpp"
-#include "cnccomp/report/compensation_map.hpp"
-#include "cnccomp/report/report_data.hpp"
+#include "app/report/compensation_map.hpp"
+#include "app/report/report_data.hpp"
 
 namespace cnccomp::report {
 

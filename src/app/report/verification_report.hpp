@@ -15,9 +15,9 @@
 #include <optional>
 #include <string>
 
-#include "cnccomp/report/compensation_map.hpp"
-#include "cnccomp/report/report_data.hpp"
-#include "cnccomp/verify.hpp"
+#include "app/report/compensation_map.hpp"
+#include "app/report/report_data.hpp"
+#include "app/verify.hpp"
 
 namespace cnccomp::report {
 

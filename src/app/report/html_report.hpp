@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cnccomp/io/output_set.hpp"
-#include "cnccomp/report/report_data.hpp"
+#include "app/report/report_data.hpp"
 
 namespace cnccomp::report {
 
