@@ -59,6 +59,16 @@ void run(const Options& o) {
     std::normal_distribution<double> noise(0.0, o.noiseUm * kUm);
     std::vector<Pending> pending;
     std::vector<BallbarTrace> ballbar;
+    // Noise on every sample of the passes an instrument records; the number of samples.
+    const auto noisyPasses = [&](std::vector<DirectedTrace>& passes) {
+        size_t n = 0;
+        for (DirectedTrace& p : passes) {
+            if (o.noiseUm > 0)
+                for (double& v : p.trace.dL) v += noise(rng);
+            n += p.trace.dL.size();
+        }
+        return n;
+    };
     const auto addTrace = [&](const std::string& name, BallbarTrace t, const char* kind, const BallbarRun* run) {
         if (o.noiseUm > 0)
             for (double& v : t.dL) v += noise(rng);
@@ -74,12 +84,7 @@ void run(const Options& o) {
         // As the instrument records and exports them: every pass of the capture, overshoot included, noise on every sample.
         for (const BallbarRun& r : plan.runs) {
             std::vector<DirectedTrace> passes = simulateCapturedPasses(k, r);
-            size_t n = 0;
-            for (DirectedTrace& p : passes) {
-                if (o.noiseUm > 0)
-                    for (double& v : p.trace.dL) v += noise(rng);
-                n += p.trace.dL.size();
-            }
+            const size_t n = noisyPasses(passes);
             std::string text = formatCapturedTrace(r, passes, o.instrument == "time", m.name);
             pending.push_back({r.name + ".csv", r.name, o.instrument + "-sampled", n,
                                [text = std::move(text)](std::ostream& out) { out << text; }});
@@ -89,12 +94,7 @@ void run(const Options& o) {
     // arcs), angle-sampled unless --instrument time.
     for (const LinearCircleRun& r : plan.circleRuns) {
         std::vector<DirectedTrace> passes = simulateLinearCircle(k, r);
-        size_t n = 0;
-        for (DirectedTrace& p : passes) {
-            if (o.noiseUm > 0)
-                for (double& v : p.trace.dL) v += noise(rng);
-            n += p.trace.dL.size();
-        }
+        const size_t n = noisyPasses(passes);
         std::string text = formatLinearCircleTrace(r, passes, o.instrument == "time", m.name);
         pending.push_back({r.name + ".csv", r.name, "circle " + std::string(linearPlaneName(r.plane)), n,
                            [text = std::move(text)](std::ostream& out) { out << text; }});

@@ -8,6 +8,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
+#include "cnccomp/io/trace_export.hpp"
 
 namespace cnccomp {
 
@@ -90,12 +91,6 @@ std::string formatLinearCircleTrace(const LinearCircleRun& run, const std::vecto
                                     const std::string& machine) {
     using namespace linear_circle_trace_detail;
     const RunCapture& c = run.capture;
-    const char sep = c.decimal == ',' ? ';' : ',';
-    const auto number = [&](double v, int decimals) {
-        std::string s = fmt::format("{:.{}f}", v, decimals);
-        if (c.decimal == ',') std::replace(s.begin(), s.end(), '.', ',');
-        return s;
-    };
     const double omegaDeg = c.feed / 60.0 / run.radius * 180.0 / kPi;  // deg/s
     if (timeSampled && !(omegaDeg > 0)) throw ModelError(fmt::format("circle run '{}': a time-sampled file needs the feed", run.name));
     std::string o = "# cnccomp ball-bar circle of the linear axes (ISO 230-4)\n";
@@ -106,22 +101,7 @@ std::string formatLinearCircleTrace(const LinearCircleRun& run, const std::vecto
     for (const auto& [key, value] : {std::pair<const char*, const std::string*>{"date", &run.date},
                                      {"instrument", &run.instrument}, {"operator", &run.operatorName}})
         if (!value->empty()) o += fmt::format("# {}: {}\n", key, lcOneLine(*value));
-    o += fmt::format("{}{}{}", timeSampled ? c.timeColumn : c.angleColumn, sep, c.lengthColumn);
-    if (passes.size() > 1) o += fmt::format("{}{}", sep, c.passColumn);
-    o += "\n";
-    double t0 = 0;
-    for (const DirectedTrace& p : passes) {
-        if (p.trace.dL.empty()) continue;
-        const double a0 = p.trace.angleDeg.front();
-        for (size_t i = 0; i < p.trace.dL.size(); ++i) {
-            const double x = timeSampled ? (t0 + std::abs(p.trace.angleDeg[i] - a0) / omegaDeg) / c.timeUnit
-                                         : p.trace.angleDeg[i] / c.angleUnit;
-            o += number(x, 7) + sep + number(p.trace.dL[i] / c.lengthUnit, c.lengthUnit >= 1.0 ? 10 : 7);
-            if (passes.size() > 1) o += fmt::format("{}{}", sep, p.direction > 0 ? "ccw" : "cw");
-            o += "\n";
-        }
-        if (timeSampled) t0 += std::abs(p.trace.angleDeg.back() - a0) / omegaDeg + 1.0;
-    }
+    appendCapturedPasses(o, c, passes, timeSampled, omegaDeg);
     return o;
 }
 

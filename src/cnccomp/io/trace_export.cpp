@@ -39,25 +39,14 @@ std::vector<DirectedTrace> simulateCapturedPasses(const Kinematics& k, const Bal
     return out;
 }
 
-std::string formatCapturedTrace(const BallbarRun& run, const std::vector<DirectedTrace>& passes, bool timeSampled,
-                                const std::string& machine) {
-    const RunCapture& c = run.capture;
+void appendCapturedPasses(std::string& o, const RunCapture& c, const std::vector<DirectedTrace>& passes, bool timeSampled,
+                          double omegaDeg) {
     const char sep = c.decimal == ',' ? ';' : ',';
     const auto number = [&](double v, int decimals) {
         std::string s = fmt::format("{:.{}f}", v, decimals);
         if (c.decimal == ',') std::replace(s.begin(), s.end(), '.', ',');
         return s;
     };
-    double omegaDeg = 0;
-    if (timeSampled) {
-        const double radius = c.feedRadius > 0 ? c.feedRadius : linearPathRadius(run);
-        if (!(c.feed > 0) || !(radius > 0))
-            throw ModelError(fmt::format("run '{}': a time-sampled file needs feed (and a non-zero feed radius)", run.name));
-        omegaDeg = c.feed / 60.0 / radius * 180.0 / M_PI;
-    }
-    // Metadata and header: cnccomp's own lines, then the capture's columns.
-    std::string o = formatTraceCsv(BallbarTrace{}, &run, machine);
-    o.resize(o.rfind("angle_deg,dL_um\n"));
     o += fmt::format("{}{}{}", timeSampled ? c.timeColumn : c.angleColumn, sep, c.lengthColumn);
     if (passes.size() > 1) o += fmt::format("{}{}", sep, c.passColumn);
     o += "\n";
@@ -74,6 +63,22 @@ std::string formatCapturedTrace(const BallbarRun& run, const std::vector<Directe
         }
         if (timeSampled) t0 += std::abs(p.trace.angleDeg.back() - a0) / omegaDeg + 1.0;  // 1 s dwell between the passes
     }
+}
+
+std::string formatCapturedTrace(const BallbarRun& run, const std::vector<DirectedTrace>& passes, bool timeSampled,
+                                const std::string& machine) {
+    const RunCapture& c = run.capture;
+    double omegaDeg = 0;
+    if (timeSampled) {
+        const double radius = c.feedRadius > 0 ? c.feedRadius : linearPathRadius(run);
+        if (!(c.feed > 0) || !(radius > 0))
+            throw ModelError(fmt::format("run '{}': a time-sampled file needs feed (and a non-zero feed radius)", run.name));
+        omegaDeg = c.feed / 60.0 / radius * 180.0 / M_PI;
+    }
+    // Metadata and header: cnccomp's own lines, then the capture's columns and the passes.
+    std::string o = formatTraceCsv(BallbarTrace{}, &run, machine);
+    o.resize(o.rfind("angle_deg,dL_um\n"));
+    appendCapturedPasses(o, c, passes, timeSampled, omegaDeg);
     return o;
 }
 

@@ -21,4 +21,9 @@ std::vector<DirectedTrace> simulateCapturedPasses(const Kinematics& machine, con
 std::string formatCapturedTrace(const BallbarRun& run, const std::vector<DirectedTrace>& passes, bool timeSampled,
                                 const std::string& machine);
 
+/// Appends the capture's column header and the passes' rows (as formatCapturedTrace writes them) to `o`; `omegaDeg` is
+/// the sweep rate (deg/s) that turns angle into time when `timeSampled`.
+void appendCapturedPasses(std::string& o, const RunCapture& capture, const std::vector<DirectedTrace>& passes,
+                          bool timeSampled, double omegaDeg);
+
 }  // namespace cnccomp
