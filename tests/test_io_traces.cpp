@@ -48,6 +48,15 @@ void scaleTrace(const std::string& path, double factor) {
     test::writeText(path, out);
 }
 
+/// identify on these traces exits 2 naming mm and writes nothing.
+void expectIdentifyRefusesMillimetres(const test::ScratchDir& dir, const std::string& traces) {
+    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
+                                dir.file("d.csv"));
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("likely in mm"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir.file("d.csv")));
+}
+
 template <typename F>
 std::string inputErrorOf(F&& f) {
     try {
@@ -68,11 +77,7 @@ TEST(TraceUnits, OneFileInMillimetresAmongMicrometresIsRefused) {
     const std::string e = inputErrorOf([&] { importRunTraces(traces, plan.runs); });
     EXPECT_NE(e.find("C-radial.csv"), std::string::npos) << e;
     EXPECT_NE(e.find("likely in mm"), std::string::npos) << e;
-    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
-                                dir.file("d.csv"));
-    EXPECT_EQ(r.exitCode, 2) << r.out;
-    EXPECT_NE(r.out.find("likely in mm"), std::string::npos) << r.out;
-    EXPECT_FALSE(fs::exists(dir.file("d.csv")));
+    expectIdentifyRefusesMillimetres(dir, traces);
 }
 
 // The whole set exported in mm and read under the default µm (issue 18: every result 1000× too small): no run spans
@@ -85,11 +90,7 @@ TEST(TraceUnits, EveryFileInMillimetresIsRefused) {
     const std::string e = inputErrorOf([&] { importRunTraces(traces, plan.runs); });
     EXPECT_NE(e.find("likely in mm while the plan reads them in um"), std::string::npos) << e;
     EXPECT_NE(e.find("below the 0.1 um a ball bar resolves"), std::string::npos) << e;
-    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces + " --out " +
-                                dir.file("d.csv"));
-    EXPECT_EQ(r.exitCode, 2) << r.out;
-    EXPECT_NE(r.out.find("likely in mm"), std::string::npos) << r.out;
-    EXPECT_FALSE(fs::exists(dir.file("d.csv")));
+    expectIdentifyRefusesMillimetres(dir, traces);
 }
 
 // µm data read under length-unit="mm": ΔL of millimetres, beyond any ball bar's travel; refused naming µm.

@@ -8,6 +8,7 @@
 
 #include "cnccomp/circle_fit.hpp"
 #include "cnccomp/error.hpp"
+#include "cnccomp/measurement/sweep.hpp"
 
 namespace cnccomp {
 
@@ -57,14 +58,7 @@ void BallbarRun::validate() const {
 
 std::vector<double> BallbarRun::anglesDeg() const {
     validate();
-    const double span = endDeg - startDeg;
-    long n = static_cast<long>(std::floor(span / stepDeg + 1e-9)) + 1;
-    const double last = startDeg + (n - 1) * stepDeg;
-    // A sweep of whole turns ends where it began: keep the first sample only.
-    if (n > 1 && std::abs(span) >= 360.0 - 1e-9 && std::abs(std::remainder(last - startDeg, 360.0)) < 1e-9) --n;
-    std::vector<double> a(static_cast<size_t>(n));
-    for (long i = 0; i < n; ++i) a[i] = startDeg + i * stepDeg;
-    return a;
+    return sweepAnglesDeg(startDeg, endDeg, stepDeg);
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/measurement/sweep.hpp"
 
 namespace cnccomp {
 
@@ -34,13 +35,7 @@ void Dbb5Run::validate() const {
 
 std::vector<double> Dbb5Run::anglesDeg() const {
     validate();
-    const double span = endDeg - startDeg;
-    long n = static_cast<long>(std::floor(span / stepDeg + 1e-9)) + 1;
-    const double last = startDeg + (n - 1) * stepDeg;
-    if (n > 1 && std::abs(span) >= 360.0 - 1e-9 && std::abs(std::remainder(last - startDeg, 360.0)) < 1e-9) --n;
-    std::vector<double> a(static_cast<size_t>(n));
-    for (long i = 0; i < n; ++i) a[static_cast<size_t>(i)] = startDeg + i * stepDeg;
-    return a;
+    return sweepAnglesDeg(startDeg, endDeg, stepDeg);
 }
 
 std::pair<Vec3, Vec3> Dbb5Run::planeAxes() const {
