@@ -126,6 +126,14 @@ TEST(IdentifyCli, BadInputFailsCleanlyWithoutOutputFiles) {
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_NE(r.out.find("under the ISO name 'EC0Y'"), std::string::npos) << r.out;
     std::filesystem::remove(traces + "/C-axial.csv");
+    // The options are checked before any trace is read: the misspelt solver is named, not the missing file.
+    r = test::runCli(base + " --solver nlopt:NOT_AN_ALGORITHM" + outs);
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("unknown NLopt algorithm 'NOT_AN_ALGORITHM'"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("C-axial.csv"), std::string::npos) << r.out;
+    r = test::runCli(base + " --rank-tolerance 2" + outs);
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("rank tolerance must be in (0, 1)"), std::string::npos) << r.out;
     r = test::runCli(base + outs);
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.out.find("C-axial.csv"), std::string::npos) << r.out;

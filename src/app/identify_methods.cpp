@@ -420,6 +420,19 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
 }  // namespace
 
 IdentifyOutcome runIdentification(const IdentifyRequest& r) {
+    // The engine's options are checked before any measurement is read: a misspelt solver fails at once, not after
+    // every trace of the plan was imported.
+    if (r.observe != "traces" && r.observe != "eccentricity")
+        throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", r.observe));
+    if (!r.formulas && r.machine) {
+        IdentifyOptions o;
+        o.solver = r.solver;
+        o.maxIterations = r.maxIterations;
+        o.rankTolerance = r.rankTolerance;
+        o.monteCarlo = r.monteCarlo;
+        o.bounds = parseBounds(*r.machine, r.bounds);
+        validateIdentifyOptions(o);
+    }
     if (!r.plan) {
         if (r.formulas) return ballbarFormulas(r);
         throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (an eccentricity "

@@ -49,7 +49,6 @@ void boxBounds(const UnknownLayout& L, const IdentifyOptions& o, Eigen::VectorXd
                                              b.name, d.name));
         }
         if (found < 0) throw ModelError(fmt::format("bound for '{}', which is not an unknown of this problem", b.name));
-        if (!(b.lower <= b.upper)) throw ModelError(fmt::format("bound for '{}': lower exceeds upper", b.name));
         lo[found] = b.lower / L[found].scale;
         hi[found] = b.upper / L[found].scale;
     }
@@ -101,12 +100,23 @@ void monteCarlo(LsqProblem& p, const ObservableSubspace& sub, const Eigen::Vecto
 
 }  // namespace
 
-IdentificationResult identify(const MachineModel& machine, const Observations& observations,
-                              const IdentifyOptions& options) {
+void validateIdentifyOptions(const IdentifyOptions& options) {
     const Solver solver = parseSolver(options.solver);
+    if (solver.nlopt && !nloptAlgorithmKnown(solver.algorithm))
+        throw ModelError(fmt::format("unknown NLopt algorithm '{}' (e.g. LD_LBFGS, LD_SLSQP, LN_BOBYQA, LN_SBPLX)",
+                                     solver.algorithm));
     if (options.maxIterations <= 0) throw ModelError("the iteration limit must be positive");
     if (!(options.rankTolerance > 0 && options.rankTolerance < 1)) throw ModelError("rank tolerance must be in (0, 1)");
     if (options.monteCarlo < 0) throw ModelError("Monte Carlo sample count must not be negative");
+    if (!solver.nlopt && !options.bounds.empty()) throw ModelError("bounds need a bounded solver: --solver nlopt:<ALGORITHM>");
+    for (const ParameterBound& b : options.bounds)
+        if (!(b.lower <= b.upper)) throw ModelError(fmt::format("bound for '{}': lower exceeds upper", b.name));
+}
+
+IdentificationResult identify(const MachineModel& machine, const Observations& observations,
+                              const IdentifyOptions& options) {
+    validateIdentifyOptions(options);
+    const Solver solver = parseSolver(options.solver);
     std::vector<int> devs = options.deviations;
     if (devs.empty())
         for (int i = 0; i < static_cast<int>(machine.deviations.size()); ++i) devs.push_back(i);
@@ -124,7 +134,6 @@ IdentificationResult identify(const MachineModel& machine, const Observations& o
         boxBounds(layout, options, lo, hi);
         so = solveNlopt(problem, x0, solver.algorithm, lo, hi, 200 * options.maxIterations);
     } else {
-        if (!options.bounds.empty()) throw ModelError("bounds need a bounded solver: --solver nlopt:<ALGORITHM>");
         SolverSettings s;
         s.maxIterations = options.maxIterations;
         s.rankTolerance = options.rankTolerance;

@@ -42,6 +42,11 @@ struct IdentificationResult {
     IdentificationReport report;
 };
 
+/// Checks the options alone, before any measurement is read (Ceres' Solver::Options::IsValid): the solver and its NLopt
+/// algorithm, the iteration limit, the rank tolerance, the Monte Carlo count, bounds only with a bounded solver and
+/// lower ≤ upper. ModelError naming the option. identify() calls it first.
+void validateIdentifyOptions(const IdentifyOptions& options);
+
 /// Throws ModelError for an empty observation list, an unknown solver or bound name, or bad options.
 IdentificationResult identify(const MachineModel& machine, const Observations& observations,
                               const IdentifyOptions& options = {});

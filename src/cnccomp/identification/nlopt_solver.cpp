@@ -42,6 +42,10 @@ std::string resultName(nlopt::result r) {
 }
 }  // namespace
 
+bool nloptAlgorithmKnown(const std::string& algorithm) {
+    return static_cast<int>(nlopt_algorithm_from_string(algorithm.c_str())) >= 0;
+}
+
 SolverOutcome solveNlopt(const LsqProblem& problem, const Eigen::VectorXd& x0, const std::string& algorithm,
                          const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, int maxEvaluations) {
     const nlopt_algorithm a = nlopt_algorithm_from_string(algorithm.c_str());

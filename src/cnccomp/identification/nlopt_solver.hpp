@@ -7,6 +7,9 @@
 
 namespace cnccomp {
 
+/// Whether NLopt knows the algorithm name (without prefix), e.g. "LD_SLSQP".
+bool nloptAlgorithmKnown(const std::string& algorithm);
+
 /// `algorithm`: NLopt name without prefix, e.g. "LD_LBFGS", "LN_BOBYQA", "LD_SLSQP". lower/upper: scaled.
 /// Throws ModelError for an unknown algorithm name.
 SolverOutcome solveNlopt(const LsqProblem& problem, const Eigen::VectorXd& x0, const std::string& algorithm,
