@@ -24,6 +24,9 @@ double backlashFromLaser(const LaserPositioningResult& r) { return -r.meanRevers
 std::string laserCompIniLines(const LaserPositioningResult& r, int joint, const std::string& fileName) {
     const double backlash = backlashFromLaser(r);
     std::string o = fmt::format("[JOINT_{}]\nCOMP_FILE = {}\nCOMP_FILE_TYPE = 1\n", joint, fileName);
+    // A relative COMP_FILE is opened from the INI file's folder: usrmotintf.cc usrmotLoadComp fopen()s the name as
+    // given, and scripts/linuxcnc.in changes to the INI's folder before starting LinuxCNC.
+    o += fmt::format("# {} beside the INI file (a relative COMP_FILE is opened from the INI's folder).\n", fileName);
     o += fmt::format("# The table carries the reversal (forward and reverse columns): BACKLASH is not needed, and "
                      "LinuxCNC ignores it on a joint with a COMP_FILE (ini-config.adoc).\n"
                      "# Without the table, the mean reversal alone would be BACKLASH = {:.6f} (mm, = -B-bar; "

@@ -30,8 +30,9 @@ CompTable compTableFromLaser(const LaserPositioningResult& r);
 /// BACKLASH, so BACKLASH = −B̄ / 1000 (B̄ < 0 for the usual lost motion: the slide lags behind the motor).
 double backlashFromLaser(const LaserPositioningResult& r);
 
-/// The lines the user adds to the INI file for joint `joint` with the table written as `fileName`, with the
-/// alternative (BACKLASH alone) as a comment.
+/// The lines the user adds to the INI file for joint `joint` with the table written as `fileName` (to be placed beside
+/// the INI file: usrmotintf.cc opens the name as given and scripts/linuxcnc.in runs LinuxCNC in the INI's folder), with
+/// the alternative (BACKLASH alone) as a comment.
 std::string laserCompIniLines(const LaserPositioningResult& r, int joint, const std::string& fileName);
 
 }  // namespace cnccomp::controllers::linuxcnc
