@@ -111,7 +111,8 @@ LaserPositioningResult evaluateLaserPositioning(const LaserPositioningRuns& in) 
         out.warnings.push_back(fmt::format("{} targets over {:.0f} mm; ISO 230-2 4.3.2 asks for at least five per "
                                            "metre ({:.0f})", m, travel, std::ceil(5 * travel / 1000)));
     if (!in.environmentCompensated)
-        out.warnings.push_back("environment compensation not applied to the laser readings (stated as not done)");
+        out.warnings.push_back("environment compensation not applied to the laser readings (stated as not done, or not "
+                                "stated)");
     return out;
 }
 

@@ -20,7 +20,8 @@
 // reported as a warning, since short axes and the first-metre rule are common). The expanded uncertainty of
 // ISO 230-2 clause 5 / ISO/TR 230-9 is not computed.
 // The positioning error as a function of position: x̄↑(P) and x̄↓(P), piecewise linear through the target means
-// (constant beyond the end targets) — the form pitch-error compensation tables take (a later round writes them).
+// (constant beyond the end targets) — the form pitch-error compensation tables take (the LinuxCNC one:
+// controllers/linuxcnc/laser_comp.hpp).
 #include <string>
 #include <vector>
 

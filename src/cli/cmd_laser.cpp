@@ -1,0 +1,71 @@
+// cnccomp laser: the ISO 230-2 evaluation of a laser interferometer's bidirectional positioning runs of one linear
+// axis (io/laser_csv.hpp for the file layout), printed as a table, optionally as JSON and as a LinuxCNC pitch-error
+// table (controllers/linuxcnc/laser_comp.hpp for its sign and INI lines). All files are written together or not at all.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "cli/command.hpp"
+#include "cnccomp/error.hpp"
+#include "cnccomp/io/laser_csv.hpp"
+#include "cnccomp/io/laser_report.hpp"
+#include "cnccomp/io/output_set.hpp"
+#include "cnccomp/laser_positioning.hpp"
+#include "controllers/linuxcnc/laser_comp.hpp"
+
+namespace cnccomp::cli {
+namespace {
+
+struct Options {
+    std::string file, json, compOut;
+    int joint = -1;
+    LaserCsvOptions csv;
+};
+
+void run(const Options& o) {
+    if (!o.compOut.empty() && o.joint < 0)
+        throw InputError("", 0, "--comp-out needs --joint N (the [JOINT_N] section the table belongs to)");
+    const LaserCsvFile in = readLaserCsv(o.file, o.csv);
+    const LaserPositioningResult r = evaluateLaserPositioning(in.runs);
+    fmt::print("{}", formatLaserTable(r, in.environmentStated));
+
+    OutputSet out({o.file});
+    std::string ini;
+    if (!o.json.empty()) out.add(o.json, formatLaserJson(r, in.environmentStated, o.file));
+    if (!o.compOut.empty()) {
+        namespace lc = controllers::linuxcnc;
+        const std::string name = r.axis + ".comp";
+        out.makeFolder(o.compOut);
+        out.add(OutputSet::fileIn(o.compOut, name, o.file), lc::formatCompTable(lc::compTableFromLaser(r), name));
+        ini = lc::laserCompIniLines(r, o.joint, name);
+    }
+    const std::vector<std::string> written = out.targets();  // commit() empties the set
+    out.commit();
+    for (const std::string& t : written) fmt::print("wrote {}\n", t);
+    if (!ini.empty()) fmt::print("add to the INI file:\n{}", ini);
+}
+
+const RegisterCommand reg([](CLI::App& app) {
+    auto o = std::make_shared<Options>();
+    auto* c = app.add_subcommand("laser", "Evaluate laser positioning runs of a linear axis (ISO 230-2) and write a "
+                                          "LinuxCNC pitch-error table");
+    c->add_option("--file", o->file, "laser CSV: target_mm, run, direction (+/-), deviation_um")
+        ->required()
+        ->check(CLI::ExistingFile);
+    c->add_option("--axis", o->csv.axis, "axis name (when the file has no '# axis:' line)");
+    c->add_option("--unit", o->csv.deviationUnit, "unit of the deviation column: um or mm")
+        ->check(CLI::IsMember({"um", "mm"}));
+    c->add_option("--target-column", o->csv.targetColumn, "name of the target column")->capture_default_str();
+    c->add_option("--run-column", o->csv.runColumn, "name of the run column")->capture_default_str();
+    c->add_option("--direction-column", o->csv.directionColumn, "name of the direction column")->capture_default_str();
+    c->add_option("--deviation-column", o->csv.deviationColumn, "name of the deviation column (default deviation_<unit>)");
+    c->add_option("--json", o->json, "write the figures as JSON");
+    c->add_option("--comp-out", o->compOut, "folder for the LinuxCNC table <axis>.comp (COMP_FILE_TYPE 1)");
+    c->add_option("--joint", o->joint, "LinuxCNC joint number of the axis (with --comp-out)")->check(CLI::NonNegativeNumber);
+    c->callback([o] { run(*o); });
+});
+
+}  // namespace
+}  // namespace cnccomp::cli
