@@ -31,17 +31,33 @@ std::string simulateInto(const test::ScratchDir& dir) {
     return traces;
 }
 
-/// Rewrites the ΔL column (the last) of a cnccomp trace file, value ↦ value·factor.
-void scaleTrace(const std::string& path, double factor) {
+/// A cnccomp trace file split into its comment and header lines (kept as they are) and its data rows.
+struct TraceText {
+    std::string head;
+    std::vector<std::string> rows;
+};
+
+TraceText readTraceText(const std::string& path) {
     std::ifstream in(path);
-    std::string line, out;
+    TraceText t;
+    std::string line;
     bool header = false;
     while (std::getline(in, line)) {
         if (line.empty() || line[0] == '#' || !header) {
             header = header || (!line.empty() && line[0] != '#');
-            out += line + "\n";
-            continue;
+            t.head += line + "\n";
+        } else {
+            t.rows.push_back(line);
         }
+    }
+    return t;
+}
+
+/// Rewrites the ΔL column (the last) of a cnccomp trace file, value ↦ value·factor.
+void scaleTrace(const std::string& path, double factor) {
+    const TraceText t = readTraceText(path);
+    std::string out = t.head;
+    for (const std::string& line : t.rows) {
         const size_t comma = line.rfind(',');
         out += line.substr(0, comma + 1) + fmt::format("{:.9g}", std::stod(line.substr(comma + 1)) * factor) + "\n";
     }
@@ -108,16 +124,10 @@ TEST(TraceUnits, MicrometreDataUnderMillimetreUnitIsRefused) {
 /// Rewrites an angle-sampled cnccomp trace (one pass) with `per` samples a step, linearly interpolated between the
 /// file's own samples.
 void densify(const std::string& path, int per) {
-    std::ifstream in(path);
-    std::string line, out;
+    const TraceText t = readTraceText(path);
+    std::string out = t.head;
     std::vector<std::pair<double, double>> rows;
-    bool header = false;
-    while (std::getline(in, line)) {
-        if (line.empty() || line[0] == '#' || !header) {
-            header = header || (!line.empty() && line[0] != '#');
-            out += line + "\n";
-            continue;
-        }
+    for (const std::string& line : t.rows) {
         const size_t comma = line.find(',');
         rows.emplace_back(std::stod(line.substr(0, comma)), std::stod(line.substr(comma + 1)));
     }

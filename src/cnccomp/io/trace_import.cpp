@@ -527,12 +527,12 @@ std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::ve
     // The whole set in a unit 1000x larger than the plan says (an mm export read under the default µm): every run
     // spans less than a ball bar resolves (kBallbarResolution); a real machine's run shows at least the instrument's
     // noise. A set whose runs are all numerically zero (a simulated perfect machine) is left alone.
+    std::vector<double> spans;  // ΔL peak to peak of each run, mm
+    for (const MeasuredTrace& t : out) spans.push_back(peakToPeak(t.trace.dL));
     double largest = 0;
     size_t largestAt = 0;
-    for (size_t i = 0; i < out.size(); ++i) {
-        const double s = peakToPeak(out[i].trace.dL);
-        if (s > largest) largest = s, largestAt = i;
-    }
+    for (size_t i = 0; i < spans.size(); ++i)
+        if (spans[i] > largest) largest = spans[i], largestAt = i;
     if (!out.empty() && largest > kNumericalZero && largest < kBallbarResolution) {
         const double unit = runs[largestAt].capture.lengthUnit;
         throw InputError(out[largestAt].path, 0,
@@ -545,8 +545,6 @@ std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::ve
     // Against the other runs: one file in another unit than the plan says (an mm export under a dL_um header) spans
     // 1000x less (or more) than the rest. Runs of one machine differ by a few times, not by hundreds.
     if (out.size() >= 3) {
-        std::vector<double> spans;
-        for (const MeasuredTrace& t : out) spans.push_back(peakToPeak(t.trace.dL));
         for (size_t i = 0; i < out.size(); ++i) {
             std::vector<double> others;
             for (size_t k = 0; k < out.size(); ++k)
