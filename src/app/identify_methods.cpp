@@ -102,19 +102,25 @@ std::vector<int> elevenErrors(const MachineModel& m, const std::string& outer, c
     return out;
 }
 
-IdentifyOptions engineOptions(const IdentifyRequest& r, std::vector<int> defaults) {
-    const MachineModel& m = *r.machine;
+/// The solver's settings of a request (no file read): what validateIdentifyOptions checks before any work.
+IdentifyOptions solverOptions(const IdentifyRequest& r) {
     IdentifyOptions io;
-    io.deviations = r.params.empty() ? std::move(defaults) : parseDeviationList(m, r.params);
-    if (io.deviations.empty())
-        for (int i = 0; i < static_cast<int>(m.deviations.size()); ++i) io.deviations.push_back(i);
     io.solver = r.solver;
     io.maxIterations = r.maxIterations;
     io.rankTolerance = r.rankTolerance;
     io.monteCarlo = r.monteCarlo;
     io.seed = r.seed;
     io.staged = !r.oneStage;
-    io.bounds = parseBounds(m, r.bounds);
+    io.bounds = parseBounds(*r.machine, r.bounds);
+    return io;
+}
+
+IdentifyOptions engineOptions(const IdentifyRequest& r, std::vector<int> defaults) {
+    const MachineModel& m = *r.machine;
+    IdentifyOptions io = solverOptions(r);
+    io.deviations = r.params.empty() ? std::move(defaults) : parseDeviationList(m, r.params);
+    if (io.deviations.empty())
+        for (int i = 0; i < static_cast<int>(m.deviations.size()); ++i) io.deviations.push_back(i);
     if (!r.start.empty()) io.start = readDeviationCsv(r.start, m);
     if (r.plan && std::isfinite(r.plan->noiseUm)) io.statedNoise = r.plan->noiseUm * kUm;
     return io;
@@ -424,15 +430,7 @@ IdentifyOutcome runIdentification(const IdentifyRequest& r) {
     // every trace of the plan was imported.
     if (r.observe != "traces" && r.observe != "eccentricity")
         throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", r.observe));
-    if (!r.formulas && r.machine) {
-        IdentifyOptions o;
-        o.solver = r.solver;
-        o.maxIterations = r.maxIterations;
-        o.rankTolerance = r.rankTolerance;
-        o.monteCarlo = r.monteCarlo;
-        o.bounds = parseBounds(*r.machine, r.bounds);
-        validateIdentifyOptions(o);
-    }
+    if (!r.formulas && r.machine) validateIdentifyOptions(solverOptions(r));
     if (!r.plan) {
         if (r.formulas) return ballbarFormulas(r);
         throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (an eccentricity "
