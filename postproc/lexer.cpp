@@ -1,6 +1,7 @@
 #include "postproc/lexer.hpp"
 
 #include "postproc/number_format.hpp"
+#include "cnccomp/io/text_util.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -168,7 +169,7 @@ void lexBlock(std::string_view s, Dialect dialect, LexedBlock& b, bool firstLine
     b.hasComment = false;
     const size_t n = s.size();
     size_t i = 0;
-    if (firstLine && n >= 3 && s.substr(0, 3) == "\xEF\xBB\xBF") i = 3;
+    if (firstLine) i = n - withoutByteOrderMark(s).size();
     while (i < n && isSpace(s[i])) ++i;
     if (i < n && s[i] == '%') {
         b.percent = true;

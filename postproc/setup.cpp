@@ -157,7 +157,7 @@ void Setup::readFile(const std::string& path) {
     int lineNo = 0;
     while (std::getline(in, text)) {
         ++lineNo;
-        std::string_view l = trim(text);
+        std::string_view l = trim(lineNo == 1 ? withoutByteOrderMark(text) : std::string_view(text));
         const size_t hash = l.find('#');
         if (hash != std::string_view::npos) l = trim(l.substr(0, hash));
         if (l.empty()) continue;
@@ -184,7 +184,7 @@ void Setup::readToolTable(const std::string& path) {
     int lineNo = 0, tools = 0;
     while (std::getline(in, text)) {
         ++lineNo;
-        std::string_view l = text;
+        std::string_view l = lineNo == 1 ? withoutByteOrderMark(text) : std::string_view(text);
         const size_t semi = l.find(';');
         if (semi != std::string_view::npos) l = l.substr(0, semi);
         l = trim(l);

@@ -90,6 +90,10 @@ TEST(InputMeaning, OldDeviationFileIsRefusedWithTheConversion) {
     test::writeText(dir.file("new.csv"), kFormat + rows);
     const DeviationSet d = readDeviationCsv(dir.file("new.csv"), m);
     EXPECT_NEAR(d.isoValue(d.require("EC0Y")), -3 * kArcsec, 1e-12);
+    // The same file saved by a spreadsheet as "CSV UTF-8" (a byte-order mark before the format line) is still the new
+    // layout: the format line is found behind the mark (it was not, and the file was refused as an old one).
+    test::writeText(dir.file("bom.csv"), "\xEF\xBB\xBF" + kFormat + rows);
+    EXPECT_NEAR(readDeviationCsv(dir.file("bom.csv"), m).isoValue(d.require("EC0Y")), -3 * kArcsec, 1e-12);
     // What cnccomp writes carries the line and reads back to the same geometry.
     const std::string written = formatDeviationCsv(d);
     EXPECT_EQ(written.rfind(kFormat, 0), 0u) << written;

@@ -77,6 +77,11 @@ TEST(PostprocCli, ToolTableGivesToolLengths) {
     const auto r = test::runCli("poses --in " + dir.file("p.ngc") + " --tool-table " + dir.file("t.tbl"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("2,G0,1.000000,0.000000,20.000000"), std::string::npos) << r.out;
+    // A tool table with a byte-order mark in front of its first line reads as without.
+    test::writeText(dir.file("bom.tbl"), "\xEF\xBB\xBFT1 P1 Z0 D1 ;end mill\nT2 P2 Z15 D8 ;end mill\n");
+    const auto bom = test::runCli("poses --in " + dir.file("p.ngc") + " --tool-table " + dir.file("bom.tbl"));
+    ASSERT_EQ(bom.exitCode, 0) << bom.out;
+    EXPECT_EQ(bom.out, r.out);
     test::writeText(dir.file("bad.tbl"), "T1 P1 Z0\nT2 P2 Zfifteen\n");
     const auto bad = test::runCli("poses --in " + dir.file("p.ngc") + " --tool-table " + dir.file("bad.tbl"));
     EXPECT_EQ(bad.exitCode, 2);
@@ -91,6 +96,11 @@ TEST(PostprocCli, SetupFileGivesOffsetsToolLengthsAndAssumedAxes) {
     const auto r = test::runCli("poses --in " + dir.file("p.nc") + " --machine " + kMachine + " --setup " + dir.file("setup.txt"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("2,G0,11.000000,0.000000,105.000000,,0.000000,0.000000"), std::string::npos) << r.out;
+    // The same file saved as "UTF-8 with BOM" (Notepad) reads the same; before, its first key was refused.
+    test::writeText(dir.file("bom.txt"), "\xEF\xBB\xBFwork-offset G54=10,0,0\ntool-length H1=100\nassume Y=0\n");
+    const auto bom = test::runCli("poses --in " + dir.file("p.nc") + " --machine " + kMachine + " --setup " + dir.file("bom.txt"));
+    ASSERT_EQ(bom.exitCode, 0) << bom.out;
+    EXPECT_NE(bom.out.find("2,G0,11.000000,0.000000,105.000000,,0.000000,0.000000"), std::string::npos) << bom.out;
     test::writeText(dir.file("bad.txt"), "work-offset G54=10,0,0\ntool-lenght H1=100\n");
     const auto bad = test::runCli("poses --in " + dir.file("p.nc") + " --setup " + dir.file("bad.txt"));
     EXPECT_EQ(bad.exitCode, 2);

@@ -55,7 +55,7 @@ bool CsvReader::nextLine(std::string_view& out) {
     if (line_ == 1) {
         if (out.size() >= 2 && ((out[0] == '\xff' && out[1] == '\xfe') || (out[0] == '\xfe' && out[1] == '\xff')))
             throw InputError(path_, 1, "UTF-16 text; save the file as UTF-8 (or ASCII) CSV");
-        if (out.substr(0, 3) == "\xef\xbb\xbf") out.remove_prefix(3);  // UTF-8 byte-order mark
+        out = withoutByteOrderMark(out);
     }
     if (out.find('\0') != std::string_view::npos) throw InputError(path_, line_, "binary data where CSV text was expected");
     return true;

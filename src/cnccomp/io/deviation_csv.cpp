@@ -39,8 +39,8 @@ constexpr const char* kFormatTag = "# cnccomp-deviations/";
 bool hasFormatLine(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
-    while (std::getline(in, line)) {
-        const std::string_view t = trim(line);
+    for (bool first = true; std::getline(in, line); first = false) {
+        const std::string_view t = trim(first ? withoutByteOrderMark(line) : std::string_view(line));
         if (t.empty()) continue;
         if (t.front() != '#') return false;  // the header: no format line before it
         if (t.rfind(kFormatTag, 0) == 0) return true;

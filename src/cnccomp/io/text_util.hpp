@@ -13,6 +13,9 @@ namespace cnccomp {
 std::optional<double> parseNumber(std::string_view s);
 /// Trim ASCII white space.
 std::string_view trim(std::string_view s);
+/// The first line of a text file without its UTF-8 byte-order mark (Excel's and LibreOffice's "CSV UTF-8", Notepad's
+/// "UTF-8 with BOM" write one). Every reader of a text file passes its first line through it.
+std::string_view withoutByteOrderMark(std::string_view firstLine);
 
 /// Checks, before any work, that `path` can be written atomically: its folder exists and it is absent or a regular
 /// file (a symbolic link is followed to its target). A directory, a device (/dev/null), a FIFO or a socket is refused
