@@ -14,7 +14,7 @@
 #include "controllers/generic/deviation_json.hpp"
 #include "controllers/generic/generic_backend.hpp"
 #include "controllers/generic/grid_map.hpp"
-#include "controllers/generic/json.hpp"
+#include "cnccomp/io/json.hpp"
 #include "controller_test_util.hpp"
 #include "test_controller_common_support.hpp"
 
@@ -133,18 +133,18 @@ TEST(ControllerGeneric, DeviationFilesAndMapJsonReadBack) {
         EXPECT_LT((c.values - d.values).cwiseAbs().maxCoeff(), 1e-9);
         // map.json carries the numbers of map.csv.
         const generic::GridMap g = generic::parseGridMapCsv(requireFile(r.files, "map.csv", "t").content, "map.csv", m);
-        const generic::Json mj = generic::parseJson(requireFile(r.files, "map.json", "t").content, "map.json");
-        const auto dx = mj.require("dx_machine_um", generic::Json::Type::Array, "map.json").numbers("map.json");
-        const auto dkz = mj.require("dkz_machine_urad", generic::Json::Type::Array, "map.json").numbers("map.json");
+        const Json mj = parseJson(requireFile(r.files, "map.json", "t").content, "map.json");
+        const auto dx = mj.require("dx_machine_um", Json::Type::Array, "map.json").numbers("map.json");
+        const auto dkz = mj.require("dkz_machine_urad", Json::Type::Array, "map.json").numbers("map.json");
         ASSERT_EQ(dx.size(), g.tip.size());
         for (size_t i = 0; i < dx.size(); ++i) {
             EXPECT_NEAR(dx[i] * kUm, g.tip[i].x(), 1e-15);
             EXPECT_NEAR(dkz[i] * 1e-6, g.toolAxis[i].z(), 1e-15);
         }
-        const auto& grid = mj.require("grid", generic::Json::Type::Array, "map.json").array;
+        const auto& grid = mj.require("grid", Json::Type::Array, "map.json").array;
         ASSERT_EQ(grid.size(), g.axes.size());
         for (size_t a = 0; a < grid.size(); ++a)
-            EXPECT_EQ(grid[a].require("nodes", generic::Json::Type::Array, "map.json").array.size(), g.axes[a].nodes.size());
+            EXPECT_EQ(grid[a].require("nodes", Json::Type::Array, "map.json").array.size(), g.axes[a].nodes.size());
     }
 }
 

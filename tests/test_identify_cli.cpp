@@ -9,6 +9,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/trace_csv.hpp"
 #include "test_support.hpp"
@@ -43,7 +44,7 @@ TEST(IdentifyCli, LeastSquaresIsTheDefaultAndRecoversAllThirteen) {
         // The CSV keeps 6 decimals of µm / arcsec.
         EXPECT_NEAR(id.values[d.offset], truth.values[d.offset], d.isAngle() ? 1e-3 * kArcsec : 1e-3 * kUm) << d.name;
     }
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     EXPECT_TRUE(j["converged"].boolean);
     EXPECT_EQ(j["rank"].num(), 13);
     EXPECT_EQ(j["observations"].num(), 6 * 360);
@@ -75,7 +76,7 @@ TEST(IdentifyCli, UnidentifiableRequestIsReportedByName) {
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("EX0C           unidentified"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("warning: 4 of 6 unknowns are not identifiable"), std::string::npos) << r.out;
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     ASSERT_EQ(j["unidentified"].array.size(), 4u);
     EXPECT_EQ(j["unidentified"][0].string, "EX0C");
     EXPECT_EQ(j["unidentified"][3].string, "EB0C");
@@ -91,7 +92,7 @@ TEST(IdentifyCli, MonteCarloSolverAndStartOptions) {
     auto r = test::runCli("identify --machine " + kMachine + " --plan " + kPlan + " --traces " + traces +
                           " --monte-carlo 20 --seed 4 --out " + dir.file("d.csv") + " --report " + dir.file("r.json"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     EXPECT_EQ(j["monte_carlo_samples"].num(), 20);
     EXPECT_GT(j["parameters"][0]["mc_stddev"].num(), 0.0);
     EXPECT_NEAR(j["sigma_um"].num(), 0.5, 0.05);

@@ -10,6 +10,7 @@
 
 #include "cnccomp/circular_test.hpp"
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "app/report/html_report.hpp"
 
@@ -233,22 +234,22 @@ TEST(Iso230_4, JsonSummaryCarriesTheFiguresGolden) {
     d.deviations.push_back({"EB0B", "bXB", "arcsec", true, 9.1234, 8.5, 9.75, 9.0});
     d.deviations.push_back({"EC0Y", "gXY", "arcsec", false});
     const report::ReportFiles files = report::reportFiles("out/r.html", d);
-    const JsonValue j = parseJson(report::formatReportSummaryJson(d, files), "summary");
+    const Json j = parseJson(report::formatReportSummaryJson(d, files), "summary");
     EXPECT_EQ(j["schema"].string, "cnccomp-report-summary/1");
-    const JsonValue& run = j["runs"][0];
+    const Json& run = j["runs"][0];
     EXPECT_EQ(run["name"].string, "C-X");
     EXPECT_EQ(run["samples"].num(), 720);
     EXPECT_EQ(run["passes"][1].string, "cw");
     EXPECT_NEAR(run["before"]["G_um"].num(), 8.0, 1e-6);          // 2b
     EXPECT_NEAR(run["before"]["H_um"].num(), 1.5, 2e-4);          // the CW offset
     EXPECT_NEAR(run["before"]["mean_radius_mm"].num(), 100.00375, 1e-8);  // R + 0.75 µm
-    EXPECT_EQ(run["after"]["G_um"].type, JsonValue::Type::Null);  // no after traces
+    EXPECT_EQ(run["after"]["G_um"].type, Json::Type::Null);  // no after traces
     EXPECT_EQ(run["plot"].string, "r-polar-C-X.svg");
     EXPECT_NEAR(j["deviations"][0]["value"].num(), 9.1234, 1e-12);
     EXPECT_NEAR(j["deviations"][0]["low95"].num(), 8.5, 1e-12);
     EXPECT_NEAR(j["deviations"][0]["truth"].num(), 9.0, 1e-12);
     EXPECT_FALSE(j["deviations"][1]["identified"].boolean);
-    EXPECT_EQ(j["deviations"][1]["value"].type, JsonValue::Type::Null);
+    EXPECT_EQ(j["deviations"][1]["value"].type, Json::Type::Null);
     ASSERT_EQ(j["unidentified"].array.size(), 1u);
     EXPECT_EQ(j["unidentified"][0].string, "EC0Y");
 }

@@ -17,6 +17,7 @@
 #include "cnccomp/kinematics.hpp"
 #include "cnccomp/linear_circle_identify.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "app/report/polar_plot.hpp"
 #include "test_browser.hpp"
@@ -116,7 +117,7 @@ TEST(PlanCircle, BadCircleNamesFileLineAndWhatIsExpected) {
 
 struct Recovered {
     DeviationSet deviations;
-    JsonValue json;
+    Json json;
     std::string out;
 };
 
@@ -139,22 +140,22 @@ void expectRoundTrip(const Recovered& got) {
     }
     // Centring offset of every pass = the pivot set-up error, in the plane's (u, v) (µm).
     const double centring[3][2] = {{5, -3}, {4, 5}, {-5, 2}};  // XY: (X, Y); YZ: (Y, Z); ZX: (Z, X)
-    const JsonValue& runs = got.json["runs"];
+    const Json& runs = got.json["runs"];
     ASSERT_EQ(runs.array.size(), 3u);
     for (size_t i = 0; i < 3; ++i) {
-        const JsonValue& c = runs[i]["centring_um"];
+        const Json& c = runs[i]["centring_um"];
         ASSERT_EQ(c.array.size(), 2u);
         for (size_t pass = 0; pass < 2; ++pass)
             for (size_t k = 0; k < 2; ++k) EXPECT_NEAR(c[pass][k].num(), centring[i][k], 0.01) << i << " " << pass << " " << k;
         EXPECT_LT(runs[i]["fit"]["sigma_um"].num(), 1e-3);
         // ISO 230-4 figures per pass and of the run.
-        const JsonValue& iso = runs[i]["iso230_4"];
+        const Json& iso = runs[i]["iso230_4"];
         EXPECT_GT(iso["G_um"].num(), 1.0);
         EXPECT_TRUE(std::isfinite(iso["H_um"].num()));
         ASSERT_EQ(iso["passes"].array.size(), 2u);
         EXPECT_EQ(iso["passes"][0]["direction"].string, "cw");
         // Diagnostics ranked by their share of G, each with its fields.
-        const JsonValue& d = runs[i]["diagnostics"];
+        const Json& d = runs[i]["diagnostics"];
         ASSERT_GT(d.array.size(), 10u);
         for (size_t k = 0; k < d.array.size(); ++k) {
             for (const char* key : {"name", "unit", "value", "low95", "high95", "circularity_um", "share_pct", "model", "identified", "rank"})
@@ -171,7 +172,7 @@ void expectRoundTrip(const Recovered& got) {
     // machine, as the circle model defines them (linear_circle_model.hpp): scale mismatch u − v, straightness S_u =
     // bow at ±R, radius offset = the common scale × R. The machine's kinematics are the oracle of the model's signs.
     const auto diagnostic = [&](size_t run, const std::string& name) {
-        for (const JsonValue& x : runs[run]["diagnostics"].array)
+        for (const Json& x : runs[run]["diagnostics"].array)
             if (x["name"].string == name) return x["value"].num();
         ADD_FAILURE() << "no diagnostic " << name;
         return 0.0;
@@ -231,7 +232,7 @@ TEST(LinearCircleCli, HtmlReportHasPolarPlotsIsoTableAndRankedDiagnostics) {
     EXPECT_NE(html.find("EA0Z"), std::string::npos);
     for (const char* run : {"xy", "yz", "zx"})
         EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("r-polar-") + run + ".svg"))) << run;
-    const JsonValue summary = readJsonFile(dir.file("r.summary.json"));
+    const Json summary = readJsonFile(dir.file("r.summary.json"));
     EXPECT_EQ(summary["runs"].array.size(), 3u);
     EXPECT_EQ(summary["tables"].array.size(), 5u);  // conditions, per pass, three runs' diagnostics
 
@@ -333,12 +334,12 @@ TEST(LinearCircleCli, TheFilesOwnDateInstrumentAndOperatorHeadTheRun) {
     const auto r = test::runCli("identify --machine " + kMachine + " --plan " + plan + " --traces " + dir.file("traces") +
                                 " --out " + dir.file("d.csv") + " --report " + dir.file("r.json"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     EXPECT_EQ(j["runs"][2]["conditions"]["date"].string, "2026-11-20 14:05");
     EXPECT_EQ(j["runs"][2]["conditions"]["instrument"].string, "QC20-W 99999");
     EXPECT_EQ(j["runs"][2]["conditions"]["operator"].string, "File Person");
     EXPECT_EQ(j["runs"][0]["conditions"]["operator"].string, "A. Tester");  // the plan's (simulate wrote it into the file)
-    EXPECT_EQ(j["runs"][1]["conditions"]["operator"].type, JsonValue::Type::Null);  // neither the plan nor the file says
+    EXPECT_EQ(j["runs"][1]["conditions"]["operator"].type, Json::Type::Null);  // neither the plan nor the file says
     EXPECT_NE(r.out.find("date 2026-11-20 14:05, instrument QC20-W 99999, operator File Person"), std::string::npos) << r.out;
     // A file of another circle is named as such.
     const std::string yz = dir.file("traces/yz.csv");
@@ -406,7 +407,7 @@ TEST(LinearCircleCli, RelativeLengthInstrumentLeavesTheDiagnostics) {
                                 dir.file("traces") + " --out " + dir.file("d.csv") + " --report " + dir.file("r.json"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("relative length: the radius offset takes up the instrument's zero"), std::string::npos) << r.out;
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     EXPECT_EQ(j["runs"][0]["conditions"]["length"].string, "relative");
     EXPECT_NEAR(j["runs"][0]["radius_offset_um"].num(), 30.5, 0.01);
     EXPECT_NEAR(j["runs"][0]["centring_um"][0][0].num(), 5.0, 0.01);

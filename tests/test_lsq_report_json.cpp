@@ -6,6 +6,7 @@
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "test_support.hpp"
 
@@ -160,7 +161,7 @@ TEST(LsqReportJson, GoldenText) {
 }
 
 TEST(LsqReportJson, ReadsBack) {
-    const JsonValue j = parseJson(formatReportJson(handMade()));
+    const Json j = parseJson(formatReportJson(handMade()));
     EXPECT_EQ(j["schema"].string, "cnccomp-identification-report/1");
     EXPECT_TRUE(j["converged"].boolean);
     EXPECT_EQ(j["rank"].num(), 1);
@@ -190,7 +191,7 @@ TEST(LsqReportJson, RealReportRoundTripsEveryNumber) {
     const IdentificationResult r = identify(m, ballbarObservations(m, runs, traces));
     test::ScratchDir dir("report-json");
     writeReportJson(dir.file("r.json"), r.report);
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     ASSERT_EQ(j["parameters"].array.size(), r.report.parameters.size());
     for (size_t i = 0; i < r.report.parameters.size(); ++i) {
         const ParameterEstimate& p = r.report.parameters[i];

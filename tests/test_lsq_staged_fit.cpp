@@ -8,6 +8,7 @@
 
 #include "cnccomp/identification/dbb5_location_errors.hpp"
 #include "cnccomp/identification/staged_fit.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "test_dbb5_support.hpp"
 #include "test_support.hpp"

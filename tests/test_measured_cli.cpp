@@ -15,6 +15,7 @@
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/trace_import.hpp"
 #include "cnccomp/version.hpp"
@@ -97,9 +98,9 @@ TEST(MeasuredCli, TimeSampledBothDirectionsRelativeInstrumentRecoverTheTruth) {
     }
     EXPECT_EQ(compared, 13) << r.out;  // here the runs tell every offset from every deviation
     // The offsets added to the files come back as the runs' dL0 (12 + 7·i µm).
-    const JsonValue j = readJsonFile(dir.file("r.json"));
+    const Json j = readJsonFile(dir.file("r.json"));
     int offsets = 0;
-    for (const JsonValue& p : j["parameters"].array) {
+    for (const Json& p : j["parameters"].array) {
         const std::string& n = p["name"].string;
         for (size_t i = 0; i < plan.runs.size(); ++i)
             if (n == plan.runs[i].name + ".dL0") {

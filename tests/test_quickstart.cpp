@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "test_browser.hpp"
 #include "test_support.hpp"
@@ -77,7 +78,7 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     const DeviationSet id = readDeviationCsv(file("3-identify/deviations.csv"), m), truth = readDeviationCsv(kTruth, m);
     for (const DeviationDef& d : m.deviations)  // 0.2 µm noise on 4400 samples: within 0.5 µm / 0.5″
         EXPECT_NEAR(id.values[d.offset], truth.values[d.offset], d.isAngle() ? 0.5 * kArcsec : 0.5 * kUm) << d.name;
-    const JsonValue ir = readJsonFile(file("3-identify/report.summary.json"));
+    const Json ir = readJsonFile(file("3-identify/report.summary.json"));
     EXPECT_EQ(ir["runs"].array.size(), 6u);
     EXPECT_EQ(ir["controllers"].array.size(), 6u);
     EXPECT_TRUE(fs::exists(file("4-map/map.svg")));
@@ -94,7 +95,7 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     for (const std::string& n : names) {
         EXPECT_TRUE(fs::exists(file("7-verify/" + n + "/report.html"))) << n;
         EXPECT_EQ(readJsonFile(file("7-verify/" + n + "/report.summary.json"))["runs"].array.size(), 6u) << n;
-        const JsonValue v = readJsonFile(file("7-verify/" + n + "/verify.json"));
+        const Json v = readJsonFile(file("7-verify/" + n + "/verify.json"));
         if (n == "ideal" || n == "corrected-programs") {
             EXPECT_TRUE(v["passed"].boolean) << n;
         }

@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/svg_map.hpp"
 #include "cnccomp/map_grid.hpp"
@@ -152,7 +153,7 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
     }
     // The plots in the page are the SVG files.
     EXPECT_NE(html.find(test::readText(dir.file("report-polar-B-X.svg")).substr(0, 200)), std::string::npos);
-    const JsonValue j = readJsonFile(dir.file("report.summary.json"));
+    const Json j = readJsonFile(dir.file("report.summary.json"));
     EXPECT_EQ(j["runs"].array.size(), 6u);
     EXPECT_EQ(j["deviations"].array.size(), 13u);
     EXPECT_EQ(j["unidentified"].array.size(), 0u);
@@ -162,14 +163,14 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
     EXPECT_GT(j["controllers"][0]["not_compensated"].array.size(), 0u);  // LinuxCNC's tables cannot hold squareness
     EXPECT_LT(j["controllers"][1]["after_max_um"].num(), 0.1 * j["controllers"][1]["before_max_um"].num());  // ISG: all
     // Before vs after on every run: the compensation removes almost all of the circular deviation.
-    for (const JsonValue& run : j["runs"].array) {
+    for (const Json& run : j["runs"].array) {
         EXPECT_GT(run["before"]["G_um"].num(), 0.0) << run["name"].string;
         EXPECT_LT(run["after"]["G_um"].num(), 2.0) << run["name"].string;  // noise 0.2 µm: a few σ
         EXPECT_NEAR(run["rms_after_um"].num(), 0.2, 0.03) << run["name"].string;
     }
     // The radial deviation F before spans several µm on some run (the machine's eccentricities), after well below.
     double spanBefore = 0, spanAfter = 0;
-    for (const JsonValue& run : j["runs"].array) {
+    for (const Json& run : j["runs"].array) {
         spanBefore = std::max(spanBefore, run["before"]["F_max_um"].num() - run["before"]["F_min_um"].num());
         spanAfter = std::max(spanAfter, run["after"]["F_max_um"].num() - run["after"]["F_min_um"].num());
     }
@@ -177,7 +178,7 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
     EXPECT_LT(spanAfter, 2.5);
     // The maps share one scale from 0 up to the worst of them.
     double worst = 0;
-    for (const JsonValue& mp : j["maps"].array) worst = std::max(worst, mp["plane_max_um"].num());
+    for (const Json& mp : j["maps"].array) worst = std::max(worst, mp["plane_max_um"].num());
     EXPECT_NEAR(j["map_scale_max_um"].num(), worst, 1e-9);
 
     if (!chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "app/report/polar_plot.hpp"
 #include "test_browser.hpp"
@@ -58,9 +59,9 @@ std::vector<std::string> headerList(const std::string& text, const std::string& 
     return out;
 }
 
-std::vector<std::string> names(const JsonValue& array, const char* key = nullptr) {
+std::vector<std::string> names(const Json& array, const char* key = nullptr) {
     std::vector<std::string> out;
-    for (const JsonValue& v : array.array) out.push_back(key ? v[key].string : v.string);
+    for (const Json& v : array.array) out.push_back(key ? v[key].string : v.string);
     return out;
 }
 
@@ -76,27 +77,27 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     for (const char* f : {"report.html", "report.summary.json", "report-polar-B-X.svg", "report-polar-C-radial-RB2.svg",
                           "report-map-1.svg", "report-map-2.svg", "verify.json"})
         EXPECT_TRUE(fs::exists(base + f)) << f;
-    const JsonValue s = readJsonFile(base + "report.summary.json"), v = readJsonFile(base + "verify.json");
+    const Json s = readJsonFile(base + "report.summary.json"), v = readJsonFile(base + "verify.json");
     ASSERT_EQ(s["runs"].array.size(), 6u);
     ASSERT_EQ(v["runs"].array.size(), 6u);
     for (size_t i = 0; i < 6; ++i) {
-        const JsonValue& run = s["runs"][i];
-        const JsonValue& raw = v["runs"][i];
+        const Json& run = s["runs"][i];
+        const Json& raw = v["runs"][i];
         ASSERT_EQ(run["name"].string, raw["name"].string);
         EXPECT_EQ(names(run["passes"]), (std::vector<std::string>{"cw", "ccw"}));  // as the test programs run them
         // F max / F min over both passes and the span of each pass, recomputed from the raw ΔL samples.
         for (const char* when : {"before", "after"}) {
             double hi = -1e9, lo = 1e9, sum = 0;
             size_t n = 0;
-            for (const JsonValue& p : raw["passes"].array) {
+            for (const Json& p : raw["passes"].array) {
                 double phi = -1e9, plo = 1e9;
-                for (const JsonValue& x : p[std::string("dL_") + when + "_um"].array) {
+                for (const Json& x : p[std::string("dL_") + when + "_um"].array) {
                     phi = std::max(phi, x.num()), plo = std::min(plo, x.num());
                     sum += x.num();
                     ++n;
                 }
                 hi = std::max(hi, phi), lo = std::min(lo, plo);
-                const auto span = std::find_if(s["spans"].array.begin(), s["spans"].array.end(), [&](const JsonValue& x) {
+                const auto span = std::find_if(s["spans"].array.begin(), s["spans"].array.end(), [&](const Json& x) {
                     return x["run"].string == run["name"].string && x["pass"].string == p["direction"].string;
                 });
                 ASSERT_NE(span, s["spans"].array.end());
@@ -114,7 +115,7 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     // The compensation: the files, what their header says they take and leave, the values left (from the truth file),
     // the residual and the volumetric figures verify reports.
     ASSERT_EQ(s["controllers"].array.size(), 1u);
-    const JsonValue& c = s["controllers"][0];
+    const Json& c = s["controllers"][0];
     EXPECT_EQ(c["name"].string, "linuxcnc-pins");
     const std::vector<std::string> files = names(c["files"]);
     EXPECT_NE(std::find(files.begin(), files.end(), (fs::path(dir.file("linuxcnc-pins")) / "cnccomp.ini").string()), files.end());
@@ -125,7 +126,7 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
     // The values left as the truth file writes them (its text, not the deviation vector): the ISO value under the ISO
     // name, the paper's value under the alias.
     const auto truthRows = test::deviationRowsAsWritten(kTruth);
-    for (const JsonValue& left : c["remaining"].array) {
+    for (const Json& left : c["remaining"].array) {
         const std::string name = left["deviation"].string;
         ASSERT_TRUE(truthRows.count(name)) << name;
         const test::DeviationRowText& row = truthRows.at(name);
@@ -152,16 +153,16 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
 }
 
 /// A polar plot's run rebuilt from the raw samples of verify.json, for its scale.
-report::RunSection runFromJson(const JsonValue& raw) {
+report::RunSection runFromJson(const Json& raw) {
     report::RunSection r;
     r.name = raw["name"].string;
     r.LB = raw["LB_mm"].num();
-    for (const JsonValue& p : raw["passes"].array) {
+    for (const Json& p : raw["passes"].array) {
         report::PolarPass pp;
         pp.direction = p["direction"].string == "CCW" ? +1 : -1;
-        for (const JsonValue& a : p["angle_deg"].array) pp.angleDeg.push_back(a.num());
-        for (const JsonValue& x : p["dL_before_um"].array) pp.before.push_back(x.num() * kUm);
-        for (const JsonValue& x : p["dL_after_um"].array) pp.after.push_back(x.num() * kUm);
+        for (const Json& a : p["angle_deg"].array) pp.angleDeg.push_back(a.num());
+        for (const Json& x : p["dL_before_um"].array) pp.before.push_back(x.num() * kUm);
+        for (const Json& x : p["dL_after_um"].array) pp.after.push_back(x.num() * kUm);
         r.passes.push_back(std::move(pp));
     }
     return r;
@@ -172,7 +173,7 @@ TEST(VerifyReport, ChromiumShowsThePageAndTheTracesBeforeAndAfterWhereTheScalePu
     const auto r = emitAndVerify(dir, "isg");  // ISG's table takes every deviation of this machine: after ≈ 0
     ASSERT_EQ(r.exitCode, 0) << r.out;
     const std::string base = dir.file("isg-report/");
-    const JsonValue v = readJsonFile(base + "verify.json");
+    const Json v = readJsonFile(base + "verify.json");
     EXPECT_LT(v["residual_um"].num(), 0.1);
     if (!test::chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
     const std::string log = test::screenshot(base + "report.html", dir.file("page.png"), 1400, 2400, dir);
@@ -184,8 +185,8 @@ TEST(VerifyReport, ChromiumShowsThePageAndTheTracesBeforeAndAfterWhereTheScalePu
     EXPECT_GT(test::countColour(*page, report::kCcwAfter), 2000);
     // The C-radial plot on its own: before (CW wide underneath, CCW on top) and after at the pixels the scale gives
     // for the samples' ΔL, every 30°.
-    const JsonValue* raw = nullptr;
-    for (const JsonValue& run : v["runs"].array)
+    const Json* raw = nullptr;
+    for (const Json& run : v["runs"].array)
         if (run["name"].string == "C-radial") raw = &run;
     ASSERT_NE(raw, nullptr);
     const report::RunSection run = runFromJson(*raw);
@@ -233,11 +234,11 @@ TEST(VerifyReport, CorrectedProgramsHaveNoMapAndTheIdealCompensationListsItsSet)
     r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("corrected") +
                      " --truth " + kTruth + " --report " + dir.file("c/report.html"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    JsonValue s = readJsonFile(dir.file("c/report.summary.json"));
+    Json s = readJsonFile(dir.file("c/report.summary.json"));
     EXPECT_EQ(s["maps"].array.size(), 0u);
     EXPECT_FALSE(fs::exists(dir.file("c/report-map-1.svg")));
     bool said = false;
-    for (const JsonValue& f : s["facts"].array) said = said || f[1].string.find("compensates its own poses only") != std::string::npos;
+    for (const Json& f : s["facts"].array) said = said || f[1].string.find("compensates its own poses only") != std::string::npos;
     EXPECT_TRUE(said);
     EXPECT_EQ(s["controllers"][0]["name"].string, "corrected test programs");
     EXPECT_EQ(s["controllers"][0]["files"].array.size(), 6u);
@@ -250,16 +251,16 @@ TEST(VerifyReport, CorrectedProgramsHaveNoMapAndTheIdealCompensationListsItsSet)
     EXPECT_EQ(s["controllers"][0]["name"].string, "ideal");
     EXPECT_EQ(s["controllers"][0]["compensated"].array.size(), 13u);
     EXPECT_EQ(s["controllers"][0]["not_compensated"].array.size(), 0u);
-    for (const JsonValue& run : s["runs"].array) EXPECT_LT(run["after"]["F_max_um"].num() - run["after"]["F_min_um"].num(), 0.01);
+    for (const Json& run : s["runs"].array) EXPECT_LT(run["after"]["F_max_um"].num() - run["after"]["F_min_um"].num(), 0.01);
 }
 
 TEST(VerifyReport, AFailedGateStillWritesTheReportAndAFailedCommandWritesNothing) {
     test::ScratchDir dir("verify-report-gate");
     auto r = emitAndVerify(dir, "linuxcnc-pins", "--max-residual-um 1");
     EXPECT_EQ(r.exitCode, 1) << r.out;
-    const JsonValue s = readJsonFile(dir.file("linuxcnc-pins-report/report.summary.json"));
+    const Json s = readJsonFile(dir.file("linuxcnc-pins-report/report.summary.json"));
     bool failed = false;
-    for (const JsonValue& f : s["facts"].array) failed = failed || (f[0].string == "gate" && f[1].string.find("FAILED") != std::string::npos);
+    for (const Json& f : s["facts"].array) failed = failed || (f[0].string == "gate" && f[1].string.find("FAILED") != std::string::npos);
     EXPECT_TRUE(failed);
     EXPECT_FALSE(readJsonFile(dir.file("linuxcnc-pins-report/verify.json"))["passed"].boolean);
     // --json names a folder: nothing at all is written, not even the report's folder.
@@ -287,7 +288,7 @@ TEST(VerifyReport, AWorseCompensationShowsARedBannerAtTheTopOfThePage) {
     const auto r = test::runCli("verify --machine " + kMachine + " --plan " + kPlan + " --compensation " + dir.file("flipped.csv") +
                                 " --truth " + kTruth + " --report " + dir.file("w/report.html"));
     EXPECT_EQ(r.exitCode, 1) << r.out;
-    const JsonValue s = readJsonFile(dir.file("w/report.summary.json"));
+    const Json s = readJsonFile(dir.file("w/report.summary.json"));
     ASSERT_EQ(s["alarms"].array.size(), 1u);
     EXPECT_EQ(s["alarms"][0].string.rfind("COMPENSATION MAKES THE MACHINE WORSE", 0), 0u);
     const std::string html = test::readText(dir.file("w/report.html"));

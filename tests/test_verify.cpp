@@ -13,6 +13,7 @@
 #include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/json.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "app/verify.hpp"
 #include "app/verify_sources.hpp"
@@ -93,11 +94,11 @@ TEST(Verify, IsoFiguresEccentricityAndJsonOfAnIdealCompensation) {
                                 " --max-residual-um 0.05 --json " + dir.file("v.json"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find("verification passed"), std::string::npos) << r.out;
-    const JsonValue j = readJsonFile(dir.file("v.json"));
+    const Json j = readJsonFile(dir.file("v.json"));
     EXPECT_EQ(j["schema"].string, "cnccomp-verify/1");
     EXPECT_EQ(j["passed"].boolean, true);
     ASSERT_EQ(j["runs"].array.size(), 6u);
-    const JsonValue& cRadial = j["runs"][3];
+    const Json& cRadial = j["runs"][3];
     EXPECT_EQ(cRadial["name"].string, "C-radial");
     ASSERT_EQ(cRadial["passes"].array.size(), 2u);
     EXPECT_EQ(cRadial["passes"][0]["direction"].string, "CW");
@@ -110,7 +111,7 @@ TEST(Verify, IsoFiguresEccentricityAndJsonOfAnIdealCompensation) {
     const Vec3 e = traceEccentricity(mm, plan.runs[3], simulateRun(Kinematics(mm, truth), plan.runs[3]));
     EXPECT_NEAR(cRadial["passes"][0]["eccentricity_before_um"][0].num(), e.x() / kUm, 1e-3);
     EXPECT_NEAR(cRadial["passes"][0]["eccentricity_before_um"][1].num(), e.y() / kUm, 1e-3);
-    EXPECT_EQ(cRadial["passes"][0]["eccentricity_before_um"][2].type, JsonValue::Type::Null);
+    EXPECT_EQ(cRadial["passes"][0]["eccentricity_before_um"][2].type, Json::Type::Null);
     EXPECT_GT(cRadial["passes"][0]["iso_before"]["circular_deviation_G_um"].num(), 0.5);
     EXPECT_LT(cRadial["passes"][0]["iso_after"]["circular_deviation_G_um"].num(), 0.01);
     EXPECT_LT(j["residual_um"].num(), 0.01);
@@ -366,12 +367,12 @@ TEST(Verify, TheDeviationsLeftCarryTheirIsoValueAndAliasValueAsTheDeviationFileW
     ASSERT_EQ(r.exitCode, 0) << r.out;
     r = test::runCli("verify --machine " + m + " --plan " + p + " --compensation " + dir.file("f") + " --truth " + t + " --json " +
                      dir.file("v.json") + " --report " + dir.file("r/report.html"));
-    const JsonValue v = readJsonFile(dir.file("v.json"));
+    const Json v = readJsonFile(dir.file("v.json"));
     EXPECT_EQ(r.exitCode, v["passed"].boolean ? 0 : 1) << r.out;
     const auto rows = test::deviationRowsAsWritten(t);
     std::set<std::string> listed;
-    for (const JsonValue& left : v["remaining"].array) {
-        if (left["iso_name"].type == JsonValue::Type::Null) continue;
+    for (const Json& left : v["remaining"].array) {
+        if (left["iso_name"].type == Json::Type::Null) continue;
         const std::string name = left["iso_name"].string;
         listed.insert(name);
         ASSERT_TRUE(rows.count(name)) << name;
@@ -449,7 +450,7 @@ TEST(Verify, ACompensationThatMakesTheMachineWorseFailsWhateverTheGate) {
         EXPECT_EQ(r.out.rfind("COMPENSATION MAKES THE MACHINE WORSE: largest dL span ", 0), 0u) << name << "\n" << r.out;
         EXPECT_NE(r.out.find("verification passed: residual"), std::string::npos) << r.out;  // the 1000 um gate itself holds
         EXPECT_NE(r.out.find("verification failed: COMPENSATION MAKES THE MACHINE WORSE"), std::string::npos) << r.out;
-        const JsonValue v = readJsonFile(dir.file(name + ".json"));
+        const Json v = readJsonFile(dir.file(name + ".json"));
         EXPECT_TRUE(v["makes_machine_worse"].boolean) << name;
         EXPECT_TRUE(v["worse"]["span"].boolean) << name;
         EXPECT_FALSE(v["passed"].boolean) << name;

@@ -4,7 +4,8 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_range.hpp"
-#include "controllers/generic/json.hpp"
+#include "controllers/generic/json_text.hpp"
+#include "cnccomp/io/json.hpp"
 
 namespace cnccomp::controllers::generic {
 namespace {

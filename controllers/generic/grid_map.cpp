@@ -13,7 +13,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "controllers/common/controller_model.hpp"
 #include "controllers/common/files.hpp"
-#include "controllers/generic/json.hpp"
+#include "controllers/generic/json_text.hpp"
 
 namespace cnccomp::controllers::generic {
 namespace {
