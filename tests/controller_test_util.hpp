@@ -22,7 +22,7 @@
 namespace cnccomp::test {
 
 /// Workspace samples (controllers/common/evaluate) without the poses where the tool axis is (nearly)
-/// parallel to a rotary axis: there the TCP has no unique answer (e.g. C at B = 0 on seed 000's machine).
+/// parallel to a rotary axis: there the TCP has no unique answer (e.g. C at B = 0 on [MultiTasking]'s machine).
 inline std::vector<AxisVector> nonSingularSamples(const MachineModel& m, int perAxis, double maxLinear = 200.0) {
     const Kinematics k(m);
     std::vector<AxisVector> out;

@@ -153,7 +153,7 @@ TEST(ControllerFanuc, PivotAndPitchErrorsClaimedAreCompensated) {
     test::report("fanuc-30i pivots + pitch (all, 3 left)", all);
 }
 
-// The TCP offsets read back are the pivot positions of the deviation set (seed 000: C axis line, spindle).
+// The TCP offsets read back are the pivot positions of the deviation set ([MultiTasking]: C axis line, spindle).
 TEST(ControllerFanuc, TcpOffsetsAreThePivotPositions) {
     const MachineModel& m = pitchMachine();
     DeviationSet d(m);

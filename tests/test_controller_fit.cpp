@@ -1,5 +1,5 @@
-// The values a controller's files carry, fitted to what that controller holds (controllers/common/fit.hpp, issue 17
-// part 1): never more tool-tip error than no compensation, the identified values where the controller holds them all,
+// The values a controller's files carry, fitted to what that controller holds (controllers/common/fit.hpp):
+// never more tool-tip error than no compensation, the identified values where the controller holds them all,
 // the quickstart machine's Fanuc files better than none, --copy-identified unchanged, the warning's tolerance.
 // Oracles: the evaluation harness (exact kinematics of the identified machine with the files read back by each
 // backend's own apply model), round trips (files byte for byte), and the issue's own figures for the Fanuc case.

@@ -456,7 +456,7 @@ TEST(ControllerLinuxcnc, EmitCommandWritesFilesAndNeverAnInput) {
 }
 
 
-// ---- the component route (issue 17) -------------------------------------------------------------------------------
+// ---- the component route -------------------------------------------------------------------------------
 
 TEST(ControllerLinuxcnc, ComponentRouteHoldsEveryDeviationAndReadsItsPinsBack) {
     // Oracle: the exact kinematics of the erroneous machine (tool tip and axis at the drive commands the files give).

@@ -54,7 +54,7 @@ TEST(ControllerSiemens, GoldenFilesOtherSampleMachinesParseBack) {
     }
 }
 
-// All 13 location errors of seed 000's machine are claimed: squareness by CEC lines (+ the head orientation
+// All 13 location errors of [MultiTasking]'s machine are claimed: squareness by CEC lines (+ the head orientation
 // folded into the chain), everything else by the kinematic chain.
 TEST(ControllerSiemens, MultitaskingTruthResidualBelowTenPercent) {
     const MachineModel& m = test::multitasking();

@@ -1,4 +1,4 @@
-// Inputs found by the reader fuzz targets (tests/fuzz/, issue 18), each reduced to what triggers it. Before the fix each
+// Inputs found by the reader fuzz targets (tests/fuzz/), each reduced to what triggers it. Before the fix each
 // one crashed or raised a sanitizer report; now the reader refuses it with an InputError naming the file and line (what
 // the CLI reports as bad input, exit 2). Oracle: the reader's own contract (bad input → InputError), README "Tests".
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Inputs whose meaning the numbers alone do not show (issue 18, part 2): a plan feed that is not the real one on
+// Inputs whose meaning the numbers alone do not show: a plan feed that is not the real one on
 // time-sampled files, deviation files written before the ISO names took ISO 230-1's meaning, and `compare` of two files
 // that name the same machine differently. Oracles: the simulator's known feed and geometry (round trips), and the
 // ISO meaning of the names (iso_names.hpp) as the deviation tests of that module check it.

@@ -1,4 +1,4 @@
-// The one CSV reader (io/csv.hpp) and what issue 18 found misread: a byte-order mark, ';' and decimal commas,
+// The one CSV reader (io/csv.hpp) and what it once misread: a byte-order mark, ';' and decimal commas,
 // non-regular files, deviations beyond any machine.
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -58,7 +58,7 @@ TEST(CsvReader, ReadsTheDialectsSpreadsheetsWrite) {
 }
 
 // A deviation file saved as "CSV UTF-8" by a spreadsheet (with a BOM, CRLF) reads exactly as the plain file. Oracle:
-// the sample file itself, read without the BOM (issue 18: with the BOM the header's 'name' was not found, the rows
+// the sample file itself, read without the BOM (with the BOM the header's 'name' was not found, the rows
 // were read under their paper aliases and five values flipped sign).
 TEST(DeviationCsvInput, ByteOrderMarkAndCrlfReadAsThePlainFile) {
     test::ScratchDir dir("io-csv-bom");
@@ -104,7 +104,7 @@ TEST(DeviationCsvInput, ValuesBeyondAnyMachineAreRefusedWithTheRange) {
     }
     test::writeText(dir.file("ok.csv"), "name,value,unit\nEX0C1,99,mm\nEA0B,0.9,deg\n");
     EXPECT_NO_THROW(readDeviationCsv(dir.file("ok.csv"), test::multitasking()));
-    // Through the CLI: exit 2 with the range, never a crash (issue 18: exit 139 with --out oh).
+    // Through the CLI: exit 2 with the range, never a crash (exit 139 with --out oh).
     test::writeText(dir.file("huge.csv"), "name,value,unit\nEX0C1,1e200,mm\n");
     const auto r = test::runCli("simulate --machine " + test::sourcePath("samples/machines/multitasking.xml") + " --plan " +
                                 test::sourcePath("samples/plans/multitasking-six-circles.xml") + " --deviations " +

@@ -1,5 +1,5 @@
 // Every command writes all of its outputs or none (io/output_set.hpp), on a full disk and on a read-only one, with a
-// message naming the folder (issue 18: emit left two files on a full disk and printed a raw filesystem error on a
+// message naming the folder (emit left two files on a full disk and printed a raw filesystem error on a
 // read-only one; testprog left an empty folder). The disks are small tmpfs mounts (root only; skipped, saying why,
 // where mounting is not permitted).
 #include <sys/mount.h>

@@ -1,4 +1,4 @@
-// Measured traces in the wrong unit (issue 18): an mm export under a dL_um header, or µm data under
+// Measured traces in the wrong unit: an mm export under a dL_um header, or µm data under
 // length-unit="mm", is refused naming the likely unit; a large file streams.
 #include <chrono>
 #include <filesystem>
@@ -83,7 +83,7 @@ std::string inputErrorOf(F&& f) {
     return "(no InputError)";
 }
 
-// One mm export among µm files (issue 18: identify gave EX0C1 5.34 µm for 12): refused, the file and "mm" named.
+// One mm export among µm files (identify gave EX0C1 5.34 µm for 12): refused, the file and "mm" named.
 TEST(TraceUnits, OneFileInMillimetresAmongMicrometresIsRefused) {
     test::ScratchDir dir("io-traces-mm");
     const std::string traces = simulateInto(dir);
@@ -96,7 +96,7 @@ TEST(TraceUnits, OneFileInMillimetresAmongMicrometresIsRefused) {
     expectIdentifyRefusesMillimetres(dir, traces);
 }
 
-// The whole set exported in mm and read under the default µm (issue 18: every result 1000× too small): no run spans
+// The whole set exported in mm and read under the default µm (every result 1000× too small): no run spans
 // what a ball bar resolves; refused naming mm. Oracle: the simulator's known truth (the same files in µm read).
 TEST(TraceUnits, EveryFileInMillimetresIsRefused) {
     test::ScratchDir dir("io-traces-all-mm");
@@ -141,7 +141,7 @@ void densify(const std::string& path, int per) {
     test::writeText(path, out);
 }
 
-// A densely sampled file (issue 18: a 38 MB trace took 81 s and 1.24 GB in identify) is averaged into bins of the
+// A densely sampled file (a 38 MB trace took 81 s and 1.24 GB in identify) is averaged into bins of the
 // plan's step: the same deviations as the file at the plan's step, the summary says so. Oracle: the plan-step files
 // of the same simulation (the bins of a linear interpolant hold the plan's samples up to the curvature over a step).
 // The speed is measured by BM_ImportDenseTrace (tests/bench), not here.
@@ -168,7 +168,7 @@ TEST(TraceUnits, DenseFileIsAveragedIntoThePlansStep) {
         EXPECT_NEAR(a.isoValue(static_cast<int>(i)), b.isoValue(static_cast<int>(i)), 0.02 * kUm) << m.deviations[i].name;
 }
 
-// A folder standing where a trace belongs is named as a folder (issue 18 called it an "empty file").
+// A folder standing where a trace belongs is named as a folder (it was called an "empty file").
 TEST(TraceUnits, AFolderNamedLikeATraceIsNamed) {
     test::ScratchDir dir("io-traces-folder");
     const std::string traces = simulateInto(dir);

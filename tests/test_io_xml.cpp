@@ -1,5 +1,5 @@
 // Machine and plan XML: unknown elements and attributes are errors naming the line and the nearest known name
-// (issue 18: `<instrument lenght-unit="mm">` was ignored and every trace read 1000x too small); X, Y, Z parallel.
+// (`<instrument lenght-unit="mm">` was ignored and every trace read 1000x too small); X, Y, Z parallel.
 #include <gtest/gtest.h>
 
 #include "cnccomp/error.hpp"

@@ -1,4 +1,4 @@
-// Forward kinematics against seed 000 eq. (1)–(13) written out independently with the paper's
+// Forward kinematics against [MultiTasking] eq. (1)–(13) written out independently with the paper's
 // small-angle HTMs: agreement to second order in the deviations.
 #include <gtest/gtest.h>
 

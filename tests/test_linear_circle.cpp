@@ -1,4 +1,4 @@
-// Ball-bar circles of two linear axes (cnccomp/linear_circle_model.hpp, issue 20).
+// Ball-bar circles of two linear axes (cnccomp/linear_circle_model.hpp).
 // Oracles: (1) first-order signatures of each diagnostic transcribed from the literature (Kakino et al. 1993, the
 // squareness / scale / servo-mismatch ellipses, the centring harmonic), written here apart from the model;
 // (2) the ISO 230-4 evaluation of the project (circular_test.hpp, G and the Fourier terms) on the simulated traces;

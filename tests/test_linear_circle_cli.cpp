@@ -1,4 +1,4 @@
-// The ball-bar circles of the linear axes (ISO 230-4, issue 20) as a user's route: <circle> plan runs, simulate,
+// The ball-bar circles of the linear axes (ISO 230-4) as a user's route: <circle> plan runs, simulate,
 // identify (text, JSON, HTML), bad input. Oracle: round trips through the executable (the machine's exact kinematics
 // simulate the traces, with known squareness and a known pivot set-up error; identify must give them back).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Model adequacy (issue 18, part 1): after every least-squares fit the residual is tested against the noise the data
+// Model adequacy: after every least-squares fit the residual is tested against the noise the data
 // can have. The case of the issue: a DBB5 B/C plan on a machine whose C table has error motions of 4–6 µm / 4–6″,
 // identified with the default eleven location and squareness errors — the fit absorbs the missing error motions into
 // the squareness and C's tilt, so the values are wrong and, before this test, the report said nothing. Oracles: the

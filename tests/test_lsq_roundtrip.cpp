@@ -1,4 +1,4 @@
-// Noise-free round trips of the least-squares engine on the multitasking machine of seed 000: simulate ball-bar
+// Noise-free round trips of the least-squares engine on the multitasking machine of [MultiTasking]: simulate ball-bar
 // runs with a known deviation set, identify from the raw ΔL samples, compare with the truth; rank-deficient
 // requests are reported by name with their identifiable combinations.
 #include <gtest/gtest.h>
@@ -56,7 +56,7 @@ const Combination* findCombination(const std::vector<Combination>& list, const s
 }
 
 TEST(LsqRoundTrip, SixCirclesRecoverAllThirteenDeviations) {
-    // Raw ΔL samples see more than the eccentricities of seed 000: γXY (EC0Y) changes the shape of the C-radial
+    // Raw ΔL samples see more than the eccentricities of [MultiTasking]: γXY (EC0Y) changes the shape of the C-radial
     // trajectories, so all 13 deviations, γXY included, are identifiable from the six runs.
     const MachineModel& m = test::multitasking();
     const IdentificationResult r = identify(m, simulate(m, truth(), sixCircles().runs, 5.0));

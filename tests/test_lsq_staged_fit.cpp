@@ -1,4 +1,4 @@
-// Least squares in two stages (identification/staged_fit.hpp; issue 18, part 1: "where the plan has runs that determine
+// Least squares in two stages (identification/staged_fit.hpp; "where the plan has runs that determine
 // a deviation exactly (squareness from the linear circles), they are not left to be absorbed by others").
 // Oracles: the simulator's known truth (round trips with seeded noise), the one-stage fit of the same data (what the
 // staging changes), and the coverage of the 95 % intervals over repeated noise.

@@ -1,4 +1,4 @@
-// Test planner on the multitasking machine of seed 000: a plan of at most six runs for the 12 deviations of
+// Test planner on the multitasking machine of [MultiTasking]: a plan of at most six runs for the 12 deviations of
 // section 5, checked independently by simulating the plan and identifying with the least-squares engine.
 #include <gtest/gtest.h>
 
@@ -89,7 +89,7 @@ TEST(PlannerMultitasking, AtMostSixRunsIdentifyTheTwelveFromRawTraces) {
 }
 
 TEST(PlannerMultitasking, EccentricitiesNeedTheCXRunForSquarenessXY) {
-    // Planning for seed 000's closed-form input (circle centres only): six runs still suffice for the twelve, and
+    // Planning for [MultiTasking]'s closed-form input (circle centres only): six runs still suffice for the twelve, and
     // γXY is seen by a single run type. Seed 000 section 4.2 names the Y-direction run; in the exact model with the
     // W-side ball set on the T-side ball it is the X-direction run (see Table3.SquarenessXYShowsInTheCXRunNotTheCYRun).
     const MachineModel& m = test::multitasking();

@@ -1,4 +1,4 @@
-// `cnccomp correct` refusing what it cannot do right (issue 18, part 2): a tool length nobody gave where a rotary
+// `cnccomp correct` refusing what it cannot do right: a tool length nobody gave where a rotary
 // move's correction depends on it (a test program's header names its length and is read), a correction that does not
 // converge (exit 3, nothing written unless --keep-partial), and one word in exponent notation in a milling program
 // (no longer a 3-D printer clue for --dialect auto: the rs274ngc lexer refuses that line).

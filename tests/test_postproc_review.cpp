@@ -1,4 +1,4 @@
-// The review's defects 5–10 of `cnccomp correct` (issue 12), each with the case that showed it: moves outside the
+// The review's defects 5–10 of `cnccomp correct`, each with the case that showed it: moves outside the
 // travel are reported; a move after a block passed through is not split for an offset splitting cannot remove;
 // --strict gives a non-zero exit status; near the singular pose of an A/C table the rotary solution stays continuous;
 // a tolerance below the output resolution is clamped and reported; words appended to a block follow its spacing.

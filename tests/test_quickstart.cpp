@@ -120,7 +120,7 @@ TEST(Quickstart, TheMainJobRunsTheWholeLoopAndKeepsEveryOutput) {
     EXPECT_LT(rows.at("ideal").verifiedAfter, 0.2);
     EXPECT_LT(rows.at("corrected-programs").verifiedAfter, 0.2);
     EXPECT_LT(rows.at("isg").verifiedAfter, 0.2);       // ISG's table holds every deviation of this machine
-    // LinuxCNC's default route, the generated kinematics component, holds the whole model (issue 17): nothing is left,
+    // LinuxCNC's default route, the generated kinematics component, holds the whole model: nothing is left,
     // and the test programs give it their tool length (G43.1), so the span is that of a controller holding everything.
     EXPECT_EQ(rows.at("linuxcnc").left, 0);
     EXPECT_LT(rows.at("linuxcnc").verifiedAfter, 0.1);

@@ -68,7 +68,7 @@ TEST(RtestAxisTables, SmallAngleModelMatchesExactKinematics) {
             const Vec3 nominal = Kinematics(m).baseToWorkpiece(q) * w;
             EXPECT_GT((exact - nominal).norm(), 1 * kUm);
         }
-    std::printf("[ seed 004 ] eq. (1)-(7) vs exact kinematics: %.2e um\n", worstDiff / kUm);
+    std::printf("[ RotaryTableModel ] eq. (1)-(7) vs exact kinematics: %.2e um\n", worstDiff / kUm);
     EXPECT_LT(worstDiff, 1e-3 * kUm);  // second order: |ξ|²·|W| ≈ 1e-4 µm here
 }
 
@@ -87,7 +87,7 @@ TEST(RtestAxisTables, PerAngleFormulasRecoverTheTables) {
     const DeviationSet d = cradleTablesPerAngle(m, "A", "C", f.plan.rtestRuns, f.traces, &perAngle);
     ASSERT_EQ(perAngle.size(), 2u);
     const auto [um, as] = worst(d, f.truth);
-    std::printf("[ seed 004 ] per-angle eq. (1)-(7): axes alone %.4f um, %.4f arcsec; A then C %.5f um, %.5f arcsec\n",
+    std::printf("[ RotaryTableModel ] per-angle eq. (1)-(7): axes alone %.4f um, %.4f arcsec; A then C %.5f um, %.5f arcsec\n",
                 um0, as0, um, as);
     // Documented tolerance of the small-angle per-angle solve (second-order terms |ξ|·|δ| and |ξ|²·|p|).
     EXPECT_LT(um, 0.002);
@@ -100,7 +100,7 @@ TEST(RtestAxisTables, LeastSquaresRecoversTheTablesExactly) {
     const Fixture& f = kinematicTables();
     const CradleLsq r = cradleLeastSquares(m, "A", "C", f.plan.rtestRuns, f.traces);
     const auto [um, as] = worst(r.deviations, f.truth);
-    std::printf("[ seed 004 ] least squares + gauge: worst %.2e um, %.2e arcsec; %zu unobservable directions\n", um, as,
+    std::printf("[ RotaryTableModel ] least squares + gauge: worst %.2e um, %.2e arcsec; %zu unobservable directions\n", um, as,
                 r.report.unobservable.size());
     EXPECT_LT(um, 0.001);
     EXPECT_LT(as, 0.001);

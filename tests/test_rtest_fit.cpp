@@ -1,4 +1,4 @@
-// Fits of seed 001 section 2.2 (Gander, Golub & Strebel 1994): planes, circles in 3D, ellipses (algebraic,
+// Fits of [Moravek2019] section 2.2 (Gander, Golub & Strebel 1994): planes, circles in 3D, ellipses (algebraic,
 // geometric, parametric with known phases) against exactly constructed shapes, and eq. (2) on a sheared circle.
 #include <gtest/gtest.h>
 
@@ -78,7 +78,7 @@ TEST(RtestFit, GeometricFitBeatsAlgebraicOnNoisyArcs) {
 }
 
 TEST(RtestFit, DiametersOfAShearedCircleGiveEquationTwo) {
-    // Circle of radius R sheared by y += γx: D45 − D135 = γ·D0 to first order (seed 001 eq. (1)–(2)).
+    // Circle of radius R sheared by y += γx: D45 − D135 = γ·D0 to first order ([Moravek2019] eq. (1)–(2)).
     const double R = 150, gamma = 20e-6;
     std::vector<Vec2> pts;
     std::vector<double> ph;

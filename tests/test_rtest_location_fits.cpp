@@ -61,7 +61,7 @@ TEST(RtestLocationFits, PaperFitsRecoverTheElevenErrors) {
     const RtestLocationResult r = rtestLocationFits(m, f.plan.rtestRuns, f.traces);
     const auto [um1, as1] = worst(r.plain, f.truth);
     const auto [um, as] = worst(r.deviations, f.truth);
-    std::printf("[ seed 001 ] plain formulas: %.4f um, %.4f arcsec; after %d refinement steps: %.2e um, %.2e arcsec\n",
+    std::printf("[ Moravek2019 ] plain formulas: %.4f um, %.4f arcsec; after %d refinement steps: %.2e um, %.2e arcsec\n",
                 um1, as1, r.refine, um, as);
     EXPECT_LT(um, 0.001);
     EXPECT_LT(as, 0.001);
@@ -85,7 +85,7 @@ TEST(RtestLocationFits, LeastSquaresRecoversTheElevenErrorsExactly) {
     const IdentificationResult res = identify(m, obs, o);
     EXPECT_TRUE(res.report.unidentified.empty());
     const auto [um, as] = worst(res.deviations, f.truth);
-    std::printf("[ seed 001 ] least squares: %.2e um, %.2e arcsec, cond %.1f\n", um, as, res.report.conditionNumber);
+    std::printf("[ Moravek2019 ] least squares: %.2e um, %.2e arcsec, cond %.1f\n", um, as, res.report.conditionNumber);
     EXPECT_LT(um, 0.001);
     EXPECT_LT(as, 0.001);
 }
@@ -110,7 +110,7 @@ TEST(RtestLocationFits, VolumetricErrorAlongXyzacFromTheElevenErrors) {
     const Fixture& f = locationRuns();
     const RtestLocationResult r = rtestLocationFits(m, f.plan.rtestRuns, f.traces);
     const VolumetricAlongRun v = volumetricErrorAlongRun(m, r.deviations, f.plan.rtestRuns[4], f.traces[4]);
-    std::printf("[ seed 001 ] XYZAC: measured RMS %.3f um, residual RMS %.2e um, max %.2e um\n", v.rmsMeasured / kUm,
+    std::printf("[ Moravek2019 ] XYZAC: measured RMS %.3f um, residual RMS %.2e um, max %.2e um\n", v.rmsMeasured / kUm,
                 v.rmsResidual / kUm, v.maxResidual / kUm);
     EXPECT_GT(v.rmsMeasured, 10 * kUm);   // the 11 errors move the ball by tens of µm along the trajectory
     EXPECT_LT(v.maxResidual, 1e-6 * kUm);  // and the identified set explains all of it

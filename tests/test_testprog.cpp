@@ -88,7 +88,7 @@ std::vector<double> simulationSamples(const testprog::RunMotion& r) {
 
 TEST(TestPrograms, EveryDialectReadsBackToTheSimulationsPosesForEverySamplePlan) {
     // Round trip through an independent reader path: the program text → `poses` (ISO interpreter or Klartext reader)
-    // → commands, against the commands simulate / simulate-runs evaluate (seed 000 Table 2, seed 003, seed 001/004).
+    // → commands, against the commands simulate / simulate-runs evaluate ([MultiTasking] Table 2, [IbarakiDBB5], [Moravek2019] / [RotaryTableModel]).
     ASSERT_GE(samplePlans().size(), 8u);
     for (const SamplePlan& sp : samplePlans()) {
         const auto motions = testprog::planMotions(sp.machine, sp.plan);

@@ -91,7 +91,7 @@ TEST(TiltingHeadErrors, FormulasRecoverTheHeadErrorsAtEveryAngle) {
         for (auto [v, n] : {std::pair{h.ex, "EAB"}, {h.ey, "EBB"}})
             as = std::max(as, std::abs(v - truthAt(f.truth, n, B)) / kArcsec);
     }
-    std::printf("[ seed 002 ] eq. (7), (9), (16), (21): worst %.5f um, %.5f arcsec over 17 angles\n", um, as);
+    std::printf("[ FanWuLi ] eq. (7), (9), (16), (21): worst %.5f um, %.5f arcsec over 17 angles\n", um, as);
     // Documented tolerance of the first-order formulas (second-order terms, amplified by L2/(L2 − L1) = 3).
     EXPECT_LT(um, 0.005);
     EXPECT_LT(as, 0.005);
@@ -115,7 +115,7 @@ TEST(TiltingHeadErrors, LeastSquaresRecoversTheTruthExactly) {
         }
         EXPECT_TRUE(r.deviations.present[f.truth.require(n)]) << n;
     }
-    std::printf("[ seed 002 ] least squares + gauge of eq. (9): worst %.2e um, %.2e arcsec\n", um, as);
+    std::printf("[ FanWuLi ] least squares + gauge of eq. (9): worst %.2e um, %.2e arcsec\n", um, as);
     EXPECT_LT(um, 0.001);
     EXPECT_LT(as, 0.001);
     // Before the gauge split the engine's εx(B) carries Q(B) = εBz cos B − εxB sin B + εx(B) (eq. (4)).

@@ -1,4 +1,4 @@
-// The closed loop of issue 9 on every sample machine: simulate the plan with a truth set → identify (least squares) →
+// The closed loop on every sample machine: simulate the plan with a truth set → identify (least squares) →
 // emit with each of the six backends → verify through the emitted files (read back by Backend::apply), through
 // corrected test programs, and with measurement noise. Oracle: the simulation on the true machine (the truth set is
 // known), with the instrument readings analysed like measured ones. Every backend × machine is held to 0.1 um of ΔL
@@ -44,8 +44,8 @@ struct Case {
     bool correctWithTruth = false;
 };
 const Case kCases[] = {
-    {"multitasking", "multitasking-six-circles.xml", "multitasking-truth.csv"},  // seed 000, six ball-bar runs
-    {"table-table-ac", "table-table-ac-rtest.xml", "table-table-ac-truth.csv"},  // seed 001, R-test, 11 errors
+    {"multitasking", "multitasking-six-circles.xml", "multitasking-truth.csv"},  // [MultiTasking], six ball-bar runs
+    {"table-table-ac", "table-table-ac-rtest.xml", "table-table-ac-truth.csv"},  // [Moravek2019], R-test, 11 errors
     {"tilting-head-b", "tilting-head-b-patterns.xml", "tilting-head-b-truth.csv"},  // head patterns (absolute bar, two tool lengths), B tables
     // B/C table with a tool-side offset and machine-zero on X, Y, Z: every backend's frame conversion (description
     // commands → controller machine coordinates) is in the loop; 15 location errors and component tables/polynomials.
@@ -58,7 +58,7 @@ const Case kCases[] = {
     {"table-table-ac", "table-table-ac-rtest.xml", "table-table-ac-truth.csv", true, {{"C", 90}, {"Y", 40}, {"X", -30}}},
 };
 
-/// R-test on the B/C table (as seed 001 on the A/C cradle): C turns at B = 0 and ±45°, B turns at C = 0, both together.
+/// R-test on the B/C table (as [Moravek2019] on the A/C cradle): C turns at B = 0 and ±45°, B turns at C = 0, both together.
 constexpr const char* kBcOffsetsPlan = R"(<?xml version="1.0" encoding="UTF-8"?>
 <plan machine="table-table-bc-offsets" description="R-test XYC, XZB, XYC at B = +-45 deg, XYZBC">
   <rtest name="XYC" ball="100 0 50" nest-length="100" steps="72">
@@ -294,7 +294,7 @@ TEST(VerifyLoop, WhatABackendLeavesIsNamedWithItsReason) {
                 if (d >= 0 && l.truth->present[static_cast<size_t>(d)] && l.machine.deviations[static_cast<size_t>(d)].size() == 1) {
                     ASSERT_TRUE(r.remaining[i].valueKnown) << where;
                     const DeviationDef& def = l.machine.deviations[static_cast<size_t>(d)];
-                    // Under its ISO name, the ISO value (issue 17: the link value printed under the ISO name misled).
+                    // Under its ISO name, the ISO value (the link value printed under the ISO name misled).
                     const double v = l.truth->isoValue(d) / (def.isAngle() ? kArcsec : kUm);
                     EXPECT_NEAR(r.remaining[i].value, v, 1e-9) << where << " " << def.name;
                 }

@@ -1,4 +1,4 @@
-// The values a controller's files carry, fitted to what that controller holds (issue 17 part 1).
+// The values a controller's files carry, fitted to what that controller holds.
 //
 // The backend is a black box: emit() writes files from a deviation set, apply() reads them back into the controller's
 // model. The free values are the entries of the deviation vector the files respond to, found from the finite-difference

@@ -1,5 +1,5 @@
 #pragma once
-// The values a controller's files carry, fitted to what that controller can hold (issue 17 part 1): the least-squares
+// The values a controller's files carry, fitted to what that controller can hold: the least-squares
 // best of the controller's adjustable values against the identified machine's tool-tip error over a stated workspace,
 // with "no compensation" and "the identified values copied" always among the candidates, so that the files never
 // leave more error than none on that workspace.

@@ -1,5 +1,5 @@
 #pragma once
-// The component route of the LinuxCNC backend (issue 17): a kinematics component generated for the machine with its
+// The component route of the LinuxCNC backend: a kinematics component generated for the machine with its
 // deviations (kins_component.hpp: the exact model, every location, squareness and component error, forward and
 // inverse, joint mode and tool-tip mode), the INI and HAL fragments that load it and set its deviation pins, and the
 // apply model that reads those files back and moves like LinuxCNC with the component loaded.

@@ -17,7 +17,7 @@
 //   compute_screw_comp): trim by the direction of motion, linear interpolation, end values held, looked up at the raw
 //   joint position.
 // Backend::apply gives the joint mode: the mode of the test programs `verify` runs (a tool-tip-mode prediction of
-// machine-coordinate programs predicted 18.7 um where the real LinuxCNC gave 60.1 um, issue 17).
+// machine-coordinate programs predicted 18.7 um where the real LinuxCNC gave 60.1 um).
 // The tests compare it with the real LinuxCNC (tests/linuxcnc).
 #include <array>
 #include <optional>

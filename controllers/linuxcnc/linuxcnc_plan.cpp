@@ -85,7 +85,7 @@ std::optional<TrtType> matchTrt(const MachineModel& m) {
     const auto [tilt, c] = trtLinks(m);
     const Link &lt = m.workpiece.links[tilt], &lc = m.workpiece.links[c];
     // A table-table machine whose axes turn the other way is not one of LinuxCNC's trt modules, and trivkins would
-    // replace the user's tool-tip kinematics in [KINS] (issue 17): refuse it by name.
+    // replace the user's tool-tip kinematics in [KINS]: refuse it by name.
     const auto refuse = [&](const Link& l, const char* axis, const char* want) {
         throw ModelError(fmt::format("{}: rotary axis {} turns about {}: LinuxCNC's {} turns it about {} (trtfuncs.c), and the "
                                      "pins route has no other table-table kinematics (trivkins would replace your tool-tip "

@@ -3,10 +3,10 @@
 // sweep as a function of its parameter (an angle in degrees, or the pose index of an R-test), and the samples the
 // simulation evaluates. One source for `cnccomp testprog` (which writes it) and `cnccomp verify` (which reads the
 // written programs back and checks them against it).
-//  <run>          seed 000 Table 2 commands (runCommands), W-side ball set at setupCommands (eq. (11)–(13));
-//  <absolute-run> the same commands, Ball 2 at its nominal position (seed 002 section 3.1);
-//  <dbb5>         dbb5Commands / dbb5SetupCommands (seed 003);
-//  <rtest>        rtestCommands, stop-and-go poses, the ball centred in the nest at the first pose (seed 001/004);
+//  <run>          [MultiTasking] Table 2 commands (runCommands), W-side ball set at setupCommands (eq. (11)–(13));
+//  <absolute-run> the same commands, Ball 2 at its nominal position ([FanWuLi] section 3.1);
+//  <dbb5>         dbb5Commands / dbb5SetupCommands ([IbarakiDBB5]);
+//  <rtest>        rtestCommands, stop-and-go poses, the ball centred in the nest at the first pose ([Moravek2019] / [RotaryTableModel]);
 //  <circle>       linearCircleCommands, the pivot ball set under the tool ball at the centre (ISO 230-4).
 #include <functional>
 #include <string>

@@ -214,7 +214,7 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
                                     "work offset active",
                                     programDialectName(o.dialect)));
     }
-    // The mode the controller must run the program in, which verify also runs it in (issue 17).
+    // The mode the controller must run the program in, which verify also runs it in.
     syntax->comment(kKinematicsModeLine);
     for (const std::string& n : r.notes) syntax->comment(n);
     syntax->comment("setup pose: " + describePose(m, C(r.setup)));

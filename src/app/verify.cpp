@@ -92,8 +92,8 @@ struct TravelCheck {
     }
 };
 
-/// The instrument's readings along one pass on machine k: ΔL of a bar (seed 000 eq. (14); absolute bar: Ball 2 at its
-/// nominal place, seed 002; DBB5, seed 003), or the R-test displacement (seed 001).
+/// The instrument's readings along one pass on machine k: ΔL of a bar ([MultiTasking] eq. (14); absolute bar: Ball 2 at its
+/// nominal place, [FanWuLi]; DBB5, [IbarakiDBB5]), or the R-test displacement ([Moravek2019]).
 void simulatePass(const Kinematics& k, const Kinematics& nominal, const testprog::RunMotion& r, const AxisVector& setup,
                   const AxisVector& nominalSetup, const std::vector<double>& t, const std::vector<AxisVector>& q,
                   BallbarTrace& trace, std::vector<Vec3>& displacement, TravelCheck& travel) {

@@ -1,5 +1,5 @@
 #pragma once
-// Verification through what the user loads (issue 9; DESIGN data flow, step 5): the plan's test programs
+// Verification through what the user loads (DESIGN data flow, step 5): the plan's test programs
 // (postproc/testprog, generated in memory and read back through the post-processor, never recomputed) go through a
 // compensation to a machine, and the simulated instrument readings are analysed exactly like measured ones.
 //   compensation: a deviation set (ideal: what a perfect TCP controller or `cnccomp correct` does with it), the
@@ -8,8 +8,8 @@
 //   machine: the true one (simulation with --truth) or the identified one (the prediction of what the compensation
 //   leaves on the machine that was measured, given what the controller can hold).
 // Per run and pass (CW, CCW): the ΔL trace before and after, ISO 230-4 circular deviation G and radial deviation F
-// (evaluateCircularTest), eccentricity (seed 000 eq. (14), Table 5 convention), ΔL span; R-test runs: the ball
-// displacement (seed 001). The volumetric tool-tip error over the plan's workspace before and after, and the deviations
+// (evaluateCircularTest), eccentricity ([MultiTasking] eq. (14), Table 5 convention), ΔL span; R-test runs: the ball
+// displacement ([Moravek2019]). The volumetric tool-tip error over the plan's workspace before and after, and the deviations
 // the compensation leaves, with the backend's reason. A plain struct, for the terminal, --json and the HTML report.
 #include <memory>
 #include <string>

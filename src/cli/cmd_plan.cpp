@@ -1,4 +1,4 @@
-// cnccomp plan: propose the ball-bar runs that make a list of deviations identifiable (issue 3 test planner).
+// cnccomp plan: propose the ball-bar runs that make a list of deviations identifiable .
 #include <cmath>
 
 #include <fmt/format.h>

@@ -95,7 +95,7 @@ AxisVector runCommands(const MachineModel& m, const BallbarRun& run, double a) {
     const double LB = run.LB, RB = run.RB, RC = run.RC, ZC = run.ZC;
     const double s = std::sin(a), c = std::cos(a);
     double X = 0, Y = 0, Z = 0;
-    switch (run.test) {  // seed 000 Table 2
+    switch (run.test) {  // [MultiTasking] Table 2
         case BallbarTest::BRadial: X = (LB + RB) * s; Z = ZC + (LB + RB) * c; break;
         case BallbarTest::BTangential: {
             const double RBT = std::hypot(RB, LB), psi = std::atan2(LB, RB);

@@ -1,5 +1,5 @@
 #pragma once
-// Double-ball-bar runs of seed 000 (Table 2) and their simulation on an exact machine model (eq. (14)–(16)).
+// Double-ball-bar runs of [MultiTasking] (Table 2) and their simulation on an exact machine model (eq. (14)–(16)).
 #include <functional>
 #include <optional>
 #include <string>
@@ -11,7 +11,7 @@
 
 namespace cnccomp {
 
-/// The twelve measurement types of seed 000 Table 2: B/C axis radial, tangential, axial (cylindrical)
+/// The twelve measurement types of [MultiTasking] Table 2: B/C axis radial, tangential, axial (cylindrical)
 /// and X/Y/Z-direction (Cartesian).
 enum class BallbarTest { BX, BY, BZ, CRadial, CTangential, CAxial, CX, CY, CZ, BRadial, BTangential, BAxial };
 
@@ -26,7 +26,7 @@ std::optional<BallbarTest> parseTest(std::string_view s);
 /// True when the head rotary axis (B) moves; false when the table axis (C) moves.
 bool rotatesHead(BallbarTest t);
 
-/// One ball-bar run: its type, geometry (seed 000 section 4 names) and angular sweep.
+/// One ball-bar run: its type, geometry ([MultiTasking] section 4 names) and angular sweep.
 struct BallbarRun {
     std::string name;
     BallbarTest test = BallbarTest::BX;
@@ -77,7 +77,7 @@ RunPlane runPlane(const MachineModel& m, const BallbarRun& run);
 
 /// Eccentricity (ex, ey, ez) in mm of a trace: centre of the least-squares circle fitted to the polar
 /// trajectory (LB + ΔL) at the sweep angle, in the plane of the rotary axis. The out-of-plane component
-/// is NaN. Sign convention: a trajectory shifted towards +X has ex > 0 (seed 000 Table 5 holds).
+/// is NaN. Sign convention: a trajectory shifted towards +X has ex > 0 ([MultiTasking] Table 5 holds).
 Vec3 traceEccentricity(const MachineModel& m, const BallbarRun& run, const BallbarTrace& trace);
 
 }  // namespace cnccomp

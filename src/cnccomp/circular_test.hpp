@@ -1,7 +1,7 @@
 #pragma once
 // ISO 230-4 evaluation of circular (ball-bar) runs: circular deviation G, radial deviation F (max, min), mean
 // radius and circular hysteresis H, per pass and per run (ISO 230-4:2005, "Test code for machine tools — Part 4:
-// Circular tests for numerically controlled machine tools", seed 003 ref. 4, which reports circularity and mean
+// Circular tests for numerically controlled machine tools", [IbarakiDBB5] ref. 4, which reports circularity and mean
 // radial error per run in its Tables 3 and 4). Definitions as used here (clause numbers of ISO 230-4 [G]):
 //  - radial deviation F: actual − nominal radius about the nominal centre (the centre ball), i.e. ΔL; F max, F min;
 //  - circular deviation G: radial separation of the two concentric circles about the least-squares centre that

@@ -1,7 +1,7 @@
 #pragma once
 // Ball-bar eccentricity formulas (the paper-literal method of `identify --method formulas` on ball-bar plans): the
 // identification of geometric deviations of multi-tasking machine tools with a swivel tool spindle head in a horizontal
-// position by ball-bar measurements (shared/seeds/000, section 5): equations (17)–(28) give the 12 identifiable
+// position by ball-bar measurements ([MultiTasking], section 5): equations (17)–(28) give the 12 identifiable
 // deviations of the w-C'bZYXB(C1)-t machine from the eccentricities of six ball-bar runs
 // (B-X, B-Y, C-axial, C-radial at (ZC, RB), (ZC', RB), (ZC', RB'')). γXY is not identified.
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// Eccentricity table: one row per ball-bar run (the input of the closed-form method of seed 000).
+// Eccentricity table: one row per ball-bar run (the input of the closed-form method of [MultiTasking]).
 #include <limits>
 #include <string>
 #include <vector>

@@ -24,7 +24,7 @@ inline Mat3 rotationVector(const Vec3& w) {
 }
 
 /// Error transform of the six components (dx, dy, dz, a, b, c): translation then exact rotation
-/// about the axis (a, b, c) — the exact counterpart of the papers' small-angle HTMs (seed 000 eq. (2), (3), (8)).
+/// about the axis (a, b, c) — the exact counterpart of the papers' small-angle HTMs ([MultiTasking] eq. (2), (3), (8)).
 inline Pose errorTransform(const Vec6& e) {
     Pose p = Pose::Identity();
     p.linear() = rotationVector(e.tail<3>());

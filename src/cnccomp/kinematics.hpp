@@ -46,7 +46,7 @@ public:
     Pose workpieceToTool(const AxisVector& q) const;
     /// A point fixed in the tool frame (e.g. the tool tip), seen from the workpiece frame.
     Vec3 toolPointInWorkpiece(const AxisVector& q, const Vec3& pointInToolFrame) const;
-    /// Point in the tool frame at distance `length` along the tool direction, plus an offset (seed 000 eq. (15)).
+    /// Point in the tool frame at distance `length` along the tool direction, plus an offset ([MultiTasking] eq. (15)).
     Vec3 toolPoint(double length, const Vec3& offset = Vec3::Zero()) const {
         return machine_->toolDirection * length + offset;
     }

@@ -1,5 +1,5 @@
 #pragma once
-// The identification route of a plan of ball-bar circles of the linear axes (<circle> runs; issue 20): every run's
+// The identification route of a plan of ball-bar circles of the linear axes (<circle> runs): every run's
 // instrument file imported (io/linear_circle_trace.hpp), its passes evaluated after ISO 230-4 (circular_test.hpp:
 // G per pass, F, hysteresis H) and its diagnostics identified on the exact model (linear_circle_model.hpp: value,
 // 95 % interval, share of the circularity, ranked; unidentified ones with their confounded groups), headed by the

@@ -2,7 +2,7 @@
 // Ball-bar circle in a plane of two linear axes (ISO 230-4:2005 circular test on XY, YZ or ZX, any machine, 3-axis
 // included): the forward model of the bar reading ΔL(θ) from a set of diagnostic parameters, and their
 // least-squares identification from one or more passes (CW and CCW), with 95 % intervals, identifiability and each
-// diagnostic's share of the circularity (issue 20).
+// diagnostic's share of the circularity.
 //
 // Plane and angle. The plane has in-plane axes (u, v): XY → (X, Y), YZ → (Y, Z), ZX → (Z, X) (the cyclic order of
 // ISO 841; the same convention as RunPlane in ballbar.hpp). θ is measured from +u towards +v; the commanded tool

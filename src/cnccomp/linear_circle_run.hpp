@@ -1,5 +1,5 @@
 #pragma once
-// A ball-bar circle of two linear axes as a run of a measurement plan (<circle>, io/plan_xml.hpp; issue 20): the
+// A ball-bar circle of two linear axes as a run of a measurement plan (<circle>, io/plan_xml.hpp): the
 // ISO 230-4:2005 circular test in XY, YZ or ZX on any machine, 3-axis included, and its simulation on a machine with
 // deviations. The circle is given in axis commands (the description's frame: the controller's machine coordinates
 // unless the machine sets machine-zero): the commanded linear axes describe
@@ -33,7 +33,7 @@ struct LinearCircleRun {
     double stepDeg = 1;             ///< angular spacing of the samples (simulation; the import's sample count check)
     double toolLength = 0;          ///< tool ball along the tool direction from the last tool frame, mm
     /// Where the pivot ball was set relative to the tool ball at the centre commands, workpiece frame, mm: a set-up
-    /// error (seed 000's work-ball offset for this run). `simulate` puts the pivot there; `identify` estimates its
+    /// error ([MultiTasking]'s work-ball offset for this run). `simulate` puts the pivot there; `identify` estimates its
     /// in-plane part per pass as the centring offset (it is not an input of the identification).
     Vec3 pivotOffset = Vec3::Zero();
     std::vector<std::pair<std::string, double>> hold;  ///< rotary axes held (deg); others at 0

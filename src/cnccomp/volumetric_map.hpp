@@ -2,7 +2,7 @@
 // Volumetric error map: over a grid of axis commands (or of tool-tip positions at a fixed tool orientation),
 // the tool-tip position error (dx, dy, dz) and the tool-orientation error between tool and workpiece of the
 // erroneous machine against the nominal one, both with the exact model (Kinematics, toolPose) — the volumetric
-// counterpart of the papers' single-point error models (seed 000 eq. (7), (10), (15); seed 004 eq. for the tool
+// counterpart of the papers' single-point error models ([MultiTasking] eq. (7), (10), (15); [RotaryTableModel] eq. for the tool
 // pose in the table frame). Computed in parallel (std::thread), no allocation per point.
 #include <array>
 #include <optional>

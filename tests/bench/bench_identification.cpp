@@ -1,5 +1,5 @@
 // Least-squares identification of the 12 seed-000 deviations from the six ball-bar runs of section 5.3, each a
-// 3600-sample trace (0.1° steps), on the exact model (issue 3 benchmark).
+// 3600-sample trace (0.1° steps), on the exact model.
 #include <benchmark/benchmark.h>
 
 #include "cnccomp/identification/lsq.hpp"

@@ -1,7 +1,7 @@
 // Import of a measured ball-bar trace: a file at the plan's step (360 samples) and a densely sampled one (1 kHz class:
 // 1 000 000 samples over the same turn, averaged into the plan's 1° bins), as bytes read a second. Compare the two
 // (`farm-bench --vs`, or the counters of one run): the dense file should read at the same bytes/s as the plan-step
-// file (issue 18: a 38 MB file took 81 s and 1.24 GB in identify; now about 1.7 s and 130 MB end to end).
+// file (a 38 MB file took 81 s and 1.24 GB in identify; now about 1.7 s and 130 MB end to end).
 #include <benchmark/benchmark.h>
 
 #include <cmath>

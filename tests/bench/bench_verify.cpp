@@ -1,4 +1,4 @@
-// `cnccomp verify` of the six-run plan (seed 000, 1° steps: 2 × 2160 samples) through the files of each backend on the
+// `cnccomp verify` of the six-run plan ([MultiTasking], 1° steps: 2 × 2160 samples) through the files of each backend on the
 // multi-tasking machine: test programs generated and read back, the apply model on every command, ΔL, ISO 230-4 figures,
 // and the volumetric grid (5 per axis, two tool lengths: 6250 poses). Target: < 1 s each.
 #include <benchmark/benchmark.h>

@@ -1,5 +1,5 @@
 // The real LinuxCNC 2.9 (Debian 12 linuxcnc-uspace + linuxcnc-uspace-dev, headless simulation) as the oracle of the
-// component route of the LinuxCNC backend (issue 17). Per sample machine: `cnccomp emit --controller linuxcnc` writes
+// component route of the LinuxCNC backend. Per sample machine: `cnccomp emit --controller linuxcnc` writes
 // its files; the generated component is compiled and installed by `halcompile --install` under a name of its own;
 // a sim configuration is built from exactly the files emit wrote (merged as README.txt says); LinuxCNC is driven over
 // MDI through 24 poses in joint mode (G49: the words are the nominal machine's commands) and, after

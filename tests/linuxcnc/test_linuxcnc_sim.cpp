@@ -130,7 +130,7 @@ Figures runOracle(const std::string& machineName, const std::string& deviationNa
     const sim::SimConfig config = sim::buildSimConfig(m, dir.path / "emitted", dir.path / "sim", kTools, kBacklash);
     const std::string letters = model.coordinates();
     std::vector<std::string> job{"mdi G90 G21 G94 G17 G40 G49 G54"};
-    // The emitted G54 program itself, whole, in AUTO (issue 17: a comment line over LinuxCNC's 254 characters aborted
+    // The emitted G54 program itself, whole, in AUTO (a comment line over LinuxCNC's 254 characters aborted
     // it with "Command too long" and G54 stayed 0).
     fs::copy_file(dir.path / "emitted" / "cnccomp-g54.ngc", config.dir / "cnccomp-g54.ngc");
     job.push_back("auto " + (config.dir / "cnccomp-g54.ngc").string());

@@ -1,8 +1,8 @@
 #pragma once
-// The eccentricity of a ball-bar run as an observation (the quantity seed 000 section 4 works with): the in-plane
+// The eccentricity of a ball-bar run as an observation (the quantity [MultiTasking] section 4 works with): the in-plane
 // centre (u, v components, RunPlane) of the least-squares circle fitted to the trace, predicted by simulating the
 // run on the current machine and fitting the same circle. Least squares on eccentricities generalises the
-// closed-form formulas (17)–(28) to any set of runs, and lets the planner reproduce seed 000's reasoning
+// closed-form formulas (17)–(28) to any set of runs, and lets the planner reproduce [MultiTasking]'s reasoning
 // (e.g. γXY moves only the eccentricity of the C-axis Y-direction run, Table 3).
 // Weight √(N/2): the centre of a circle fitted to N samples of noise σ has a standard deviation σ·√(2/N), so the
 // residuals are in units of ΔL noise like those of BallbarObservation. No analytic Jacobian (finite differences).

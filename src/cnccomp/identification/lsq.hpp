@@ -1,5 +1,5 @@
 #pragma once
-// General least-squares identification (issue 3): any subset of a machine's deviations (location errors,
+// General least-squares identification: any subset of a machine's deviations (location errors,
 // squareness, spindle offsets, component-error coefficients) from any observations (ball-bar ΔL samples,
 // R-test displacements, …) on the exact kinematic model, with the runs' nuisance parameters.
 // Levenberg–Marquardt by default, NLopt as an alternative for bounded problems; the result carries a report

@@ -1,5 +1,5 @@
 #pragma once
-// Observation models for the general least-squares identification (issue 3).
+// Observation models for the general least-squares identification.
 //
 // HOW ANOTHER OBSERVATION KIND PLUGS IN (R-test ball displacements, DBB5 circles, probe points, ...):
 //   1. Derive from ObservationModel, one object per measured run. Keep the measured values (internal units,
@@ -120,7 +120,7 @@ public:
 
 using Observations = std::vector<std::unique_ptr<ObservationModel>>;
 
-/// Raw ΔL samples of one ball-bar run (seed 000 eq. (14)–(16)), predicted exactly as simulateRun() does:
+/// Raw ΔL samples of one ball-bar run ([MultiTasking] eq. (14)–(16)), predicted exactly as simulateRun() does:
 /// the W-side ball set where the T-side ball is at the setup commands, then ΔL at every sample angle.
 /// Nuisance parameters: the tool-ball offset (xT yT zT, eq. (15)) when run.estimateToolBallOffset, the
 /// work-ball offset (xW yW zW, eq. (16)) when run.estimateWorkBallOffset.

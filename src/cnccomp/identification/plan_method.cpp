@@ -43,7 +43,7 @@ const char* planMethodFormulas(PlanMethod m) {
     switch (m) {
         case PlanMethod::Ballbar:
             return "eccentricity formulas (17)-(28) of the ball-bar identification of geometric deviations of "
-                   "multi-tasking machine tools with a swivel tool spindle head (shared/seeds/000)";
+                   "multi-tasking machine tools with a swivel tool spindle head ([MultiTasking])";
         case PlanMethod::HeadPatterns:
             return "eq. (7), (9), (16), (21) of Fan, Wu & Li, 'A novel geometric error identification methodology for "
                    "the tilting head of five-axis machine tools based on double ball bar'";

@@ -1,7 +1,7 @@
 #pragma once
 // Every run of a measurement plan as observations for the least-squares engine, reading DIR/<run>.csv for each:
-// ball-bar runs (BallbarObservation), absolute ball-bar runs (seed 002), R-test runs (seed 001/004) and DBB5
-// runs (seed 003).
+// ball-bar runs (BallbarObservation), absolute ball-bar runs ([FanWuLi]), R-test runs ([Moravek2019] / [RotaryTableModel]) and DBB5
+// runs ([IbarakiDBB5]).
 #include <string>
 
 #include "cnccomp/identification/observation.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Test planner (issue 3): proposes a small set of ball-bar runs, chosen from candidate run types (seed 000
+// Test planner: proposes a small set of ball-bar runs, chosen from candidate run types ([MultiTasking]
 // Table 2) × geometries, that makes a list of deviations identifiable by the least-squares engine with a good
 // condition number, and explains which deviation needs which run.
 //
@@ -24,7 +24,7 @@ struct PlannerOptions {
     double planStepDeg = 1.0;           ///< angle step written into the plan
     std::string mounting = "none";      ///< estimate-mounting of every run: none, tool, work, both
     /// What identification will use: "traces" (raw ΔL samples, BallbarObservation) or "eccentricity" (circle
-    /// centres only, as seed 000's closed form; EccentricityObservation).
+    /// centres only, as [MultiTasking]'s closed form; EccentricityObservation).
     std::string observe = "traces";
     int maxRuns = 10;
     double targetCondition = 300.0;     ///< of the scaled Jacobian (µm, arcsec)
@@ -50,7 +50,7 @@ struct ExtraAdvice {
     std::vector<std::string> needs;    ///< when identified: runs it needs
     double sigmaPerUm = 0;             ///< when identified
     /// Candidate run types whose measurement it changes at all (≥ 5 % of the most sensitive candidate), e.g. only
-    /// "C-Y" for γXY seen through eccentricities (seed 000 Table 3).
+    /// "C-Y" for γXY seen through eccentricities ([MultiTasking] Table 3).
     std::vector<std::string> seenByTypes;
     /// Candidate runs that, added to the plan, identify it along with the request; best (smallest σ) first.
     std::vector<std::string> extraRuns;

@@ -1,6 +1,6 @@
 #pragma once
 // Per-angle R-test tables ("A simple modeling method to identify the kinematic errors of machine tool rotary table",
-// Zhejiang University, shared/seeds/004): the six kinematic errors of each rotary axis of a cradle (A tilting table carrying a
+// Zhejiang University, [RotaryTableModel]): the six kinematic errors of each rotary axis of a cradle (A tilting table carrying a
 // C rotary table) as functions of its angle — three linear shifts δ(θ) and three angular errors ξ(θ) of the axis'
 // rotating frame — and the small-angle model of the workpiece point, eq. (1)–(7):
 //   ᶜW = ᶜδ(γ) + R(ᶜξ(γ))·W_N (1),   ᴬW = ᴬδ(α) + R(ᴬξ(α))·(Rot_C(γ)·ᶜW) (4),   W_F = Rot_A(α)·ᴬW,

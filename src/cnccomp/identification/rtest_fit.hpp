@@ -1,5 +1,5 @@
 #pragma once
-// Least-squares fits used to read geometric errors off R-test trajectories (seed 001 section 2.2, after
+// Least-squares fits used to read geometric errors off R-test trajectories ([Moravek2019] section 2.2, after
 // Gander, Golub & Strebel 1994, "Least-squares fitting of circles and ellipses"): planes (the "straight line in
 // two planes perpendicular to the plane of interpolation", fitted jointly), circles in 3D, and ellipses —
 // algebraic conic fit with ‖u‖ = 1, geometric fit in the parametric form x = z + Q(α)(a cos φ, b sin φ) by
@@ -48,7 +48,7 @@ EllipseFit fitEllipse(const std::vector<Eigen::Vector2d>& points);
 /// ellipses, such as a circle seen edge-on.
 EllipseFit fitEllipsePhases(const std::vector<Eigen::Vector2d>& points, const std::vector<double>& phases);
 
-/// Diameter of the ellipse along the direction at `angle` (rad), through its centre (the D45 / D135 of seed 001 eq. (2)).
+/// Diameter of the ellipse along the direction at `angle` (rad), through its centre (the D45 / D135 of [Moravek2019] eq. (2)).
 double ellipseDiameter(const EllipseFit& e, double angle);
 
 /// Distance from a point to an ellipse and the phase of the closest point (Newton on the phase).

@@ -24,7 +24,7 @@
 // measurement — as the paper eliminates known errors with its kinematic model (section 3.1); refine = 0 gives the
 // plain formulas.
 // Source: M. Morávek, O. Hořejš, P. Bach, "Set of geometric errors evaluation based on R-test measurement",
-// MM Science Journal 2019 (DOI 10.17973/MMSJ.2019_03_2018106), shared/seeds/001: section 2.2, eq. (2), section 3.2.
+// MM Science Journal 2019 (DOI 10.17973/MMSJ.2019_03_2018106), [Moravek2019]: section 2.2, eq. (2), section 3.2.
 // Names: ISO 230-1 (iso_names.hpp); the fits produce link values, the squareness readings C of eq. (2) are the
 // aliases CXY, CZX, CYZ of the sample machine (90° minus the angle between the positive directions).
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// Commands and simulation of an R-test run (seed 001 section 3); the run itself is measurement/rtest_run.hpp.
+// Commands and simulation of an R-test run ([Moravek2019] section 3); the run itself is measurement/rtest_run.hpp.
 #include <vector>
 
 #include "cnccomp/kinematics.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 // Tilting-head errors from head patterns (J. Fan, C. Wu, Z. Li, "A novel geometric error identification methodology
-// for the tilting head of five-axis machine tools based on double ball bar", shared/seeds/002): geometric errors of a tilting head B from a double ball bar in Y, X and Z patterns,
+// for the tilting head of five-axis machine tools based on double ball bar", [FanWuLi]): geometric errors of a tilting head B from a double ball bar in Y, X and Z patterns,
 // each with two tool lengths L1 < L2. The spindle turns about Ball 1 while X/Y/Z keep Ball 1 still; Ball 2 sits at
 // its nominal position O and Δd is the length change from the nominal bar length (absolute bar, section 3.1).
 // The patterns are the seed-000 runs B-Y, B-X, B-Z (RB = L, LB = d) simulated with Ball 2 at O.

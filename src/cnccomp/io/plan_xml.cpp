@@ -188,7 +188,7 @@ BallbarRun readBallbarRun(const XMLElement& e, const std::string& path, bool abs
     r.tableAxis = xml::textOr(e, "table-axis", "C");
     readCapture(e, path, instrument, r.capture);
     if (absolute && r.capture.relativeLength)
-        xml::fail(e, path, "an absolute run measures the absolute length (seed 002); its instrument cannot be length=\"relative\"");
+        xml::fail(e, path, "an absolute run measures the absolute length ([FanWuLi]); its instrument cannot be length=\"relative\"");
     try {
         r.validate();
     } catch (const ModelError& ex) {

@@ -1,9 +1,9 @@
 #pragma once
 // Measurement plans: <plan machine="..."> with one element per run. Run names are unique across all kinds (each
 // run's data is DIR/<name>.csv).
-//  <run>          ball-bar run of seed 000 Table 2 (W-side ball set on the T-side ball at the setup commands);
-//  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute (seed 002);
-//  <rtest>        R-test run (seed 001/004): ball on the table, nest on the spindle, rotary sweeps;
+//  <run>          ball-bar run of [MultiTasking] Table 2 (W-side ball set on the T-side ball at the setup commands);
+//  <absolute-run> the same attributes, but Ball 2 sits at its nominal position and ΔL is absolute ([FanWuLi]);
+//  <rtest>        R-test run ([Moravek2019] / [RotaryTableModel]): ball on the table, nest on the spindle, rotary sweeps;
 //  <dbb5>         DBB5 run (ball bar held at 45°): linear circle in a plane, rotary-axis circle, or cone frustum.
 //  <circle>       ball-bar circle of two linear axes (ISO 230-4), any machine (linear_circle_run.hpp).
 #include <string>

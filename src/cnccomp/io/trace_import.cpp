@@ -156,7 +156,7 @@ void sampleAt(const std::vector<double>& angle, const std::vector<double>& value
 }  // namespace
 
 double linearPathRadius(const BallbarRun& r) {
-    switch (r.test) {  // seed 000 Table 2, the (X, Y, Z) circle of runCommands()
+    switch (r.test) {  // [MultiTasking] Table 2, the (X, Y, Z) circle of runCommands()
         case BallbarTest::BRadial: return r.LB + r.RB;
         case BallbarTest::BTangential: return std::hypot(r.RB, r.LB);
         case BallbarTest::CRadial: return std::abs(r.RC - r.LB);
@@ -374,7 +374,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         const double t0 = ps.rows.front().x;
         // The feed from the data: a pass runs the sweep and both overshoot arcs, from its first to its last sample.
         // A plan feed 1 % off the real one turns into a stretched angle scale that moves the pattern between the CW
-        // and CCW passes (issue 18: EC0Y off by 1.8″ on the multi-tasking sample, 0.9″ at 0.5 %); refused beyond 0.1 %
+        // and CCW passes (EC0Y off by 1.8″ on the multi-tasking sample, 0.9″ at 0.5 %); refused beyond 0.1 %
         // plus one sample period of the pass's duration (where the first and last samples may fall) [G].
         if (ps.rows.size() >= 3) {
             const double duration = ps.rows.back().x - t0;

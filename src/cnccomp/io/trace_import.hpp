@@ -45,7 +45,7 @@ struct MeasuredTrace {
     TraceImportSummary summary;
 };
 
-/// Radius of the circle the linear axes describe in the run's commands (seed 000 Table 2): the path the
+/// Radius of the circle the linear axes describe in the run's commands ([MultiTasking] Table 2): the path the
 /// programmed feed F is measured on (G94). B-radial LB+RB, B-tangential √(RB²+LB²), C-radial |RC−LB|,
 /// C-tangential √(RC²+LB²), B-axial and B-X/Y/Z RB, C-axial and C-X/Y/Z RC.
 double linearPathRadius(const BallbarRun& run);

@@ -1,5 +1,5 @@
 #pragma once
-// R-test runs (seed 001 section 3): a precision ball fixed on the table, a sensor nest on the spindle that
+// R-test runs ([Moravek2019] section 3): a precision ball fixed on the table, a sensor nest on the spindle that
 // measures the 3D displacement of the ball centre while the rotary axes move and the linear axes keep the nest
 // on the ball (on the nominal machine). XYC, YZA and XYZAC trajectories are sweeps of the rotary axes.
 // The run as planned (a measurement); its commands and simulation are identification/rtest_run.hpp.
