@@ -1,6 +1,8 @@
 // cnccomp laser: the ISO 230-2 evaluation of a laser interferometer's bidirectional positioning runs of one linear
 // axis (io/laser_csv.hpp for the file layout), printed as a table, optionally as JSON and as a LinuxCNC pitch-error
-// table (controllers/linuxcnc/laser_comp.hpp for its sign and INI lines). All files are written together or not at all.
+// table (controllers/linuxcnc/laser_comp.hpp for its sign and INI lines), and with --machine as the axis' positioning
+// component error in a deviation set (cnccomp/laser_deviation.hpp), merged into an existing set with --merge. All files
+// are written together or not at all.
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,9 +11,12 @@
 
 #include "cli/command.hpp"
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/laser_csv.hpp"
 #include "cnccomp/io/laser_report.hpp"
+#include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/output_set.hpp"
+#include "cnccomp/laser_deviation.hpp"
 #include "cnccomp/laser_positioning.hpp"
 #include "controllers/linuxcnc/laser_comp.hpp"
 
@@ -19,7 +24,7 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string file, json, compOut;
+    std::string file, json, compOut, machine, deviationsOut, merge;
     int joint = -1;
     LaserCsvOptions csv;
 };
@@ -27,11 +32,29 @@ struct Options {
 void run(const Options& o) {
     if (!o.compOut.empty() && o.joint < 0)
         throw InputError("", 0, "--comp-out needs --joint N (the [JOINT_N] section the table belongs to)");
+    if (!o.deviationsOut.empty() && o.machine.empty())
+        throw InputError("", 0, "--deviations-out needs --machine M.xml (the machine whose positioning component it sets)");
+    if (!o.merge.empty() && o.deviationsOut.empty()) throw InputError("", 0, "--merge needs --deviations-out");
     const LaserCsvFile in = readLaserCsv(o.file, o.csv);
     const LaserPositioningResult r = evaluateLaserPositioning(in.runs);
     fmt::print("{}", formatLaserTable(r, in.environmentStated));
 
-    OutputSet out({o.file});
+    OutputSet out({o.file, o.machine, o.merge});
+    std::string deviationNote;
+    if (!o.deviationsOut.empty()) {
+        const MachineModel m = readMachineXml(o.machine);
+        DeviationSet laser(m);
+        const LaserComponentResult c = setPositioningComponent(laser, r, o.file);
+        const DeviationSet set = o.merge.empty() ? laser : mergeDeviations(readDeviationCsv(o.merge, m), laser);
+        out.add(o.deviationsOut, formatDeviationCsv(set));
+        deviationNote = fmt::format(
+            "deviation set: {} = the mean bidirectional deviation (sign from the machine's kinematics: {:+.0f}), largest "
+            "residual at the targets {:.3f} um{}{}; the reversal (B = {:.3f} um, mean {:.3f} um) depends on the approach "
+            "direction and is not in the set (it goes to the controllers' backlash / two-column tables)\n",
+            c.component, c.sensitivity, c.largestResidualUm,
+            c.nodesOutside ? fmt::format(", {} table node(s) outside the targets hold the end targets' value", c.nodesOutside) : "",
+            o.merge.empty() ? "" : fmt::format(", merged into {}", o.merge), c.reversalUm, c.meanReversalUm);
+    }
     std::string ini;
     if (!o.json.empty()) out.add(o.json, formatLaserJson(r, in.environmentStated, o.file));
     if (!o.compOut.empty()) {
@@ -44,6 +67,7 @@ void run(const Options& o) {
     const std::vector<std::string> written = out.targets();  // commit() empties the set
     out.commit();
     for (const std::string& t : written) fmt::print("wrote {}\n", t);
+    fmt::print("{}", deviationNote);
     if (!ini.empty()) fmt::print("add to the INI file:\n{}", ini);
 }
 
@@ -64,6 +88,11 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--json", o->json, "write the figures as JSON");
     c->add_option("--comp-out", o->compOut, "folder for the LinuxCNC table <axis>.comp (COMP_FILE_TYPE 1)");
     c->add_option("--joint", o->joint, "LinuxCNC joint number of the axis (with --comp-out)")->check(CLI::NonNegativeNumber);
+    c->add_option("--machine", o->machine, "machine description XML (with --deviations-out)")->check(CLI::ExistingFile);
+    c->add_option("--deviations-out", o->deviationsOut,
+                  "deviation CSV with the axis' positioning component E<axis><axis> (the mean bidirectional deviation)");
+    c->add_option("--merge", o->merge, "deviation CSV to merge into (its other deviations kept; with --deviations-out)")
+        ->check(CLI::ExistingFile);
     c->callback([o] { run(*o); });
 });
 
