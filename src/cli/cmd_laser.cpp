@@ -18,20 +18,29 @@
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/laser_deviation.hpp"
 #include "cnccomp/laser_positioning.hpp"
+#include "controllers/fanuc/laser_pitch.hpp"
+#include "controllers/heidenhain/laser_com.hpp"
+#include "controllers/isg/laser_lsec.hpp"
 #include "controllers/linuxcnc/laser_comp.hpp"
+#include "controllers/siemens/laser_eec.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string file, json, compOut, machine, deviationsOut, merge;
-    int joint = -1;
+    std::string file, json, compOut, machine, deviationsOut, merge, controller = "linuxcnc", referenceDirection = "+";
+    int joint = -1, axisNumber = 0;
     LaserCsvOptions csv;
 };
 
 void run(const Options& o) {
-    if (!o.compOut.empty() && o.joint < 0)
+    const bool linuxcnc = o.controller == "linuxcnc";
+    if (!o.compOut.empty() && linuxcnc && o.joint < 0)
         throw InputError("", 0, "--comp-out needs --joint N (the [JOINT_N] section the table belongs to)");
+    if (!o.compOut.empty() && (o.controller == "fanuc-30i" || o.controller == "siemens-840d" || o.controller == "isg") &&
+        o.axisNumber < 1)
+        throw InputError("", 0, fmt::format("--controller {} needs --axis-number N (the control's number of the axis)", o.controller));
+    const bool referenceForward = o.referenceDirection == "+";
     if (!o.deviationsOut.empty() && o.machine.empty())
         throw InputError("", 0, "--deviations-out needs --machine M.xml (the machine whose positioning component it sets)");
     if (!o.merge.empty() && o.deviationsOut.empty()) throw InputError("", 0, "--merge needs --deviations-out");
@@ -58,11 +67,27 @@ void run(const Options& o) {
     std::string ini;
     if (!o.json.empty()) out.add(o.json, formatLaserJson(r, in.environmentStated, o.file));
     if (!o.compOut.empty()) {
-        namespace lc = controllers::linuxcnc;
-        const std::string name = r.axis + ".comp";
         out.makeFolder(o.compOut);
-        out.add(OutputSet::fileIn(o.compOut, name, o.file), lc::formatCompTable(lc::compTableFromLaser(r), name));
-        ini = lc::laserCompIniLines(r, o.joint, name);
+        const auto add = [&](const std::string& name, const std::string& text) {
+            out.add(OutputSet::fileIn(o.compOut, name, o.file), text);
+        };
+        if (linuxcnc) {
+            namespace lc = controllers::linuxcnc;
+            const std::string name = r.axis + ".comp";
+            add(name, lc::formatCompTable(lc::compTableFromLaser(r), name));
+            ini = lc::laserCompIniLines(r, o.joint, name);
+        } else if (o.controller == "fanuc-30i") {
+            add("CNCCOMP_LASER_" + r.axis + ".PRM", controllers::fanuc::fanucLaserPitch(r, o.axisNumber, referenceForward).file);
+        } else if (o.controller == "siemens-840d") {
+            const auto e = controllers::siemens::siemensLaserEec(r, fmt::format("AX{}", o.axisNumber), referenceForward);
+            add("AX_EEC.INI", e.eec);
+            add("AX_LASER_MD.INI", e.machineData);
+        } else if (o.controller == "heidenhain-tnc") {
+            const auto c = controllers::heidenhain::heidenhainLaserCom(r, referenceForward);
+            add(c.name, c.text);
+        } else {
+            add("LSEC_" + r.axis + ".LIS", controllers::isg::isgLaserLsec(r, o.axisNumber, r.axis));
+        }
     }
     const std::vector<std::string> written = out.targets();  // commit() empties the set
     out.commit();
@@ -88,6 +113,18 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--json", o->json, "write the figures as JSON");
     c->add_option("--comp-out", o->compOut, "folder for the LinuxCNC table <axis>.comp (COMP_FILE_TYPE 1)");
     c->add_option("--joint", o->joint, "LinuxCNC joint number of the axis (with --comp-out)")->check(CLI::NonNegativeNumber);
+    c->add_option("--controller", o->controller,
+                  "controller of the --comp-out files: linuxcnc (COMP_FILE), fanuc-30i (3620-3624 + data, 1851/1852), "
+                  "siemens-840d (EEC + MD32450/32700), heidenhain-tnc (.COM + MP710), isg (bilateral LSEC list)")
+        ->check(CLI::IsMember({"linuxcnc", "fanuc-30i", "siemens-840d", "heidenhain-tnc", "isg"}))
+        ->capture_default_str();
+    c->add_option("--axis-number", o->axisNumber, "the control's number of the axis (fanuc-30i A word, siemens-840d AXn, isg kopf.achs_nr)")
+        ->check(CLI::PositiveNumber);
+    c->add_option("--reference-direction", o->referenceDirection,
+                  "direction of the axis' reference point approach (+ or -): the one-table controllers take that "
+                  "direction's error and add the backlash in the other")
+        ->check(CLI::IsMember({"+", "-"}))
+        ->capture_default_str();
     c->add_option("--machine", o->machine, "machine description XML (with --deviations-out)")->check(CLI::ExistingFile);
     c->add_option("--deviations-out", o->deviationsOut,
                   "deviation CSV with the axis' positioning component E<axis><axis> (the mean bidirectional deviation)");
