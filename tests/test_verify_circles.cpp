@@ -105,5 +105,24 @@ TEST(VerifyCircles, TheCliImprovesWithTheIdentifiedSetAndFlagsAWrongSign) {
     EXPECT_NE(bad.out.find("COMPENSATION MAKES THE MACHINE WORSE"), std::string::npos) << bad.out;
 }
 
+// The knee mill with table-moving X and Y (the pivot rides on the table): its squareness, identified from its own circles
+// and compensated, leaves only the programs' rounding (its truth is squareness alone).
+TEST(VerifyCircles, TheKneeMillsCirclesCloseWithItsIdentifiedSquareness) {
+    const MachineModel m = readMachineXml(src("samples/machines/mill-3axis-table-xy.xml"));
+    const MeasurementPlan plan = readPlanXml(src("samples/plans/mill-3axis-table-xy-circles.xml"));
+    const DeviationSet truth = readDeviationCsv(src("samples/deviations/mill-3axis-table-xy-truth.csv"), m);
+    VerifyCompensation comp;
+    comp.kind = VerifyCompensation::Kind::Deviations;
+    comp.model = idealCompensation(m, truth);
+    comp.description = "truth";
+    VerifyOptions o;
+    o.volumetricPerAxis = 2;
+    const VerifyResult r = verify(m, plan, truth, "truth", comp, o);
+    EXPECT_GT(r.residualBefore, 1.0 * kUm);
+    EXPECT_LT(r.residual, 0.01 * kUm);
+    for (const VerifyRun& run : r.runs)
+        for (const VerifyPass& p : run.passes) EXPECT_LT(p.isoAfter.circularity, 0.01 * kUm) << run.name << " " << p.label;
+}
+
 }  // namespace
 }  // namespace cnccomp
