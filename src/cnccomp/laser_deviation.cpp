@@ -73,7 +73,7 @@ LaserComponentResult setPositioningComponent(DeviationSet& set, const LaserPosit
     }
 
     // Sensitivity: the reading per unit value of the component, at the target farthest from 0 (a polynomial vanishes
-    // at 0), with a unit component (table: every node 1 mm; polynomial: e(q) = q).
+    // at 0), with a unit component (table: 1 µm at every node; polynomial: 1 µm per mm).
     const int n = d.size();
     const size_t far = static_cast<size_t>(std::max_element(q.begin(), q.end(), [](double a, double b) {
                                                 return std::abs(a) < std::abs(b);
