@@ -4,6 +4,7 @@
 // bilateral SSFK": setpoint 19866.7 µm, actual 19856.5 µm (+) and 19874.7 µm (−) → −102 and 80 × 0.1 µm).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -12,13 +13,17 @@
 
 #include "cnccomp/io/laser_csv.hpp"
 #include "cnccomp/laser_positioning.hpp"
+#include "cnccomp/io/machine_xml.hpp"
+#include "controllers/backend.hpp"
 #include "controllers/common/laser_axis.hpp"
 #include "controllers/fanuc/laser_pitch.hpp"
 #include "controllers/fanuc/parameter_file.hpp"
 #include "controllers/heidenhain/laser_com.hpp"
 #include "controllers/heidenhain/tnc_table.hpp"
 #include "controllers/isg/laser_lsec.hpp"
+#include "controllers/siemens/compensation_tables.hpp"
 #include "controllers/siemens/laser_eec.hpp"
+#include "laser_test_machines.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
@@ -77,16 +82,97 @@ TEST(LaserControllers, SiemensEecHoldsTheErrorAndBacklashTheMeanLostMotion) {
     EXPECT_NE(e.eec.find("POSCTRL_GAIN"), std::string::npos);
 }
 
-// HEIDENHAIN: X.COM, AXISPOS at the targets, EXX = the error (mm) of the reference direction; MP710 named with β.
+// HEIDENHAIN: X.COM, AXISPOS at the targets, the column of the axis' positioning component with the emit's sign
+// (a gantry's X on the tool side: C1 = −error); MP710 named with β.
 TEST(LaserControllers, HeidenhainComTableHoldsTheErrorAtTheTargets) {
-    const auto c = controllers::heidenhain::heidenhainLaserCom(sample());
-    const auto t = controllers::heidenhain::parseTncTable(c.name, c.text, {"NR", "AXISPOS", "EXX"});
+    const auto c = controllers::heidenhain::heidenhainLaserCom(sample(), 1, -1.0);
+    const auto t = controllers::heidenhain::parseTncTable(c.name, c.text, {"NR", "AXISPOS", "C1"});
     ASSERT_EQ(t.rows.size(), 11u);
     EXPECT_EQ(t.cell(5, t.column("AXISPOS")), "251.200000");
-    EXPECT_NEAR(std::stod(t.cell(5, t.column("EXX"))), kUp251 * 1e-3, 1e-10);
-    EXPECT_NEAR(std::stod(t.cell(0, t.column("EXX"))), kUp0 * 1e-3, 1e-10);
+    EXPECT_NEAR(std::stod(t.cell(5, t.column("C1"))), -kUp251 * 1e-3, 1e-12);
+    EXPECT_NEAR(std::stod(t.cell(0, t.column("C1"))), -kUp0 * 1e-3, 1e-12);
     EXPECT_NE(c.text.find(fmt::format("MP710 (backlash compensation, mm) of axis X to {:.6f}", -kMeanReversal * 1e-3)),
               std::string::npos) << c.text;
+}
+
+// HEIDENHAIN through the CLI agrees with `emit --controller heidenhain-tnc` (kinematics_table.cpp) on the same error:
+// a deviation set whose EXX holds the laser's x̄↑ at its targets (EXX = x̄↑ / s, s = the reading per unit of EXX: +1 on
+// the gantry) emits the same X.COM column at the same positions (oracle: the emit route's own convention; a sign or
+// column that differed would make the two files compensate in opposite directions). The knee mill (table X moving −X
+// in the bed frame) is refused by the emit route ("a TNC MachAxis X moves along +X"); its laser table is checked by
+// hand: EXX = x̄↑ / (−1) on the table side, written as is: C1 = −x̄↑, the same correction as the gantry's.
+TEST(LaserControllers, HeidenhainComAgreesWithTheEmitRouteOnGantryAndKneeMill) {
+    const test::ScratchDir dir("laser-heidenhain");
+    const std::string laserFile = test::sourcePath("samples/laser/mill-3axis-x.csv");
+    const LaserPositioningResult r = evaluateLaserPositioning(readLaserCsv(laserFile).runs);
+    for (const auto& [xml, s] : {std::pair{test::gantryXml(), 1.0}, std::pair{test::kneeXml(), -1.0}}) {
+        const std::string machineFile = dir.file(s > 0 ? "gantry.xml" : "knee.xml");
+        test::writeText(machineFile, xml);
+        const std::string out = dir.file(s > 0 ? "gantry" : "knee");
+        const test::CliResult cli = test::runCli(fmt::format("laser --file '{}' --controller heidenhain-tnc --machine '{}' --comp-out '{}'",
+                                                             laserFile, machineFile, out));
+        ASSERT_EQ(cli.exitCode, 0) << cli.out;
+        const auto got = controllers::heidenhain::parseTncTable("laser X.COM", test::readText(out + "/X.COM"), {"NR", "AXISPOS", "C1"});
+        EXPECT_NEAR(std::stod(got.cell(0, got.column("C1"))), -r.targets[0].meanForward * 1e-3, 1e-9);
+        EXPECT_NEAR(std::stod(got.cell(8, got.column("C1"))), -r.targets[8].meanForward * 1e-3, 1e-9);
+        if (s < 0) continue;
+        const MachineModel m = readMachineXml(machineFile);
+        DeviationSet d(m);
+        const int exx = m.deviationIndex("EXX");
+        for (size_t k = 0; k < r.targets.size(); ++k) d.values[m.deviations[static_cast<size_t>(exx)].offset + static_cast<int>(k)] =
+                                                          r.targets[k].meanForward * 1e-3 / s;
+        d.present[static_cast<size_t>(exx)] = 1;
+        const controllers::EmitResult e = controllers::backend("heidenhain-tnc").emit({m, d, "laser", "2026-11-26"});
+        const auto com = std::find_if(e.files.begin(), e.files.end(), [](const controllers::OutputFile& f) { return f.name == "X.COM"; });
+        ASSERT_NE(com, e.files.end());
+        const auto want = controllers::heidenhain::parseTncTable("emit X.COM", com->content, {"NR", "AXISPOS", "C1"});
+        ASSERT_EQ(got.rows.size(), want.rows.size());
+        for (size_t i = 0; i < want.rows.size(); ++i) {
+            EXPECT_NEAR(std::stod(got.cell(i, got.column("AXISPOS"))), std::stod(want.cell(i, want.column("AXISPOS"))), 1e-9);
+            EXPECT_NEAR(std::stod(got.cell(i, got.column("C1"))), std::stod(want.cell(i, want.column("C1"))), 1e-9) << i;
+        }
+    }
+}
+
+// Fanuc and Sinumerik through the CLI agree with their emit routes (fanuc-30i pitch tables, siemens-840d EEC) on the same
+// error: the gantry with EXX = x̄↑ at the laser's targets; both files read back by the backends' own readers and compared
+// at the targets −400, 0, 400 mm, points of both grids (oracle: the emit route's convention, see above).
+TEST(LaserControllers, FanucAndSiemensAgreeWithTheirEmitRoutes) {
+    const test::ScratchDir dir("laser-fanuc-siemens");
+    const std::string laserFile = test::sourcePath("samples/laser/mill-3axis-x.csv");
+    const LaserPositioningResult r = evaluateLaserPositioning(readLaserCsv(laserFile).runs);
+    const std::string machineFile = dir.file("gantry.xml");
+    test::writeText(machineFile, test::gantryXml());
+    const MachineModel m = readMachineXml(machineFile);
+    DeviationSet d(m);
+    const int exx = m.deviationIndex("EXX");
+    for (size_t k = 0; k < r.targets.size(); ++k)
+        d.values[m.deviations[static_cast<size_t>(exx)].offset + static_cast<int>(k)] = r.targets[k].meanForward * 1e-3;
+    d.present[static_cast<size_t>(exx)] = 1;
+    const auto fileOf = [](const controllers::EmitResult& e, const std::string& name) {
+        const auto it = std::find_if(e.files.begin(), e.files.end(), [&](const controllers::OutputFile& f) { return f.name == name; });
+        return it == e.files.end() ? std::string() : it->content;
+    };
+    for (const char* controller : {"fanuc-30i", "siemens-840d"}) {
+        const test::CliResult cli = test::runCli(fmt::format("laser --file '{}' --controller {} --axis-number 1 --comp-out '{}'",
+                                                             laserFile, controller, dir.file(controller)));
+        ASSERT_EQ(cli.exitCode, 0) << cli.out;
+    }
+    const controllers::EmitResult fe = controllers::backend("fanuc-30i").emit({m, d, "laser", "2026-11-26"});
+    const auto fEmit = controllers::fanuc::pitchFromFile(m, controllers::fanuc::parseParameterFile("emit", fileOf(fe, "CNCCOMP.PRM")));
+    const auto fLaser = controllers::fanuc::pitchFromFile(
+        m, controllers::fanuc::parseParameterFile("laser", test::readText(dir.file("fanuc-30i/CNCCOMP_LASER_X.PRM"))));
+    ASSERT_EQ(fEmit.size(), 1u);
+    ASSERT_EQ(fLaser.size(), 1u);
+    const controllers::siemens::EecTable sEmit =
+        controllers::siemens::parseEec(m, "emit", fileOf(controllers::backend("siemens-840d").emit({m, d, "laser", "2026-11-26"}), "AX_EEC.INI")).at(0);
+    const controllers::siemens::EecTable sLaser =
+        controllers::siemens::parseEec(m, "laser", test::readText(dir.file("siemens-840d/AX_EEC.INI"))).at(0);
+    for (double P : {-400.0, 0.0, 400.0}) {
+        EXPECT_NEAR(fLaser[0].correction(P, 1e-4), fEmit[0].correction(P, 1e-4), 1.0e-4) << P;  // whole units, each rounded
+        EXPECT_NEAR(sLaser.table.at(P), sEmit.table.at(P), 1e-6) << P;
+        EXPECT_NEAR(sLaser.table.at(P), r.errorAt(P, true) * 1e-3, 1e-6) << P;
+    }
 }
 
 // ISG: bilateral: .pos = x̄↑, .neg = x̄↓ in 0.1 µm at the targets (0.1 µm setpoints); the vendor's own example row.
@@ -117,7 +203,7 @@ TEST(LaserControllers, IsgBilateralListFollowsTheVendorExample) {
 TEST(LaserControllers, CliWritesEachControllersFilesAndRefusesAMissingAxisNumber) {
     const test::ScratchDir dir("laser-controllers");
     for (const auto& [controller, file] : {std::pair{"fanuc-30i", "CNCCOMP_LASER_X.PRM"}, std::pair{"siemens-840d", "AX_EEC.INI"},
-                                           std::pair{"heidenhain-tnc", "X.COM"}, std::pair{"isg", "LSEC_X.LIS"}}) {
+                                           std::pair{"isg", "LSEC_X.LIS"}}) {
         const std::string out = dir.file(controller);
         const test::CliResult r = test::runCli(fmt::format("laser --file '{}' --controller {} --axis-number 1 --comp-out '{}'",
                                                            kSample, controller, out));

@@ -19,52 +19,15 @@
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/laser_deviation.hpp"
 #include "cnccomp/laser_positioning.hpp"
+#include "laser_test_machines.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
 namespace {
 
 const std::string kLaser = test::sourcePath("samples/laser/mill-3axis-x.csv");
-// The targets of samples/laser/mill-3axis-x.csv as table nodes of EXX.
-const char* kNodes = "-400 -321.7 -238.4 -160.9 -79.3 0 81.6 158.2 242.7 319.5 400";
-
-/// The sample gantry mill (X Y Z on the tool side) with EXX as a table at the laser's targets.
-std::string gantryXml() {
-    return fmt::format(R"(<machine name="gantry-laser">
-  <workpiece><fixed name="T"/></workpiece>
-  <tool direction="0 0 -1">
-    <axis name="X" type="linear" direction="1 0 0" min="-400" max="400"/>
-    <axis name="Y" type="linear" direction="0 1 0" min="-250" max="250"/>
-    <axis name="Z" type="linear" direction="0 0 1" min="-450" max="0"/>
-    <fixed name="S"/>
-  </tool>
-  <deviations>
-    <location name="EC0Y" link="Y" component="c"/>
-    <component name="EXX" link="X" component="x" basis="table" nodes="{}"/>
-  </deviations>
-</machine>
-)", kNodes);
-}
-
-/// The knee mill of samples/machines/mill-3axis-table-xy.xml (table X on saddle Y, moving opposite to the command)
-/// with EXX as a table: the component moves the workpiece, so it reads with the opposite sign.
-std::string kneeXml() {
-    return fmt::format(R"(<machine name="knee-laser">
-  <workpiece>
-    <axis name="Y" type="linear" direction="0 -1 0" min="-250" max="250"/>
-    <axis name="X" type="linear" direction="-1 0 0" min="-400" max="400"/>
-  </workpiece>
-  <tool direction="0 0 -1">
-    <axis name="Z" type="linear" direction="0 0 1" min="-450" max="0"/>
-    <fixed name="S"/>
-  </tool>
-  <deviations>
-    <location name="EC0X" link="X" component="c"/>
-    <component name="EXX" link="X" component="x" basis="table" nodes="{}"/>
-  </deviations>
-</machine>
-)", kNodes);
-}
+using test::gantryXml;
+using test::kneeXml;
 
 // Hand calculation from the file's ten readings at each target (5 runs × 2 directions, µm):
 //   242.7: + 3.19 3.26 3.65 3.60 3.19, − 6.51 6.42 6.48 6.22 6.72 → x̄ = 49.24 / 10 = 4.924 µm

@@ -7,21 +7,22 @@
 
 namespace cnccomp::controllers::heidenhain {
 
-LaserCom heidenhainLaserCom(const LaserPositioningResult& r, bool referenceForward) {
+LaserCom heidenhainLaserCom(const LaserPositioningResult& r, int column, double sign, bool referenceForward) {
     const LaserAxisCompensation c = laserAxisCompensation(r, referenceForward);
     LaserCom out;
     out.name = r.axis + ".COM";
     out.backlashMm = c.backlashUm * 1e-3;
     TncTable t;
     t.name = out.name;
-    const std::string column = "E" + r.axis + r.axis;
-    t.columns = {"NR", "AXISPOS", column};
+    const std::string columnName = fmt::format("C{}", column);
+    t.columns = {"NR", "AXISPOS", columnName};
     for (size_t i = 0; i < c.positions.size(); ++i)
-        t.rows.push_back({std::to_string(i), fmt::format("{:.6f}", c.positions[i]), fmt::format("{:.7f}", c.referenceUm[i] * 1e-3)});
+        t.rows.push_back({std::to_string(i), fmt::format("{:.6f}", c.positions[i]), fmt::format("{:.9f}", sign * c.referenceUm[i] * 1e-3)});
     const std::vector<std::string> notes = {
         fmt::format("cnccomp laser: positioning error of axis {} from ISO 230-2 laser runs (mm, actual - target)", r.axis),
-        fmt::format("the error approached in {} (the reference-approach direction [G]); assign with COMPTAB {}:{} on the "
-                    "MachAxis {} row [G]", referenceForward ? "+" : "-", out.name, column, r.axis),
+        fmt::format("the error approached in {} (the reference-approach direction [G]) as the column of its positioning "
+                    "component, with the sign cnccomp emit gives it ({:+g} x the laser's error); COMPTAB {}:{} on the "
+                    "MachAxis {} row", referenceForward ? "+" : "-", sign, out.name, columnName, r.axis),
         fmt::format("set MP710 (backlash compensation, mm) of axis {} to {:.6f} (= -mean reversal) [G]; one value leaves up "
                     "to {:.3f} um of the reversal at single targets", r.axis, out.backlashMm, c.backlashLeftUm),
         servoMismatchNote("MP1810 kv factor [G]"),

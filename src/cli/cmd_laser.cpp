@@ -3,6 +3,7 @@
 // table (controllers/linuxcnc/laser_comp.hpp for its sign and INI lines), and with --machine as the axis' positioning
 // component error in a deviation set (cnccomp/laser_deviation.hpp), merged into an existing set with --merge. All files
 // are written together or not at all.
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -83,7 +84,21 @@ void run(const Options& o) {
             add("AX_EEC.INI", e.eec);
             add("AX_LASER_MD.INI", e.machineData);
         } else if (o.controller == "heidenhain-tnc") {
-            const auto c = controllers::heidenhain::heidenhainLaserCom(r, referenceForward);
+            // The column and sign of the axis' positioning component as `emit` writes it (laser_com.hpp).
+            if (o.machine.empty())
+                throw InputError("", 0, "--controller heidenhain-tnc needs --machine M.xml (the .COM column and sign of the "
+                                        "axis' positioning component come from its description)");
+            const MachineModel m = readMachineXml(o.machine);
+            double far = 0;
+            for (const LaserTargetResult& t : r.targets)
+                if (std::abs(t.target) > std::abs(far)) far = t.target;
+            AxisVector cmd = AxisVector::Zero(m.axisCount());
+            const int axis = m.requireAxis(r.axis);
+            cmd[axis] = far;
+            const PositioningComponent pc = positioningComponent(m, r.axis, m.fromController(cmd)[axis]);
+            const DeviationDef& d = m.deviations[static_cast<size_t>(pc.deviation)];
+            const double sign = (d.side == Side::Tool ? -1.0 : 1.0) / pc.sensitivity;
+            const auto c = controllers::heidenhain::heidenhainLaserCom(r, d.component + 1, sign, referenceForward);
             add(c.name, c.text);
         } else {
             add("LSEC_" + r.axis + ".LIS", controllers::isg::isgLaserLsec(r, o.axisNumber, r.axis));

@@ -36,29 +36,48 @@ double reading(const Kinematics& nominal, const Kinematics& actual, const AxisVe
 
 }  // namespace
 
+PositioningComponent positioningComponent(const MachineModel& m, const std::string& axisName, double atCommand) {
+    const int axis = m.axisIndex(axisName);
+    if (axis < 0) throw ModelError(fmt::format("machine '{}' has no axis '{}' (the laser file's axis)", m.name, axisName));
+    const Link& link = m.axisLink(axis);
+    if (link.kind != AxisKind::Linear)
+        throw ModelError(fmt::format("axis '{}' of machine '{}' is not linear: the laser positioning runs are of a linear axis",
+                                     axisName, m.name));
+    const std::string name = "E" + axisName + axisName;
+    const int index = m.deviationIndex(name);
+    if (index < 0)
+        throw ModelError(fmt::format("machine '{}' has no component error '{}' (the positioning of {}): add "
+                                     "<component name=\"{}\" link=\"{}\" component=\"...\" basis=\"table\" nodes=\"...\"/> to "
+                                     "its <deviations>", m.name, name, axisName, name, link.name));
+    const DeviationDef& d = m.deviations[static_cast<size_t>(index)];
+    const Side side = m.axisSide(axis);
+    if (d.kind != DeviationKind::Component || d.side != side || &m.chain(side).links[static_cast<size_t>(d.link)] != &link)
+        throw ModelError(fmt::format("deviation '{}' of machine '{}' is not a component error of axis {}'s link", name,
+                                     m.name, axisName));
+    if (d.basis.type == ComponentBasis::Type::Fourier)
+        throw ModelError(fmt::format("deviation '{}': a Fourier basis cannot hold a linear axis' positioning error", name));
+    // A unit component (table: 1 µm at every node; polynomial: 1 µm per mm, small enough to stay linear) and its
+    // reading at `atCommand` (a polynomial vanishes at 0: the caller picks a command away from it).
+    const int n = d.size();
+    DeviationSet unit(m);
+    for (int k = 0; k < n; ++k)
+        unit.values[d.offset + k] = d.basis.type == ComponentBasis::Type::Table || k == 0 ? kUm : 0.0;
+    const double e = d.basis.evaluate(atCommand, unit.values.data() + d.offset, link.modulo);
+    if (std::abs(e) < 1e-12)
+        throw ModelError(fmt::format("deviation '{}': the laser's targets are all at the axis' zero", name));
+    const double s = reading(Kinematics(m), Kinematics(m, unit), laserPose(m, axis, atCommand), axis) / e;
+    if (!(std::abs(s) > 0.5))
+        throw ModelError(fmt::format("deviation '{}' of machine '{}' does not move the tool along axis {} (reading {:.3g} "
+                                     "per unit): it is not that axis' positioning error", name, m.name, axisName, s));
+    return {index, s};
+}
+
 LaserComponentResult setPositioningComponent(DeviationSet& set, const LaserPositioningResult& laser,
                                              const std::string& laserSource) {
     const MachineModel& m = set.machine();
     const int axis = m.axisIndex(laser.axis);
     if (axis < 0) throw ModelError(fmt::format("machine '{}' has no axis '{}' (the laser file's axis)", m.name, laser.axis));
     const Link& link = m.axisLink(axis);
-    if (link.kind != AxisKind::Linear)
-        throw ModelError(fmt::format("axis '{}' of machine '{}' is not linear: the laser positioning runs are of a linear axis",
-                                     laser.axis, m.name));
-    const std::string name = "E" + laser.axis + laser.axis;
-    const int index = m.deviationIndex(name);
-    if (index < 0)
-        throw ModelError(fmt::format("machine '{}' has no component error '{}' (the positioning of {}): add "
-                                     "<component name=\"{}\" link=\"{}\" component=\"...\" basis=\"table\" nodes=\"...\"/> to "
-                                     "its <deviations>", m.name, name, laser.axis, name, link.name));
-    const DeviationDef& d = m.deviations[static_cast<size_t>(index)];
-    const Side side = m.axisSide(axis);
-    if (d.kind != DeviationKind::Component || d.side != side || &m.chain(side).links[static_cast<size_t>(d.link)] != &link)
-        throw ModelError(fmt::format("deviation '{}' of machine '{}' is not a component error of axis {}'s link", name,
-                                     m.name, laser.axis));
-    if (d.basis.type == ComponentBasis::Type::Fourier)
-        throw ModelError(fmt::format("deviation '{}': a Fourier basis cannot hold a linear axis' positioning error", name));
-
     std::vector<double> q, x;  // commands (mm) and mean bidirectional deviations (mm) at the targets
     for (const LaserTargetResult& t : laser.targets) {
         AxisVector c = AxisVector::Zero(m.axisCount());
@@ -72,22 +91,16 @@ LaserComponentResult setPositioningComponent(DeviationSet& set, const LaserPosit
         x.push_back(t.mean * kUm);
     }
 
-    // Sensitivity: the reading per unit value of the component, at the target farthest from 0 (a polynomial vanishes
-    // at 0), with a unit component (table: 1 µm at every node; polynomial: 1 µm per mm).
-    const int n = d.size();
+    // Sensitivity at the target farthest from 0.
     const size_t far = static_cast<size_t>(std::max_element(q.begin(), q.end(), [](double a, double b) {
                                                 return std::abs(a) < std::abs(b);
                                             }) - q.begin());
-    DeviationSet unit(m);  // 1 µm at every node / 1 µm per mm: small enough to stay linear
-    for (int k = 0; k < n; ++k)
-        unit.values[d.offset + k] = d.basis.type == ComponentBasis::Type::Table || k == 0 ? kUm : 0.0;
-    const double e = d.basis.evaluate(q[far], unit.values.data() + d.offset, link.modulo);
-    if (std::abs(e) < 1e-12)
-        throw ModelError(fmt::format("deviation '{}': the laser's targets are all at the axis' zero", name));
-    const double s = reading(Kinematics(m), Kinematics(m, unit), laserPose(m, axis, q[far]), axis) / e;
-    if (!(std::abs(s) > 0.5))
-        throw ModelError(fmt::format("deviation '{}' of machine '{}' does not move the tool along axis {} (reading {:.3g} "
-                                     "per unit): it is not that axis' positioning error", name, m.name, laser.axis, s));
+    const PositioningComponent pc = positioningComponent(m, laser.axis, q[far]);
+    const int index = pc.deviation;
+    const DeviationDef& d = m.deviations[static_cast<size_t>(index)];
+    const int n = d.size();
+    const double s = pc.sensitivity;
+    const std::string name = d.name;
 
     LaserComponentResult r;
     r.component = name;

@@ -34,6 +34,15 @@ struct LaserComponentResult {
     int nodesOutside = 0;         ///< table nodes outside the measured targets (given the end targets' value)
 };
 
+/// Which component of the machine holds the positioning error of `axis` (E<axis><axis>) and how a laser reads it: the
+/// deviation's index and the sensitivity s (reading per unit value, from the exact model at `atCommand`, the other axes at
+/// 0 or mid-travel). ModelError as setPositioningComponent.
+struct PositioningComponent {
+    int deviation = -1;
+    double sensitivity = 0;
+};
+PositioningComponent positioningComponent(const MachineModel& m, const std::string& axis, double atCommand);
+
 /// Sets the positioning component of the laser's axis (E<axis><axis>) in `set` from the laser result. Throws
 /// ModelError when the machine has no such axis or component, the component is not of that axis' link or has a
 /// Fourier basis, or does not move the tool along the axis (|s| < 0.5); InputError (file = the laser's source) when a
