@@ -78,6 +78,14 @@ TEST(VerifyCircles, TheIdealCompensationOfTheSquarenessLeavesTheCirclesOfTheMach
     }
     EXPECT_FALSE(r.worse.any());
     EXPECT_LT(r.volumetric.maxAfter, r.volumetric.maxBefore);
+    // The programs of the other dialects (G2/G3 of Fanuc and Sinumerik, Klartext CC / C) read back to the same circles.
+    for (const auto d : {testprog::ProgramDialect::Fanuc, testprog::ProgramDialect::Sinumerik, testprog::ProgramDialect::Heidenhain}) {
+        VerifyOptions od = o;
+        od.dialect = d;
+        const VerifyResult rd = verify(m, plan, truth, "truth", comp, od);
+        EXPECT_NEAR(rd.residualBefore, r.residualBefore, 1e-6) << static_cast<int>(d);
+        EXPECT_NEAR(rd.residual, r.residual, 1e-6) << static_cast<int>(d);
+    }
 }
 
 // Through the executable: identify's own set improves every circle (exit 0); the same set with the sign turned makes
