@@ -42,10 +42,13 @@ std::string runType(const testprog::RunMotion& r) {
     if (r.dbb5)
         return r.dbb5->kind == Dbb5Run::Kind::LinearCircle ? fmt::format("DBB5 {} circle", r.dbb5->plane)
                                                            : fmt::format("DBB5 {} circle", r.dbb5->axis);
+    if (r.circle) return fmt::format("{} circle (ISO 230-4)", linearPlaneName(r.circle->plane));
     return "R-test";
 }
 
-double barLength(const testprog::RunMotion& r) { return r.ballbar ? r.ballbar->LB : r.dbb5 ? r.dbb5->LB : 0.0; }
+double barLength(const testprog::RunMotion& r) {
+    return r.ballbar ? r.ballbar->LB : r.dbb5 ? r.dbb5->LB : r.circle ? r.circle->radius : 0.0;
+}
 
 /// The commands of one run that reach the drives: setup and the samples of each pass.
 struct RunCommands {
@@ -120,6 +123,12 @@ void simulatePass(const Kinematics& k, const Kinematics& nominal, const testprog
         ref = r.kind == testprog::RunKind::AbsoluteBallbar
                   ? nominal.toolPointInWorkpiece(nominalSetup, nominal.toolPoint(b.RB, b.toolBallOffset)) + b.workBallOffset
                   : k.toolPointInWorkpiece(setup, tool) + b.workBallOffset;  // eq. (11)–(13), (16)
+    } else if (r.circle) {
+        // ISO 230-4 circle of the linear axes (linear_circle_run.hpp): the pivot ball set under the tool ball at the
+        // centre commands as they reach the drives, ΔL = |P(θ) − P(centre)| − R in the workpiece frame.
+        tool = k.toolPoint(r.circle->toolLength);
+        LB = r.circle->radius;
+        ref = k.toolPointInWorkpiece(setup, tool);
     } else {
         tool = k.toolPoint(r.dbb5->toolLength);
         LB = r.dbb5->LB;
@@ -153,6 +162,10 @@ void analyse(const MachineModel& m, const testprog::RunMotion& r, const BallbarT
         eccentricity = iso.center.x() * e1 + iso.center.y() * e2;
         for (int c = 0; c < 3; ++c)
             if (std::abs(e1[c]) + std::abs(e2[c]) == 0) eccentricity[c] = NAN;
+    } else if (r.circle) {  // the least-squares centre along the plane's axes u, v (X Y Z components; the third NaN)
+        const std::array<char, 2> ax = linearPlaneAxes(r.circle->plane);
+        eccentricity[ax[0] - 'X'] = iso.center.x();
+        eccentricity[ax[1] - 'X'] = iso.center.y();
     }
 }
 
@@ -231,9 +244,6 @@ std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const 
 }
 
 PlanWorkspace planWorkspace(const MachineModel& m, const MeasurementPlan& plan, const VerifyOptions& options) {
-    if (!plan.circleRuns.empty())
-        throw ModelError("verify does not re-simulate circles of the linear axes (<circle>) yet (issue 20): verify a plan "
-                         "without them");
     const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
     testprog::TestProgramOptions po;
     po.dialect = options.dialect;
@@ -257,9 +267,6 @@ double VerifyRun::spanAfter() const {
 VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const DeviationSet& simulated,
                     const std::string& simulatedName, const VerifyCompensation& comp, const VerifyOptions& options) {
     if (comp.kind == VerifyCompensation::Kind::None) throw ModelError("verify: no compensation given");
-    if (!plan.circleRuns.empty())
-        throw ModelError("verify does not re-simulate circles of the linear axes (<circle>) yet (issue 20): verify a plan "
-                         "without them");
     if ((comp.kind == VerifyCompensation::Kind::Deviations || comp.kind == VerifyCompensation::Kind::ControllerFiles) && !comp.model)
         throw ModelError("verify: the compensation has no controller model");
     const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);

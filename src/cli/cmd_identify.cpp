@@ -19,6 +19,7 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
 #include "cnccomp/io/text_util.hpp"
+#include "cnccomp/laser_deviation.hpp"
 #include "app/report/html_report.hpp"
 #include "app/report/identification_report.hpp"
 #include "app/report/linear_circle_report.hpp"
@@ -28,7 +29,7 @@ namespace {
 
 struct Options {
     IdentifyRequest request;
-    std::string method = "least-squares", measure, machine, plan, out, report, truth;
+    std::string method = "least-squares", measure, machine, plan, out, report, truth, merge;
     std::string anglesOut, volumetricOut, isoOut, profileOut;
     std::string reportControllers, reportGrid, reportPlane = "XY";
 };
@@ -87,7 +88,7 @@ void run(Options o) {
         {"--iso-out", o.isoOut}, {"--profile-out", o.profileOut}};
     for (size_t i = 0; i < outputs.size(); ++i) {
         if (outputs[i].second.empty()) continue;
-        refuseToOverwrite(outputs[i].second, {o.machine, o.plan, o.truth, r.start, r.eccentricities});
+        refuseToOverwrite(outputs[i].second, {o.machine, o.plan, o.truth, r.start, r.eccentricities, o.merge});
         for (size_t j = 0; j < i; ++j)
             if (outputs[j].second == outputs[i].second)
                 throw ModelError(fmt::format("{} and {} name the same file '{}'", outputs[j].first, outputs[i].first,
@@ -114,8 +115,11 @@ void run(Options o) {
     if (res.measured && res.result && plan) runs = report::measuredRunSections(m, *plan, *res.measured, *res.result);
 
     // Everything is computed: stage every output, then commit them together (all or nothing).
-    OutputSet staged({o.machine, o.plan, o.truth, r.start, r.eccentricities});
-    staged.add(o.out, formatDeviationCsv(res.deviations));
+    OutputSet staged({o.machine, o.plan, o.truth, r.start, r.eccentricities, o.merge});
+    // --merge: the identified deviations replace theirs in an existing set (e.g. the laser's positioning components
+    // and a rotary-axis identification), the others are kept (laser_deviation.hpp, mergeDeviations).
+    staged.add(o.out, formatDeviationCsv(o.merge.empty() ? res.deviations
+                                                          : mergeDeviations(readDeviationCsv(o.merge, m), res.deviations)));
     if (res.circles && html) {
         if (!o.reportControllers.empty() || !o.reportGrid.empty())
             throw ModelError("--report-controllers and --report-grid: the circles of the linear axes write no maps or "
@@ -158,7 +162,8 @@ void run(Options o) {
 
     // A model that does not fit says so before anything else of the result.
     if (res.report && !res.report->adequacy.fits) fmt::print("WARNING: {}\n", res.report->adequacy.message);
-    fmt::print("{} -> {}{}\n", res.summary, o.out, o.report.empty() ? "" : ", report -> " + o.report);
+    fmt::print("{} -> {}{}{}\n", res.summary, o.out, o.merge.empty() ? "" : " (merged into " + o.merge + ")",
+               o.report.empty() ? "" : ", report -> " + o.report);
     if (res.report) printReport(*res.report);
     if (res.circles) printLinearCircles(*res.circles);
     printCircularTests(runs);
@@ -236,6 +241,9 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_flag("--components", r.components,
                 "DBB5: also the component errors (error motions) of the rotary table axis from its on-axis runs, as tables");
     c->add_option("--profile-out", o->profileOut, "DBB5 --components: CSV of the component profiles over angle (bed frame, um / arcsec)");
+    c->add_option("--merge", o->merge,
+                  "deviation CSV the identified deviations are merged into (its others kept), written to --out")
+        ->check(CLI::ExistingFile);
     c->add_option("--truth", o->truth, "deviation CSV to print next to the result")->check(CLI::ExistingFile);
     c->callback([o] { run(*o); });
 });

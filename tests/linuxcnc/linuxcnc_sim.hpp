@@ -55,6 +55,9 @@ struct SimOptions {
     /// Joint limits of ±100000 instead of the description's travel: a world-straight move in tool-tip mode that turns
     /// a rotary axis takes the joints far out of the travel on the way (LinuxCNC would stop it at the limit).
     bool wideJointLimits = false;
+    /// Net motion.switchkins-type (M68 E3): false for a kinematics module without switchable kinematics (trivkins has
+    /// no such pin in 2.9: "Pin 'motion.switchkins-type' does not exist").
+    bool switchkins = true;
     /// Component route: the module name the component was installed under (installComponent); the emitted files'
     /// cnccomp_kins is renamed to it.
     std::string module;
