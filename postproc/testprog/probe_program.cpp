@@ -182,8 +182,10 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     w.comment(fmt::format("cnccomp sphere probing: machine {} plan {}", o.machineFile.empty() ? m.name : o.machineFile,
                           o.planFile));
     w.comment(kKinematicsModeLine);
+    int touches = 0;
+    for (const SphereRunCommands& rc : cmds.runs) touches += static_cast<int>(rc.poses.size()) * rc.run.touchesPerPose();
     w.comment(fmt::format("{} poses, {} touches; result file {}: one line per touch TOUCH <pose> <touch> {}X Y Z A B C",
-                          cmds.poseCount(), 0, o.log, d == ProgramDialect::Fanuc || d == ProgramDialect::Heidenhain ? "" : "<flag 1 triggered 0 missed> "));
+                          cmds.poseCount(), touches, o.log, d == ProgramDialect::Fanuc || d == ProgramDialect::Heidenhain ? "" : "<flag 1 triggered 0 missed> "));
     for (const SphereRunCommands& rc : cmds.runs)
         w.comment(fmt::format("sphere {}: centre {:g} {:g} {:g} mm diameter {:g} stylus {:g} tool length {:g} approach {:g} "
                               "feed {:g} clearance {:g}",
@@ -262,10 +264,6 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
         case ProgramDialect::Sinumerik: w.block("M30"); break;
         case ProgramDialect::Heidenhain: w.block(fmt::format("END PGM {} MM", name)); break;
     }
-    // The touch count in the header.
-    const std::string placeholder = fmt::format("{} poses, 0 touches", cmds.poseCount());
-    if (const size_t p = w.text.find(placeholder); p != std::string::npos)
-        w.text.replace(p, placeholder.size(), fmt::format("{} poses, {} touches", cmds.poseCount(), out.touches));
     out.files.push_back({probeProgramFileName(d), w.text});
     if (d == ProgramDialect::Heidenhain) {
         // FN 16 format file: the text with %-formats, then the Q parameters (TNC 640 Klartext manual, FN 16).
