@@ -137,7 +137,7 @@ TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheRead
 }
 
 TEST(ProbeProgram, CliWritesTheProgramAndIdentifyReadsTheSimulatedResult) {
-    // The whole chain through the command line: testprog, simulate (the result file), identify (exit 0, all eight).
+    // The whole chain through the command line: testprog, simulate (the result file), identify (exit 0, the eight location errors and the three squareness errors).
     test::ScratchDir dir("probe-cli");
     const std::string M = test::sourcePath("samples/machines/table-table-ac.xml");
     const std::string P = test::sourcePath("samples/plans/table-table-ac-sphere.xml");
@@ -152,7 +152,7 @@ TEST(ProbeProgram, CliWritesTheProgramAndIdentifyReadsTheSimulatedResult) {
     r = test::runCli("identify --machine " + M + " --plan " + P + " --traces " + dir.file("sim") + " --probe-log run.txt --out " +
                      dir.file("d.csv"));
     ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(r.out.find("identified 8 of 8"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("identified 11 of 11"), std::string::npos) << r.out;  // 8 location errors, 3 squareness
     // No result file: exit 2 naming it.
     r = test::runCli("identify --machine " + M + " --plan " + P + " --traces " + dir.file("sim") + " --out " + dir.file("e.csv"));
     EXPECT_EQ(r.exitCode, 2) << r.out;
