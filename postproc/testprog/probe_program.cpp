@@ -96,7 +96,7 @@ public:
                 const Kinematics nominal(m_);
                 (void)from;
                 block("TCH PROBE 4.0 MEASURING IN 3-D");
-                block("TCH PROBE 4.1 Q1");
+                block("TCH PROBE 4.1 Q20");
                 // The direction in the machine's linear axes: the commanded move from the approach to the target.
                 const AxisVector c0 = m_.toController(from), c1 = m_.toController(to);
                 std::string v;
@@ -220,7 +220,8 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
             w.block("CYCL DEF 7.1 X+0");
             w.block("CYCL DEF 7.2 Y+0");
             w.block("CYCL DEF 7.3 Z+0");
-            w.comment("[G] TCH PROBE 4 results (Q1..Q3) taken as the stylus ball centre at the trigger");
+            w.comment("[G] TCH PROBE 4 MEASURING IN 3-D block syntax (4.1 result Q, 4.2 incremental vector, 4.3 DIST F TL)");
+            w.comment("results from Q115-Q117: spindle position at the contact (TNC 640 preassigned Q parameters)");
             w.comment("[G] FN 16 appends each output to the file when the program writes it again");
             break;
     }
@@ -267,8 +268,11 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     out.files.push_back({probeProgramFileName(d), w.text});
     if (d == ProgramDialect::Heidenhain) {
         // FN 16 format file: the text with %-formats, then the Q parameters (TNC 640 Klartext manual, FN 16).
-        std::string a = "\"TOUCH %1.0LF %1.0LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF\", Q100, Q101, Q1, Q2, Q3, Q4, "
-                        "Q5, Q6;\n";
+        // Q115–Q117: the spindle position at the contact (stylus length and ball radius not compensated), i.e. the
+        // machine axes' values under TOOL CALL 0 and a zero datum (TNC 640 user's manual, "Preassigned Q parameters:
+        // coordinates after probing during program run"); Q4–Q6: the pose's A B C as commanded.
+        std::string a = "\"TOUCH %1.0LF %1.0LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF\", Q100, Q101, Q115, Q116, Q117, "
+                        "Q4, Q5, Q6;\n";
         out.files.push_back({"PROBE.A", a});
     }
     return out;
