@@ -70,7 +70,7 @@ TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
     const std::string& t = p.files[0].text;
     EXPECT_EQ(p.files[0].file, "probe.ngc");
     EXPECT_NE(t.find("(LOGOPEN,run1.txt)\n"), std::string::npos);
-    EXPECT_NE(t.find("\nG38.3 X100.000000 Y50.000000 Z151.500000 F100\n"
+    EXPECT_NE(t.find("\nG38.3 X100.000000 Y50.000000 Z154.500000 F100\n"
                      "(LOG,TOUCH 0 0 #5070 #5061 #5062 #5063 #5064 #5065 #5066)\n"),
               std::string::npos);
     EXPECT_NE(t.find("(LOG,TOUCH 22 4 #5070 #5061 #5062 #5063 #5064 #5065 #5066)"), std::string::npos);

@@ -235,8 +235,8 @@ TEST(ProbeLog, MissedOutOfWindowDuplicatedAndMissingTouchesAreNamedNeverFitted) 
     };
     // #5070 = 0 on line 13 (pose 2 touch 2).
     expectError(logWith(m, c, 12, [](ProbeTouch& t) { t.triggered = 0; }), 13, "pose 2 touch 2: missed");
-    // The pole touch of pose 1 3 mm farther out than the nominal surface (window ±2 mm).
-    expectError(logWith(m, c, 5, [&](ProbeTouch& t) { t.q[m.axisIndex("Z")] += 3.0; }), 6, "pose 1 touch 0: the stylus");
+    // The pole touch of pose 1 0.6 mm farther out than the nominal surface (window ±0.5 mm).
+    expectError(logWith(m, c, 5, [&](ProbeTouch& t) { t.q[m.axisIndex("Z")] += 0.6; }), 6, "pose 1 touch 0: the stylus");
     // A log without the flag: a touch at the end of its probing move is a missed touch.
     {
         ProbeLog log = simulateSphereProbing(Kinematics(m), c);

@@ -144,7 +144,7 @@ public:
     }
     std::string sinumerikFile() const {
         std::string s;
-        for (char c : o_.log) s.push_back(std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::toupper(c)) : '_');
+        for (char c : o_.log) s.push_back(std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : '_');
         return s;
     }
 
