@@ -254,7 +254,7 @@ TEST(ProbeLog, MissedOutOfWindowDuplicatedAndMissingTouchesAreNamedNeverFitted) 
             for (const auto& s : v) joined += (joined.empty() ? "" : " ") + s;
             noFlag += joined + "\n";
         }
-        expectError(noFlag, 5, "a missed touch");
+        expectError(noFlag, 5, "pose 0 touch 4: missed: the probe stopped at the end of its probing move");
     }
     // The rotary axes of another pose.
     expectError(logWith(m, c, 20, [&](ProbeTouch& t) { t.q[m.axisIndex("C")] += 1 * kDeg; }), 21, "axis C");
