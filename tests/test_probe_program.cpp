@@ -161,3 +161,43 @@ TEST(ProbeProgram, CliWritesTheProgramAndIdentifyReadsTheSimulatedResult) {
 
 }  // namespace
 }  // namespace cnccomp
+
+namespace cnccomp {
+namespace {
+
+TEST(ProbeVerify, TheCentresSpreadBeforeAndCoincideAfterAnIdealOrEmittedCompensation) {
+    // verify on a sphere plan: the probing program's moves on the true machine, without and with the compensation of the
+    // identified set; the fitted centres spread by the errors before and coincide after (the identified set is the
+    // truth's location and squareness errors, found from the simulated result file).
+    test::ScratchDir dir("probe-verify");
+    const std::string M = test::sourcePath("samples/machines/table-table-ac.xml");
+    const std::string P = test::sourcePath("samples/plans/table-table-ac-sphere.xml");
+    const std::string T = test::sourcePath("samples/deviations/table-table-ac-truth.csv");
+    auto r = test::runCli("simulate --machine " + M + " --plan " + P + " --deviations " + T + " --out " + dir.file("sim"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    r = test::runCli("identify --machine " + M + " --plan " + P + " --traces " + dir.file("sim") + " --out " + dir.file("d.csv"));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    for (const std::string& controller : {std::string(""), std::string("linuxcnc"), std::string("siemens-840d")}) {
+        std::string comp = dir.file("d.csv");
+        if (!controller.empty()) {
+            comp = dir.file("emit-" + controller);
+            r = test::runCli("emit --machine " + M + " --deviations " + dir.file("d.csv") + " --controller " + controller +
+                             " --out " + comp);
+            ASSERT_EQ(r.exitCode, 0) << r.out;
+        }
+        r = test::runCli("verify --machine " + M + " --plan " + P + " --compensation " + comp + " --truth " + T +
+                         " --json " + dir.file("v-" + controller + ".json"));
+        ASSERT_EQ(r.exitCode, 0) << controller << "\n" << r.out;
+        EXPECT_NE(r.out.find("sphere probing (centre spread)"), std::string::npos) << r.out;
+        // "residual (largest span after compensation): 0.000 um (before: 128.190 um)"
+        const size_t at = r.out.find("residual (largest span after compensation): ");
+        ASSERT_NE(at, std::string::npos) << r.out;
+        const double after = std::stod(r.out.substr(at + 44));
+        const double before = std::stod(r.out.substr(r.out.find("(before: ", at) + 9));
+        EXPECT_GT(before, 50.0) << controller;
+        EXPECT_LT(after, 0.05) << controller << "\n" << r.out;
+    }
+}
+
+}  // namespace
+}  // namespace cnccomp
