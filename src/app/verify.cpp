@@ -1,5 +1,7 @@
 #include "app/verify.hpp"
 
+#include "app/verify_sphere.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -269,15 +271,27 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
     if (comp.kind == VerifyCompensation::Kind::None) throw ModelError("verify: no compensation given");
     if ((comp.kind == VerifyCompensation::Kind::Deviations || comp.kind == VerifyCompensation::Kind::ControllerFiles) && !comp.model)
         throw ModelError("verify: the compensation has no controller model");
-    const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
-    testprog::TestProgramOptions po;
-    po.dialect = options.dialect;
-    const testprog::TestProgramSet programs = testprog::makeTestPrograms(m, plan, po);
     const Kinematics k(m, simulated), nominal(m);
     VerifyResult out;
     out.machine = m.name;
     out.simulated = simulatedName;
     out.compensation = comp.description;
+    if (!plan.sphereRuns.empty()) {
+        // Sphere probing (verify_sphere.hpp): the spread of the fitted sphere centres over the poses.
+        if (!comp.model)
+            throw ModelError("verify: a sphere plan takes a deviation set or controller files (a corrected program carries "
+                             "no probing moves)");
+        out.runs = verifySphereRuns(m, plan, k, *comp.model, options.dialect);
+        for (const VerifyRun& r : out.runs) {
+            out.residualBefore = std::max(out.residualBefore, r.spanBefore());
+            out.residual = std::max(out.residual, r.spanAfter());
+        }
+        out.volumetric.note = "sphere plans: no volumetric figure (the probing poses are not sampled as a workspace)";
+    } else {
+    const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
+    testprog::TestProgramOptions po;
+    po.dialect = options.dialect;
+    const testprog::TestProgramSet programs = testprog::makeTestPrograms(m, plan, po);
     std::vector<RunCommands> programmed;
     for (size_t i = 0; i < motions.size(); ++i) {
         const testprog::RunMotion& r = motions[i];
@@ -340,6 +354,7 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
         volumetric(m, simulated, *comp.model, gridOver(m, motions, programmed, options.volumetricPerAxis), out.volumetric);
     } else {
         out.volumetric.note = "a corrected program compensates its own poses only: no volumetric figure";
+    }
     }
     for (const controllers::Coverage& c : comp.notCompensated) {
         VerifyRemaining rem;
