@@ -181,6 +181,12 @@ private:
 
 }  // namespace
 
+void appendMapRows(std::span<const MapPoint> points, const MachineModel& m, std::string& out) {
+    const RowWriter rows(m);
+    std::vector<char> row(rows.rowMax());
+    for (const MapPoint& p : points) out.append(row.data(), rows.write(p, row.data()));
+}
+
 std::string formatMapCsv(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo& info) {
     std::string all;
     writeMap(map, m, info, [&](const std::string& chunk) { all += chunk; });

@@ -17,6 +17,8 @@ struct MapCsvInfo {
 
 /// Text of the map file.
 std::string formatMapCsv(const VolumetricMap& map, const MachineModel& machine, const MapCsvInfo& info);
+/// Appends the rows of `points` to `out`: the text writeMapCsv writes after the header.
+void appendMapRows(std::span<const MapPoint> points, const MachineModel& machine, std::string& out);
 /// Writes the map atomically.
 void writeMapCsv(const std::string& path, const VolumetricMap& map, const MachineModel& machine, const MapCsvInfo& info);
 /// The map of `request` written to `path` as writeMapCsv would write computeMap's map, byte for byte, without holding

@@ -54,10 +54,10 @@ size_t writeFixed(uint64_t scaled, int d, char* out) {
 size_t formatExact(double value, int d, char* out) {
     const double p = std::fabs(value) * kPow10[d];
     if (!(p < 4e15)) return viaPrintf(value, d, out);  // also NaN and infinities
-    const double whole = std::floor(p);
-    const double frac = p - whole;  // exact
+    const uint64_t whole = static_cast<uint64_t>(p);      // p < 2^52: truncation is floor, and exact
+    const double frac = p - static_cast<double>(whole);  // exact
     if (std::fabs(frac - 0.5) <= p * 0x1p-52) return viaPrintf(value, d, out);
-    const uint64_t scaled = static_cast<uint64_t>(whole) + (frac > 0.5 ? 1 : 0);
+    const uint64_t scaled = whole + (frac > 0.5 ? 1 : 0);
     size_t n = 0;
     if (std::signbit(value)) out[n++] = '-';
     return n + writeFixed(scaled, d, out + n);
