@@ -12,7 +12,7 @@
 #include "postproc/block_writer.hpp"
 #include "postproc/correction.hpp"
 #include "postproc/klartext_blocks.hpp"
-#include "postproc/number_format.hpp"
+#include "cnccomp/io/number_format.hpp"
 
 namespace cnccomp::pp {
 namespace {

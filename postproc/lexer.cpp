@@ -1,6 +1,6 @@
 #include "postproc/lexer.hpp"
 
-#include "postproc/number_format.hpp"
+#include "cnccomp/io/number_format.hpp"
 #include "cnccomp/io/text_util.hpp"
 
 #include <charconv>

@@ -19,7 +19,7 @@
 #include "postproc/block_writer.hpp"
 #include "postproc/klartext_correct.hpp"
 #include "postproc/line_reader.hpp"
-#include "postproc/number_format.hpp"
+#include "cnccomp/io/number_format.hpp"
 
 namespace cnccomp::pp {
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <span>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
@@ -195,6 +196,107 @@ TEST(Map, CsvRoundTripAndSvgPicture) {
     EXPECT_THROW(renderMapSvg(map, m, parseMapPlane("XY@C=45"), {}), InputError);   // not a grid value
     EXPECT_THROW(renderMapSvg(map, m, parseMapPlane("XZ"), {}), InputError);        // Z is not a range
     EXPECT_THROW(parseMapPlane("X@Z=0"), InputError);
+}
+
+/// A sink that keeps every block it is handed, checking the order.
+class CollectingSink : public MapSink {
+public:
+    std::vector<MapPoint> points;
+    int slots = 0;
+    void begin(int n, long) override { slots = n; }
+    void inOrder(int slot, long first, std::span<const MapPoint> block) override {
+        EXPECT_GE(slot, 0);
+        EXPECT_LT(slot, slots);
+        EXPECT_EQ(first, static_cast<long>(points.size()));  // flat-index order, no gap
+        points.insert(points.end(), block.begin(), block.end());
+    }
+};
+
+bool samePoint(const MapPoint& a, const MapPoint& b) {
+    return a.q == b.q && a.tip == b.tip && a.error == b.error && a.rotation == b.rotation && a.tilt == b.tilt && a.ok == b.ok;
+}
+
+TEST(Map, StreamedBlocksAreTheWholeMap) {
+    // Oracle: computeMap's stored points (the same kernel, held whole). Every block once, in order, bit for bit; the
+    // statistics do not depend on the thread count (summed block by block).
+    const MachineModel& m = test::multitasking();
+    DeviationSet d(m);
+    for (const auto& def : m.deviations) d.set(def.name, def.isAngle() ? 7 * kArcsec : 0.009);
+    MapRequest r = req(m, d, "X=-200:200:10 Y=-100:100:20 B=-90:90:30 C=0:270:90", 100.0);  // 41·11·7·4 = 12628
+    r.threads = 1;
+    const VolumetricMap whole = computeMap(r);
+    for (int threads : {1, 2, 3}) {
+        r.threads = threads;
+        CollectingSink sink;
+        const MapStatistics s = streamMap(r, sink);
+        ASSERT_EQ(sink.points.size(), whole.points.size());
+        for (size_t i = 0; i < whole.points.size(); ++i) ASSERT_TRUE(samePoint(sink.points[i], whole.points[i])) << i;
+        EXPECT_EQ(s.norm.rms, whole.stats.norm.rms) << threads;
+        EXPECT_EQ(s.tilt.rms, whole.stats.tilt.rms) << threads;
+        EXPECT_EQ(s.worstIndex, whole.stats.worstIndex);
+        EXPECT_EQ(s.points, whole.stats.points);
+    }
+}
+
+TEST(Map, StreamedCsvAndPictureAreTheHeldMapsBytes) {
+    // Oracle: writeMapCsv / renderMapSvg of computeMap's whole map. Both modes (machine axes; a fixed orientation,
+    // where every point solves the inverse kinematics), two thread counts; the plane's points kept on the way.
+    const MachineModel& m = test::multitasking();
+    DeviationSet d(m);
+    d.set("EX0C", 0.01);
+    d.setLinkValue("EC0Y", 5 * kArcsec);
+    d.set("EA0C1", -9 * kArcsec);
+    test::ScratchDir dir("map_stream");
+    struct Case {
+        MapRequest request;
+        const char* plane;
+    };
+    DeviationSet tt(tableTable());
+    tt.set("EY0A", 0.02);
+    tt.set("EB0C", 10 * kArcsec);
+    std::vector<Case> cases;
+    cases.push_back({req(m, d, "X=-100:100:5 Y=-60:60:20 Z=0 B=-30:30:30 C=0:90:90", 100.0), "XY@B=30,C=90"});
+    cases.push_back({req(tableTable(), tt, "X=-100:100:50 Y=-100:100:25 Z=0:60:30", 120.0, Vec3(0.3, -0.2, -1).normalized()),
+                     "XY@Z=30"});
+    for (Case& c : cases) {
+        const MachineModel& mm = c.request.machine;
+        const VolumetricMap whole = computeMap(c.request);
+        writeMapCsv(dir.file("whole.csv"), whole, mm, {mm.name, "truth.csv"});
+        const MapPlane plane = parseMapPlane(c.plane);
+        const std::string svg = renderMapSvg(whole, mm, plane, {"t"});
+        for (int threads : {1, 2}) {
+            c.request.threads = threads;
+            VolumetricMap head = describeMap(c.request);
+            const std::vector<long> keep = planePointIndices(head, plane);
+            std::vector<MapPoint> kept;
+            head.stats = streamMapCsv(dir.file("streamed.csv"), c.request, {mm.name, "truth.csv"}, keep, &kept);
+            EXPECT_EQ(test::readText(dir.file("streamed.csv")), test::readText(dir.file("whole.csv"))) << c.plane;
+            ASSERT_EQ(kept.size(), keep.size());
+            for (size_t k = 0; k < keep.size(); ++k) EXPECT_TRUE(samePoint(kept[k], whole.points[keep[k]]));
+            EXPECT_EQ(renderMapSvg(head, kept, mm, plane, {"t"}), svg);
+        }
+    }
+    EXPECT_THROW(planePointIndices(describeMap(cases[0].request), parseMapPlane("XY@C=45")), InputError);
+}
+
+TEST(Map, AFailingSinkStopsTheStreamAndLeavesNoFile) {
+    const MachineModel& m = test::multitasking();
+    DeviationSet d(m);
+    d.set("EX0C", 0.01);
+    class Failing : public MapSink {
+    public:
+        int blocks = 0;
+        void inOrder(int, long, std::span<const MapPoint>) override {
+            if (++blocks == 3) throw ModelError("sink failed");
+        }
+    } sink;
+    MapRequest r = req(m, d, "X=-200:200:1 Y=-100:100:10 C=0:90:90", 50.0);  // 401·21·2 = 16842 points, 16 blocks
+    r.threads = 2;
+    EXPECT_THROW(streamMap(r, sink), ModelError);
+    EXPECT_EQ(sink.blocks, 3);
+    test::ScratchDir dir("map_stream_fail");
+    EXPECT_THROW(streamMapCsv(dir.file("m.csv"), r, {m.name, "x"}, std::vector<long>{5, 3}), ModelError);  // not increasing
+    EXPECT_FALSE(std::filesystem::exists(dir.file("m.csv")));
 }
 
 TEST(Map, CommandLine) {

@@ -12,7 +12,7 @@
 #include "postproc/dialect.hpp"
 #include "postproc/lexer.hpp"
 #include "postproc/line_reader.hpp"
-#include "postproc/number_format.hpp"
+#include "cnccomp/io/number_format.hpp"
 
 namespace cnccomp::pp {
 namespace {

@@ -63,16 +63,21 @@ void run(const Options& o) {
     }
     refuseToOverwrite(o.out, {o.machine, o.deviations});
     if (!o.svg.empty()) refuseToOverwrite(o.svg, {o.machine, o.deviations, o.out});
+    // The map is streamed to the file (memory flat in the grid size); the picture's plane is kept on the way.
     const auto t0 = std::chrono::steady_clock::now();
-    const VolumetricMap map = computeMap(req);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    VolumetricMap map = describeMap(req);
+    std::vector<long> planeIndices;
+    if (!o.svg.empty()) planeIndices = planePointIndices(map, plane);
+    std::vector<MapPoint> planePoints;
     const MapCsvInfo info{m.name, o.deviations};
-    std::string svgText;
-    if (!o.svg.empty())
-        svgText = renderMapSvg(map, m, plane, {fmt::format("machine {}, deviations {}", m.name, o.deviations)});
-    writeMapCsv(o.out, map, m, info);
-    if (!o.svg.empty()) writeFileAtomically(o.svg, [&](std::ostream& out) { out << svgText; });
-    fmt::print("volumetric map of '{}' with {} ({} points, {:.3f} s)\n", m.name, o.deviations, map.points.size(), seconds);
+    map.stats = streamMapCsv(o.out, req, info, planeIndices, &planePoints);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!o.svg.empty()) {
+        const std::string svgText =
+            renderMapSvg(map, planePoints, m, plane, {fmt::format("machine {}, deviations {}", m.name, o.deviations)});
+        writeFileAtomically(o.svg, [&](std::ostream& out) { out << svgText; });
+    }
+    fmt::print("volumetric map of '{}' with {} ({} points, {:.3f} s)\n", m.name, o.deviations, req.grid.size(), seconds);
     for (const std::string& l : formatMapStatistics(map, m)) fmt::print("  {}\n", l);
     fmt::print("wrote {}{}\n", o.out, o.svg.empty() ? "" : " and " + o.svg);
     if (map.stats.failed > 0)

@@ -1,7 +1,11 @@
 #include "cnccomp/volumetric_map.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <barrier>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <thread>
 
@@ -115,11 +119,52 @@ void prepare(Plan& p) {
                                      m.name, centre.axis.x(), centre.axis.y(), centre.axis.z()));
 }
 
-/// The per-point kernel: no allocation.
-void evaluate(const Plan& p, long index, MapPoint& out) {
+/// The pose of one kinematic chain at the last commands it was evaluated at: a grid varies its last axes fastest, so
+/// one chain's axes (often the longer tool chain's) stay put over many points and its pose is reused. The reuse is
+/// exact: a chain's pose depends on its own axes only, and it is reused only when all of them have the same bit pattern.
+struct ChainMemo {
+    std::array<int, kMaxAxes> axes{};  ///< the chain's axis indices
+    int count = 0;
+    std::array<uint64_t, kMaxAxes> key{};
+    bool valid = false;
+    Pose pose = Pose::Identity();
+
+    ChainMemo(const MachineModel& m, Side side) {
+        for (const Link& l : m.chain(side).links)
+            if (l.axisIndex >= 0) axes[count++] = l.axisIndex;
+    }
+    /// True when the pose is that of `q` (else the key is set to q and the caller stores the new pose).
+    bool holds(const AxisVector& q) {
+        bool same = valid;
+        for (int i = 0; i < count; ++i) {
+            const uint64_t k = std::bit_cast<uint64_t>(q[axes[i]]);
+            same = same && key[i] == k;
+            key[i] = k;
+        }
+        valid = true;
+        return same;
+    }
+};
+
+/// One worker's scratch: the chain poses of the nominal and the actual machine.
+struct Scratch {
+    ChainMemo nominalWork, nominalTool, actualWork, actualTool;
+    explicit Scratch(const MachineModel& m)
+        : nominalWork(m, Side::Workpiece), nominalTool(m, Side::Tool), actualWork(m, Side::Workpiece), actualTool(m, Side::Tool) {}
+};
+
+/// toolPose(k, q, tip) (inverse_kinematics.cpp) with the chains' poses reused from `work` and `tool` when their axes
+/// have not moved: the same operations on the same values, so the same bits.
+ToolPose toolPoseReusing(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, ChainMemo& work, ChainMemo& tool) {
+    if (!work.holds(q)) work.pose = k.baseToWorkpiece(q);
+    if (!tool.holds(q)) tool.pose = k.baseToTool(q);
+    const Pose wMt = work.pose.inverse(Eigen::Isometry) * tool.pose;
+    return {wMt * tipInToolFrame, wMt.linear() * k.machine().toolDirection};
+}
+
+/// The per-point kernel at per-axis grid indices `idx`: no allocation.
+void evaluate(const Plan& p, const long* idx, MapPoint& out, Scratch& ws) {
     const MapRequest& r = *p.request;
-    std::array<long, kMaxGridAxes> idx;
-    r.grid.unflatten(index, idx.data());
     AxisVector q = p.base;
     out.ok = true;
     if (!r.toolOrientation) {
@@ -151,8 +196,8 @@ void evaluate(const Plan& p, long index, MapPoint& out) {
     }
     out.q.fill(0.0);
     for (int a = 0; a < q.size(); ++a) out.q[a] = q[a];
-    const ToolPose n = toolPose(p.nominal, q, p.tipInTool);
-    const ToolPose a = toolPose(p.actual, q, p.tipInTool);
+    const ToolPose n = toolPoseReusing(p.nominal, q, p.tipInTool, ws.nominalWork, ws.nominalTool);
+    const ToolPose a = toolPoseReusing(p.actual, q, p.tipInTool, ws.actualWork, ws.actualTool);
     out.tip = n.tip;
     out.error = a.tip - n.tip;
     const Vec3 cr = n.axis.cross(a.axis);
@@ -209,56 +254,168 @@ struct Accumulator {
     }
 };
 
-MapStatistics run(const Plan& plan, MapPoint* store) {
+/// Grid points per block: fixed by the grid's size alone, so that the statistics (summed block by block, blocks
+/// merged in order) do not depend on the thread count.
+long blockPoints(long n) { return std::clamp<long>((n + 15) / 16, 64, 8192); }
+
+/// The streaming engine. Persistent workers evaluate one block each per round into their slot (two sets of slots:
+/// round r and r − 1) and call sink.evaluated there; meanwhile the calling thread merges the statistics of round
+/// r − 1 and calls sink.inOrder on its blocks in flat-index order. Rounds are separated by a barrier.
+MapStatistics run(const Plan& plan, MapSink& sink) {
     const MapRequest& r = *plan.request;
     const long n = r.grid.size();
+    const long block = blockPoints(n);
+    const long blocks = (n + block - 1) / block;
     int threads = r.threads > 0 ? r.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    threads = static_cast<int>(std::clamp<long>(n / 256, 1, threads));
-    std::vector<Accumulator> acc(threads);
-    std::vector<std::exception_ptr> errors(threads);
-    const auto work = [&](int t) {
-        try {
-            const long lo = n * t / threads, hi = n * (t + 1) / threads;
-            MapPoint local;
-            for (long i = lo; i < hi; ++i) {
-                MapPoint& pt = store ? store[i] : local;
-                evaluate(plan, i, pt);
-                acc[t].add(i, pt);
+    threads = static_cast<int>(std::clamp<long>(blocks, 1, threads));
+    const long rounds = (blocks + threads - 1) / threads;
+    const int slots = 2 * threads;
+    sink.begin(slots, block);
+    std::vector<std::vector<MapPoint>> buffers(slots);
+    std::vector<Accumulator> acc(slots);
+    std::vector<std::exception_ptr> errors(slots);
+    std::vector<MapPoint*> where(slots, nullptr);
+    std::atomic<bool> stop{false};
+    std::barrier sync(threads + 1);
+    const auto slotOf = [&](long round, int w) { return static_cast<int>(round % 2) * threads + w; };
+
+    const auto worker = [&](int w) {
+        Scratch ws(r.machine);
+        std::array<long, kMaxGridAxes> idx{};
+        for (long round = 0;; ++round) {
+            sync.arrive_and_wait();  // round starts
+            if (stop.load()) break;
+            const long b = round * threads + w;
+            const int slot = slotOf(round, w);
+            if (b < blocks) {
+                try {
+                    const long lo = b * block, count = std::min(block, n - lo);
+                    MapPoint* pts = sink.storage(lo, count);
+                    if (!pts) {
+                        buffers[slot].resize(static_cast<size_t>(block));
+                        pts = buffers[slot].data();
+                    }
+                    where[slot] = pts;
+                    acc[slot] = Accumulator{};
+                    r.grid.unflatten(lo, idx.data());
+                    for (long k = 0; k < count; ++k) {
+                        evaluate(plan, idx.data(), pts[k], ws);
+                        acc[slot].add(lo + k, pts[k]);
+                        for (int i = static_cast<int>(r.grid.axes.size()) - 1; i >= 0; --i) {  // next grid point
+                            if (++idx[i] < r.grid.axes[i].count) break;
+                            idx[i] = 0;
+                        }
+                    }
+                    sink.evaluated(slot, lo, std::span<const MapPoint>(pts, static_cast<size_t>(count)));
+                } catch (...) {
+                    errors[slot] = std::current_exception();
+                }
             }
-        } catch (...) {
-            errors[t] = std::current_exception();
+            sync.arrive_and_wait();  // round done
         }
     };
+
+    Accumulator total;
+    std::exception_ptr failure;
+    // Hands round `round`'s blocks to the sink in order (calling thread).
+    const auto deliver = [&](long round) {
+        for (int w = 0; w < threads; ++w) {
+            const long b = round * threads + w;
+            if (b >= blocks) break;
+            const int slot = slotOf(round, w);
+            const long lo = b * block, count = std::min(block, n - lo);
+            total.merge(acc[slot]);
+            sink.inOrder(slot, lo, std::span<const MapPoint>(where[slot], static_cast<size_t>(count)));
+        }
+    };
+    const auto firstError = [&](long round) {
+        for (int w = 0; w < threads; ++w)
+            if (errors[slotOf(round, w)]) return errors[slotOf(round, w)];
+        return std::exception_ptr{};
+    };
+
     std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-    work(0);
-    for (auto& th : pool) th.join();
-    for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
-    for (int t = 1; t < threads; ++t) acc[0].merge(acc[t]);
-    return acc[0].finish();
+    pool.reserve(threads);
+    try {
+        for (int w = 0; w < threads; ++w) pool.emplace_back(worker, w);
+    } catch (...) {
+        failure = std::current_exception();
+    }
+    if (failure) {  // a thread could not start: release the ones that did
+        stop = true;
+        for (size_t k = pool.size(); k < static_cast<size_t>(threads); ++k) sync.arrive_and_drop();
+        sync.arrive_and_wait();
+        for (auto& t : pool) t.join();
+        std::rethrow_exception(failure);
+    }
+    long done = 0;  // rounds evaluated
+    for (long round = 0; round <= rounds; ++round) {
+        if (round == rounds || failure) stop = true;
+        sync.arrive_and_wait();  // round starts (or the workers stop)
+        if (stop.load()) break;
+        if (round > 0) {
+            try {
+                deliver(round - 1);
+            } catch (...) {
+                failure = std::current_exception();
+            }
+        }
+        sync.arrive_and_wait();  // round done
+        done = round + 1;
+        if (!failure) failure = firstError(round);
+    }
+    for (auto& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    if (done > 0) deliver(done - 1);
+    return total.finish();
 }
+
+/// A sink that keeps nothing (statistics only).
+class NullSink : public MapSink {};
+
+/// A sink whose blocks are evaluated straight into a whole map's points.
+class StoreSink : public MapSink {
+public:
+    explicit StoreSink(std::vector<MapPoint>& points) : points_(points) {}
+    MapPoint* storage(long first, long) override { return points_.data() + first; }
+
+private:
+    std::vector<MapPoint>& points_;
+};
 
 }  // namespace
 
-VolumetricMap computeMap(const MapRequest& request) {
-    Plan plan(request);
-    prepare(plan);
+VolumetricMap describeMap(const MapRequest& request) {
     VolumetricMap map;
     map.grid = request.grid;
     map.axisNames = request.machine.axisNames;
     map.toolLength = request.toolLength;
     map.toolOrientation = request.toolOrientation;
     if (map.toolOrientation) *map.toolOrientation = map.toolOrientation->normalized();
+    return map;
+}
+
+VolumetricMap computeMap(const MapRequest& request) {
+    Plan plan(request);
+    prepare(plan);
+    VolumetricMap map = describeMap(request);
     map.points.resize(static_cast<size_t>(request.grid.size()));
-    map.stats = run(plan, map.points.data());
+    StoreSink sink(map.points);
+    map.stats = run(plan, sink);
     return map;
 }
 
 MapStatistics mapStatistics(const MapRequest& request) {
     Plan plan(request);
     prepare(plan);
-    return run(plan, nullptr);
+    NullSink sink;
+    return run(plan, sink);
+}
+
+MapStatistics streamMap(const MapRequest& request, MapSink& sink) {
+    Plan plan(request);
+    prepare(plan);
+    return run(plan, sink);
 }
 
 }  // namespace cnccomp

@@ -3,9 +3,11 @@
 // the tool-tip position error (dx, dy, dz) and the tool-orientation error between tool and workpiece of the
 // erroneous machine against the nominal one, both with the exact model (Kinematics, toolPose) — the volumetric
 // counterpart of the papers' single-point error models ([MultiTasking] eq. (7), (10), (15); [RotaryTableModel] eq. for the tool
-// pose in the table frame). Computed in parallel (std::thread), no allocation per point.
+// pose in the table frame). Computed in parallel (std::thread), no allocation per point, block by block: a map
+// can be streamed to a file without ever being held whole.
 #include <array>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "cnccomp/deviations.hpp"
@@ -58,10 +60,35 @@ struct VolumetricMap {
     MapStatistics stats;
 };
 
+/// Receiver of a streamed map (streamMap): the grid's points in blocks of consecutive flat indices, every block once.
+/// The default members do nothing.
+class MapSink {
+public:
+    virtual ~MapSink() = default;
+    /// Called once before any block: `slots` block buffers are in use at once (slot numbers 0 … slots − 1), each of
+    /// at most `blockPoints` points.
+    virtual void begin(int slots, long blockPoints) { (void)slots, (void)blockPoints; }
+    /// Where to evaluate the block [first, first + count) (on a worker thread); nullptr: in the engine's own buffer.
+    virtual MapPoint* storage(long first, long count) { return (void)first, (void)count, nullptr; }
+    /// On a worker thread, as soon as a block is evaluated (blocks of other slots are evaluated at the same time):
+    /// e.g. format it into the slot's own buffer.
+    virtual void evaluated(int slot, long first, std::span<const MapPoint> points) { (void)slot, (void)first, (void)points; }
+    /// On the calling thread, once per block in flat-index order, after that block's `evaluated` (while later blocks
+    /// are evaluated): e.g. write it. The slot is not reused before this returns.
+    virtual void inOrder(int slot, long first, std::span<const MapPoint> points) { (void)slot, (void)first, (void)points; }
+};
+
+/// The map of `request` without its points or statistics (grid, axis names, tool; the orientation normalised): what
+/// a streamed map's file header and picture show.
+VolumetricMap describeMap(const MapRequest& request);
 /// Evaluates every grid point and keeps them. Throws ModelError/InputError on grid names the machine does not
 /// have, or ranges outside the travel.
 VolumetricMap computeMap(const MapRequest& request);
 /// Statistics only (no storage proportional to the grid): the fast path for very large grids.
 MapStatistics mapStatistics(const MapRequest& request);
+/// Evaluates the grid block by block (all threads of the request) and hands every block to `sink`: memory does not
+/// grow with the grid. Returns the statistics (the same as mapStatistics'; they are summed block by block and do not
+/// depend on the thread count). Throws as computeMap, or what the sink throws (the workers are stopped first).
+MapStatistics streamMap(const MapRequest& request, MapSink& sink);
 
 }  // namespace cnccomp

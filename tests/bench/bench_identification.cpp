@@ -1,5 +1,5 @@
-// Least-squares identification of the 12 seed-000 deviations from the six ball-bar runs of section 5.3, each a
-// 3600-sample trace (0.1° steps), on the exact model.
+// Least-squares identification of the 12 seed-000 deviations from the six ball-bar runs of section 5.3, on the exact
+// model: each run a 360-sample trace (1° steps, the main job's; argument 360) or a 3600-sample one (0.1°). CPU time.
 #include <benchmark/benchmark.h>
 
 #include "cnccomp/identification/lsq.hpp"
@@ -18,10 +18,10 @@ struct Fixture {
     std::vector<BallbarRun> runs = readPlanXml(std::string(CNCCOMP_SOURCE_DIR) + "/samples/plans/multitasking-six-circles.xml").runs;
     std::vector<BallbarTrace> traces;
     IdentifyOptions options;
-    Fixture() {
+    explicit Fixture(int samples) {
         const Kinematics k(machine, truth);
         for (BallbarRun& r : runs) {
-            r.stepDeg = 0.1;
+            r.stepDeg = 360.0 / samples;
             traces.push_back(simulateRun(k, r));
         }
         options.deviations = parseDeviationList(machine, "dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ");
@@ -31,13 +31,13 @@ struct Fixture {
     }
 };
 
-Fixture& fixture() {
-    static Fixture f;
-    return f;
+Fixture& fixture(int samples = 3600) {
+    static Fixture f360(360), f3600(3600);
+    return samples == 360 ? f360 : f3600;
 }
 
 void BM_IdentifyTwelveFromSixTraces(benchmark::State& state) {
-    Fixture& f = fixture();
+    Fixture& f = fixture(static_cast<int>(state.range(0)));
     const Observations obs = ballbarObservations(f.machine, f.runs, f.traces);
     int iterations = 0;
     for (auto _ : state) {
@@ -48,7 +48,7 @@ void BM_IdentifyTwelveFromSixTraces(benchmark::State& state) {
     state.counters["samples"] = static_cast<double>(obs.size() * f.traces[0].dL.size());
     state.counters["lm_iterations"] = iterations;
 }
-BENCHMARK(BM_IdentifyTwelveFromSixTraces)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IdentifyTwelveFromSixTraces)->ArgName("samples")->Arg(360)->Arg(3600)->Unit(benchmark::kMillisecond);
 
 void BM_JacobianSixTraces(benchmark::State& state) {
     Fixture& f = fixture();

@@ -12,8 +12,9 @@
 #include "postproc/dialect.hpp"
 #include "postproc/lexer.hpp"
 #include "postproc/line_reader.hpp"
-#include "postproc/number_format.hpp"
+#include "cnccomp/io/number_format.hpp"
 
+using namespace cnccomp;
 using namespace cnccomp::pp;
 
 namespace {

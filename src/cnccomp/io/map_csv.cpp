@@ -1,13 +1,18 @@
 #include "cnccomp/io/map_csv.hpp"
 
 #include <array>
+#include <cstdio>
+#include <functional>
 #include <iterator>
+#include <memory>
 #include <ostream>
+#include <span>
 
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/csv.hpp"
+#include "cnccomp/io/number_format.hpp"
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp {
@@ -53,9 +58,8 @@ std::vector<std::string> formatMapStatistics(const VolumetricMap& map, const Mac
 
 namespace {
 
-/// Writes the map through `sink` in chunks (a million-point map never sits in memory twice).
-template <class Sink>
-void writeMap(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo& info, Sink&& sink) {
+/// The '#' header lines and the column line.
+std::string mapHeader(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo& info) {
     std::string out;
     out += "# cnccomp volumetric error map (errors = actual - nominal, in the workpiece frame)\n";
     out += fmt::format("# machine: {}\n", info.machine.empty() ? m.name : info.machine);
@@ -74,13 +78,60 @@ void writeMap(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo&
     for (const std::string& l : formatMapStatistics(map, m)) out += "# " + l + "\n";
     for (int a = 0; a < m.axisCount(); ++a) out += axisColumn(m, a) + ",";
     for (size_t i = 0; i < std::size(kErrorColumns); ++i) out += std::string(kErrorColumns[i]) + (i + 1 < std::size(kErrorColumns) ? "," : "\n");
-    std::array<double, kMaxAxes> scale{};
-    for (int a = 0; a < m.axisCount(); ++a) scale[a] = m.axisLink(a).kind == AxisKind::Rotary ? 1.0 / kDeg : 1.0;
+    return out;
+}
+
+/// Formats map rows: every axis command (mm, deg) with 6 decimals, the tip (mm) with 6, the errors (µm, arcsec) with
+/// 5, ok; the text printf's "%.6f" / "%.5f" would write (NumberStyle::exact), several times faster.
+class RowWriter {
+public:
+    explicit RowWriter(const MachineModel& m) : axes_(m.axisCount()) {
+        for (int a = 0; a < axes_; ++a) scale_[a] = m.axisLink(a).kind == AxisKind::Rotary ? 1.0 / kDeg : 1.0;
+        six_.decimals = 6;
+        six_.exact = true;
+        five_.decimals = 5;
+        five_.exact = true;
+    }
+    /// The longest row write() can produce.
+    size_t rowMax() const { return (static_cast<size_t>(axes_) + 12) * (kMaxNumberChars + 1) + 2; }
+    /// Writes the row of `p` at `out` (rowMax() bytes at least) and returns its length.
+    size_t write(const MapPoint& p, char* out) const {
+        char* c = out;
+        const auto put = [&](double v, const NumberStyle& st) {
+            c += formatNumber(v, st, c);
+            *c++ = ',';
+        };
+        for (int a = 0; a < axes_; ++a) put(p.q[a] * scale_[a], six_);
+        put(p.tip.x(), six_);
+        put(p.tip.y(), six_);
+        put(p.tip.z(), six_);
+        put(p.error.x() / kUm, five_);
+        put(p.error.y() / kUm, five_);
+        put(p.error.z() / kUm, five_);
+        put(p.error.norm() / kUm, five_);
+        put(p.rotation.x() / kArcsec, five_);
+        put(p.rotation.y() / kArcsec, five_);
+        put(p.rotation.z() / kArcsec, five_);
+        put(p.tilt / kArcsec, five_);
+        *c++ = p.ok ? '1' : '0';
+        *c++ = '\n';
+        return static_cast<size_t>(c - out);
+    }
+
+private:
+    int axes_;
+    std::array<double, kMaxAxes> scale_{};
+    NumberStyle six_, five_;
+};
+
+/// Writes the map through `sink` in chunks (a million-point map never sits in memory twice).
+template <class Sink>
+void writeMap(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo& info, Sink&& sink) {
+    std::string out = mapHeader(map, m, info);
+    const RowWriter rows(m);
+    std::vector<char> row(rows.rowMax());
     for (const MapPoint& p : map.points) {
-        for (int a = 0; a < m.axisCount(); ++a) fmt::format_to(std::back_inserter(out), "{:.6f},", p.q[a] * scale[a]);
-        fmt::format_to(std::back_inserter(out), "{:.6f},{:.6f},{:.6f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{}\n", p.tip.x(),
-                       p.tip.y(), p.tip.z(), p.error.x() / kUm, p.error.y() / kUm, p.error.z() / kUm, p.error.norm() / kUm,
-                       p.rotation.x() / kArcsec, p.rotation.y() / kArcsec, p.rotation.z() / kArcsec, p.tilt / kArcsec, p.ok ? 1 : 0);
+        out.append(row.data(), rows.write(p, row.data()));
         if (out.size() > (1u << 20)) {
             sink(out);
             out.clear();
@@ -89,7 +140,52 @@ void writeMap(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo&
     sink(out);
 }
 
+/// streamMapCsv's sink: rows formatted on the workers (one text buffer per slot), written in order, the points the
+/// caller asked for copied out.
+class CsvSink : public MapSink {
+public:
+    using Write = std::function<void(const char*, size_t)>;
+    CsvSink(const MachineModel& m, Write out, std::span<const long> keep, std::vector<MapPoint>* kept)
+        : rows_(m), out_(std::move(out)), keep_(keep), kept_(kept) {}
+    void begin(int slots, long blockPoints) override {
+        text_.resize(static_cast<size_t>(slots));
+        for (Text& t : text_) t.data.reset(new char[static_cast<size_t>(blockPoints) * rows_.rowMax()]);
+    }
+    void evaluated(int slot, long, std::span<const MapPoint> points) override {
+        Text& t = text_[static_cast<size_t>(slot)];
+        t.size = 0;
+        for (const MapPoint& p : points) t.size += rows_.write(p, t.data.get() + t.size);
+    }
+    void inOrder(int slot, long first, std::span<const MapPoint> points) override {
+        const Text& t = text_[static_cast<size_t>(slot)];
+        out_(t.data.get(), t.size);
+        const long last = first + static_cast<long>(points.size());
+        while (next_ < keep_.size() && keep_[next_] < last) {
+            if (keep_[next_] >= first && kept_) kept_->push_back(points[static_cast<size_t>(keep_[next_] - first)]);
+            ++next_;
+        }
+    }
+
+private:
+    struct Text {
+        std::unique_ptr<char[]> data;  ///< blockPoints rows at most
+        size_t size = 0;
+    };
+    RowWriter rows_;
+    Write out_;
+    std::span<const long> keep_;
+    std::vector<MapPoint>* kept_;
+    size_t next_ = 0;
+    std::vector<Text> text_;
+};
+
 }  // namespace
+
+void appendMapRows(std::span<const MapPoint> points, const MachineModel& m, std::string& out) {
+    const RowWriter rows(m);
+    std::vector<char> row(rows.rowMax());
+    for (const MapPoint& p : points) out.append(row.data(), rows.write(p, row.data()));
+}
 
 std::string formatMapCsv(const VolumetricMap& map, const MachineModel& m, const MapCsvInfo& info) {
     std::string all;
@@ -99,6 +195,51 @@ std::string formatMapCsv(const VolumetricMap& map, const MachineModel& m, const 
 
 void writeMapCsv(const std::string& path, const VolumetricMap& map, const MachineModel& m, const MapCsvInfo& info) {
     writeFileAtomically(path, [&](std::ostream& o) { writeMap(map, m, info, [&](const std::string& chunk) { o << chunk; }); });
+}
+
+MapStatistics streamMapCsv(const std::string& path, const MapRequest& request, const MapCsvInfo& info,
+                           std::span<const long> keep, std::vector<MapPoint>* kept) {
+    for (size_t i = 1; i < keep.size(); ++i)
+        if (keep[i] <= keep[i - 1]) throw ModelError("streamMapCsv: the points to keep must be in increasing order");
+    VolumetricMap head = describeMap(request);
+    MapStatistics stats;
+    if (!request.toolOrientation) {
+        // Machine axes: a point costs little, so the statistics for the header take a pass of their own and the rows
+        // are written straight into the file on the second.
+        head.stats = mapStatistics(request);
+        writeFileAtomically(path, [&](std::ostream& o) {
+            const std::string h = mapHeader(head, request.machine, info);
+            o.write(h.data(), static_cast<std::streamsize>(h.size()));
+            if (kept) kept->clear();
+            CsvSink sink(request.machine, [&](const char* d, size_t n) { o.write(d, static_cast<std::streamsize>(n)); },
+                         keep, kept);
+            stats = streamMap(request, sink);
+        });
+        return stats;
+    }
+    // A fixed orientation: every point solves the inverse kinematics (tens of times a forward pose), so the grid is
+    // evaluated once, its rows spilled into an anonymous temporary file and copied after the header.
+    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> spill(std::tmpfile(), &std::fclose);
+    if (!spill) throw ModelError(fmt::format("{}: cannot create a temporary file for the map rows", path));
+    const auto put = [&](const char* d, size_t n) {
+        if (std::fwrite(d, 1, n, spill.get()) != n)
+            throw ModelError(fmt::format("{}: cannot write the map rows to a temporary file (disk full?)", path));
+    };
+    if (kept) kept->clear();
+    CsvSink sink(request.machine, put, keep, kept);
+    head.stats = stats = streamMap(request, sink);
+    if (std::fflush(spill.get()) != 0 || std::fseek(spill.get(), 0, SEEK_SET) != 0)
+        throw ModelError(fmt::format("{}: cannot read back the map rows from a temporary file", path));
+    writeFileAtomically(path, [&](std::ostream& o) {
+        const std::string h = mapHeader(head, request.machine, info);
+        o.write(h.data(), static_cast<std::streamsize>(h.size()));
+        std::vector<char> buf(size_t{1} << 20);
+        for (size_t n; (n = std::fread(buf.data(), 1, buf.size(), spill.get())) > 0;)
+            o.write(buf.data(), static_cast<std::streamsize>(n));
+        if (std::ferror(spill.get()))
+            throw ModelError(fmt::format("{}: cannot read back the map rows from a temporary file", path));
+    });
+    return stats;
 }
 
 MapCsvTable readMapCsv(const std::string& path) {

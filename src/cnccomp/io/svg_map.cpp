@@ -154,20 +154,39 @@ double planeMaxError(const VolumetricMap& map, const MapPlane& plane) {
     return e;
 }
 
-std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const MapPlane& plane, const SvgInfo& info) {
+std::vector<long> planePointIndices(const VolumetricMap& map, const MapPlane& plane) {
+    const PlaneCut c = planeCut(map, nullptr, plane);
+    std::vector<long> out;
+    out.reserve(static_cast<size_t>(map.grid.axes[c.iu].count * map.grid.axes[c.iv].count));
+    for (long ku = 0; ku < map.grid.axes[c.iu].count; ++ku)
+        for (long kv = 0; kv < map.grid.axes[c.iv].count; ++kv) out.push_back(flatIndex(map.grid, c, ku, kv));
+    return out;
+}
+
+namespace {
+
+/// The picture, its points from `planePoints` (u-major, planePointIndices' order) or, without, from map.points.
+std::string render(const VolumetricMap& map, const std::vector<MapPoint>* planePoints, const MachineModel& m,
+                   const MapPlane& plane, const SvgInfo& info) {
     const MapGrid& g = map.grid;
     const PlaneCut pc = planeCut(map, &m, plane);
     const int iu = pc.iu, iv = pc.iv;
     const std::string& cutText = pc.text;
     const GridAxis &au = g.axes[iu], &av = g.axes[iv];
-    const auto flat = [&](long ku, long kv) { return flatIndex(g, pc, ku, kv); };
+    if (planePoints && static_cast<long>(planePoints->size()) != au.count * av.count)
+        throw ModelError(fmt::format("map picture: {} points given for a plane of {} x {}", planePoints->size(), au.count,
+                                     av.count));
+    const auto point = [&](long ku, long kv) -> const MapPoint& {
+        return planePoints ? (*planePoints)[static_cast<size_t>(ku * av.count + kv)]
+                           : map.points[static_cast<size_t>(flatIndex(g, pc, ku, kv))];
+    };
     const std::string id = escape(info.idPrefix);
     // Plane statistics.
     double emax = 0, emin = HUGE_VAL, sum = 0;
     long n = 0;
     for (long ku = 0; ku < au.count; ++ku)
         for (long kv = 0; kv < av.count; ++kv) {
-            const MapPoint& p = map.points[flat(ku, kv)];
+            const MapPoint& p = point(ku, kv);
             if (!p.ok) continue;
             emax = std::max(emax, p.error.norm());
             emin = std::min(emin, p.error.norm());
@@ -218,7 +237,7 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
     // Cells.
     for (long ku = 0; ku < au.count; ++ku)
         for (long kv = 0; kv < av.count; ++kv) {
-            const MapPoint& p = map.points[flat(ku, kv)];
+            const MapPoint& p = point(ku, kv);
             const double u = au.value(ku), v = av.value(kv);
             const std::string fill = p.ok ? shade(p.error.norm() / kUm) : "#d0d0d0";
             s += fmt::format("<rect x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"{}\" stroke=\"{}\" stroke-width=\"0.3\"/>\n",
@@ -247,7 +266,7 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
         const double scale = 0.9 * cell / emax;  // px per mm of error
         for (long ku = every / 2; ku < au.count; ku += every)
             for (long kv = every / 2; kv < av.count; kv += every) {
-                const MapPoint& p = map.points[flat(ku, kv)];
+                const MapPoint& p = point(ku, kv);
                 if (!p.ok) continue;
                 const double x0 = X(au.value(ku)), y0 = Y(av.value(kv));
                 const double dx = p.error[cu] * scale, dy = -p.error[cv] * scale;
@@ -297,6 +316,17 @@ std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const 
     s += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" font-size=\"13\">|e| (µm)</text>\n", bx - 4, top - 10);
     s += "</svg>\n";
     return s;
+}
+
+}  // namespace
+
+std::string renderMapSvg(const VolumetricMap& map, const MachineModel& m, const MapPlane& plane, const SvgInfo& info) {
+    return render(map, nullptr, m, plane, info);
+}
+
+std::string renderMapSvg(const VolumetricMap& map, const std::vector<MapPoint>& planePoints, const MachineModel& m,
+                         const MapPlane& plane, const SvgInfo& info) {
+    return render(map, &planePoints, m, plane, info);
 }
 
 }  // namespace cnccomp

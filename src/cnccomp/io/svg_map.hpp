@@ -37,5 +37,12 @@ double planeMaxError(const VolumetricMap& map, const MapPlane& plane);
 /// is not on the grid).
 std::string renderMapSvg(const VolumetricMap& map, const MachineModel& machine, const MapPlane& plane,
                          const SvgInfo& info);
+/// Flat grid indices of the plane's points, u-major (throws like renderMapSvg; map.points is not read): what a
+/// streamed map keeps for its picture.
+std::vector<long> planePointIndices(const VolumetricMap& map, const MapPlane& plane);
+/// The same picture from the plane's points alone (`planePoints[k]` is the point at planePointIndices(map, plane)[k];
+/// map.points is not read): the picture of a streamed map.
+std::string renderMapSvg(const VolumetricMap& map, const std::vector<MapPoint>& planePoints, const MachineModel& machine,
+                         const MapPlane& plane, const SvgInfo& info);
 
 }  // namespace cnccomp

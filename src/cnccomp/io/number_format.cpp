@@ -1,0 +1,122 @@
+#include "cnccomp/io/number_format.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+
+namespace cnccomp {
+
+namespace {
+int clampDecimals(const NumberStyle& s) { return s.point ? (s.decimals < 0 ? 0 : (s.decimals > 15 ? 15 : s.decimals)) : 0; }
+
+size_t viaPrintf(double value, int decimals, char* out) {
+    const int len = std::snprintf(out, kMaxNumberChars, "%.*f", decimals, value);
+    return len < 0 ? 0 : static_cast<size_t>(len) < kMaxNumberChars ? static_cast<size_t>(len) : kMaxNumberChars - 1;
+}
+
+/// "00" … "99": two digits per division.
+constexpr char kPairs[] =
+    "0001020304050607080910111213141516171819202122232425262728293031323334353637383940414243444546474849"
+    "5051525354555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
+
+/// `scaled` / 10^d written with d decimals (at least one integer digit; no point when d = 0) at `out`; returns the
+/// length.
+size_t writeFixed(uint64_t scaled, int d, char* out) {
+    char buf[24];
+    char* const end = buf + sizeof buf;
+    char* p = end;
+    while (scaled >= 100) {
+        const unsigned r = static_cast<unsigned>(scaled % 100);
+        scaled /= 100;
+        p -= 2;
+        std::memcpy(p, kPairs + 2 * r, 2);
+    }
+    if (scaled >= 10) {
+        p -= 2;
+        std::memcpy(p, kPairs + 2 * scaled, 2);
+    } else {
+        *--p = static_cast<char>('0' + scaled);
+    }
+    while (end - p < d + 1) *--p = '0';
+    const size_t whole = static_cast<size_t>(end - p - d);
+    std::memcpy(out, p, whole);
+    if (d == 0) return whole;
+    out[whole] = '.';
+    std::memcpy(out + whole + 1, p + whole, static_cast<size_t>(d));
+    return whole + 1 + static_cast<size_t>(d);
+}
+
+/// NumberStyle::exact. The product p = |value| · 10^d is computed with one rounding (10^d is exact), so it is within
+/// p · 2^-53 of the exact product; unless p is that close to a half-integer, rounding p to the nearest integer rounds
+/// the exact product too, which is printf's result. The rare undecided cases (and non-finite or huge values) go to
+/// snprintf itself.
+size_t formatExact(double value, int d, char* out) {
+    const double p = std::fabs(value) * kPow10[d];
+    if (!(p < 4e15)) return viaPrintf(value, d, out);  // also NaN and infinities
+    const uint64_t whole = static_cast<uint64_t>(p);      // p < 2^52: truncation is floor, and exact
+    const double frac = p - static_cast<double>(whole);  // exact
+    if (std::fabs(frac - 0.5) <= p * 0x1p-52) return viaPrintf(value, d, out);
+    const uint64_t scaled = whole + (frac > 0.5 ? 1 : 0);
+    size_t n = 0;
+    if (std::signbit(value)) out[n++] = '-';
+    return n + writeFixed(scaled, d, out + n);
+}
+}  // namespace
+
+double roundToStyle(double value, const NumberStyle& style) {
+    const int d = clampDecimals(style);
+    const double scaled = std::round(value * kPow10[d]);
+    return scaled / kPow10[d];
+}
+
+size_t formatNumber(double value, const NumberStyle& style, char* out) {
+    const int d = clampDecimals(style);
+    if (style.exact && style.point && style.fixed && !style.plus && !style.bareFraction) return formatExact(value, d, out);
+    if (!std::isfinite(value)) value = 0.0;
+    const double scaledAbs = std::round(std::fabs(value) * kPow10[d]);
+    size_t n = 0;
+    if (scaledAbs >= 9e18) return viaPrintf(value, d, out);
+    uint64_t scaled = static_cast<uint64_t>(scaledAbs);
+    const bool negative = value < 0 && scaled != 0;
+    if (negative) out[n++] = '-';
+    else if (style.plus) out[n++] = '+';
+    uint64_t p10 = 1;
+    for (int k = 0; k < d; ++k) p10 *= 10;
+    const uint64_t ip = scaled / p10;
+    uint64_t frac = scaled % p10;
+    char digits[24];
+    int fd = d;
+    if (style.point && !style.fixed) {
+        while (fd > 0 && frac % 10 == 0) {
+            frac /= 10;
+            --fd;
+        }
+    }
+    const bool omitInteger = style.point && style.bareFraction && ip == 0 && fd > 0;
+    if (!omitInteger) {
+        int k = 0;
+        uint64_t v = ip;
+        do {
+            digits[k++] = static_cast<char>('0' + v % 10);
+            v /= 10;
+        } while (v);
+        while (k) out[n++] = digits[--k];
+    }
+    if (style.point) {
+        out[n++] = '.';
+        for (int k = fd - 1; k >= 0; --k) {
+            digits[k] = static_cast<char>('0' + frac % 10);
+            frac /= 10;
+        }
+        for (int k = 0; k < fd; ++k) out[n++] = digits[k];
+    }
+    return n;
+}
+
+double tenTo(int e) {
+    static constexpr double kNeg[] = {1, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15};
+    return e <= 0 && e >= -15 ? kNeg[-e] : std::pow(10.0, e);
+}
+
+}  // namespace cnccomp
