@@ -80,7 +80,7 @@ TOOL_TABLE = sim.tbl
 [HAL]
 # README.txt: the route's HAL file loaded after the machine's own HAL file (its setp lines win)
 HALFILE = base.hal
-HALFILE = {}
+HALFILE = {}{}
 
 [TRAJ]
 COORDINATES = {}
@@ -93,7 +93,8 @@ MAX_LINEAR_ACCELERATION = 100000
 MAX_ANGULAR_VELOCITY = 50000
 )",
                                 m.name, coordinates, coordinates.size(), o.servoPeriodNs,
-                                o.route == Route::Pins ? "cnccomp.hal" : "cnccomp-kins.hal", coordinates);
+                                o.route == Route::Pins ? "cnccomp.hal" : "cnccomp-kins.hal",
+                                o.extraHal ? "\nHALFILE = harness.hal" : "", coordinates);
     for (char c : coordinates)
         s += fmt::format("\n[AXIS_{}]\nMIN_LIMIT = -100000\nMAX_LIMIT = 100000\nMAX_VELOCITY = 50000\nMAX_ACCELERATION = 50000\n", c);
     for (size_t n = 0; n < coordinates.size(); ++n) {
@@ -221,6 +222,7 @@ SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const f
     c.ini = dir / "sim.ini";
     writeText(c.ini.string(), mergeIni(baseIni(m, c.coordinates, backlash, o), fragment));
     writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled));
+    if (o.extraHal) writeText((dir / "harness.hal").string(), o.extraHal(c.coordinates));
     if (kins) {
         writeText((dir / "cnccomp-kins.hal").string(), routeText("cnccomp-kins.hal"));
     } else {
@@ -244,10 +246,10 @@ std::string componentUnavailableReason() {
     return {};
 }
 
-double installComponent(const fs::path& emitted, const std::string& module, const fs::path& work) {
+double installComp(const fs::path& source, const std::string& name, const std::string& module, const fs::path& work) {
     fs::create_directories(work);
-    std::string t = readText((emitted / "cnccomp_kins.comp").string());
-    for (size_t at = 0; (at = t.find("cnccomp_kins", at)) != std::string::npos; at += module.size()) t.replace(at, 12, module);
+    std::string t = readText(source.string());
+    for (size_t at = 0; (at = t.find(name, at)) != std::string::npos; at += module.size()) t.replace(at, name.size(), module);
     const fs::path src = work / (module + ".comp"), log = work / "halcompile.log";
     writeText(src.string(), t);
     const auto t0 = std::chrono::steady_clock::now();
@@ -257,6 +259,10 @@ double installComponent(const fs::path& emitted, const std::string& module, cons
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (rc != 0) throw std::runtime_error(fmt::format("halcompile --install {} failed (exit {}):\n{}", src.string(), rc, tail(readText(log.string()), 60)));
     return seconds;
+}
+
+double installComponent(const fs::path& emitted, const std::string& module, const fs::path& work) {
+    return installComp(emitted / "cnccomp_kins.comp", "cnccomp_kins", module, work);
 }
 
 void uninstallComponent(const std::string& module) {
