@@ -54,6 +54,7 @@ struct SimOptions {
     Route route = Route::Pins;
     int servoPeriodNs = 50000;  ///< 50 us for the joint tables' comp filter (see above); the component route needs none
     bool sampled = false;
+    double taskCycle = 0.001;  ///< [TASK] CYCLE_TIME, s (the probing tests take 0.01: see run())
     /// Joint limits of ±100000 instead of the description's travel: a world-straight move in tool-tip mode that turns
     /// a rotary axis takes the joints far out of the travel on the way (LinuxCNC would stop it at the limit).
     bool wideJointLimits = false;
@@ -114,11 +115,13 @@ struct RunResult {
     std::vector<Sample> samples;
     double seconds = 0;
     long overruns = 0;  ///< samples lost by the sampler's FIFO (must be 0)
+    int retries = 0;    ///< runs started again after LinuxCNC's "Queue is not empty after probing" (run())
 };
 
 /// Runs LinuxCNC on the configuration with a job (lines `mdi <G-code>` / `record <label>` / `auto <program file>` /
 /// `sample <program file>` / `setp <pin or parameter> <value>`, see driver.py) and returns the records. Throws std::runtime_error with the end of
-/// LinuxCNC's log when the run fails. With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
+/// LinuxCNC's log when the run fails; a run that LinuxCNC aborted with "Queue is not empty after probing" (an upstream
+/// race after probe moves, see run()) starts again, at most 4 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
 /// (INI, HAL, job, log) is copied there.
 RunResult run(const SimConfig& c, const std::vector<std::string>& job);
 /// The records of run() (the MDI tests).
