@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <ostream>
+#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -20,6 +21,8 @@
 #include "cnccomp/identification/plan_observations.hpp"
 #include "cnccomp/identification/rtest_axis_tables.hpp"
 #include "cnccomp/identification/rtest_location_fits.hpp"
+#include "cnccomp/identification/sphere_probe.hpp"
+#include "cnccomp/io/probe_log.hpp"
 #include "cnccomp/identification/dbb5_component_errors.hpp"
 #include "cnccomp/identification/dbb5_cone_frustum.hpp"
 #include "cnccomp/identification/dbb5_location_errors.hpp"
@@ -423,6 +426,60 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
     return out;
 }
 
+
+// ---- touch probe on a calibration sphere (issue 21)
+
+/// Default unknowns of a sphere plan: the location errors of every rotary axis the plan turns, except the two no
+/// sphere centre can show: the position along the axis' own line and its zero position (rotation about itself). For a
+/// table-table A/C machine: EY0A EZ0A EB0A EC0A EX0C EY0C EA0C EB0C.
+std::vector<int> sphereDefaults(const MachineModel& m, const Observations& obs) {
+    std::set<std::string> turning;
+    for (const auto& o : obs)
+        for (const std::string& a : o->turningAxes()) turning.insert(a);
+    std::vector<int> out;
+    for (int i = 0; i < static_cast<int>(m.deviations.size()); ++i) {
+        const DeviationDef& d = m.deviations[static_cast<size_t>(i)];
+        if (d.kind != DeviationKind::Location) continue;
+        const Link* l = &m.chain(d.side).links[static_cast<size_t>(d.link)];
+        if (l->kind != AxisKind::Rotary || !turning.count(l->name)) continue;
+        const Vec3 axis = l->direction.normalized();
+        const int c = d.component;  // 0..2 translation x y z, 3..5 rotation a b c
+        if (std::abs(axis[c % 3]) > 0.999) continue;  // along the axis' line or about it
+        out.push_back(i);
+    }
+    return out;
+}
+
+IdentifyOutcome sphereProbe(const IdentifyRequest& r) {
+    if (r.traces.empty())
+        throw ModelError(fmt::format("give the folder of the probe result file with --traces DIR (DIR/{})", r.probeLog));
+    if (r.formulas) throw ModelError("the sphere method has no paper's formulas: use --method least-squares");
+    const MachineModel& m = *r.machine;
+    const SpherePlanCommands cmds = sphereCommands(m, r.plan->sphereRuns);
+    const ProbeLog log = readProbeLog((std::filesystem::path(r.traces) / r.probeLog).string(), m);
+    Observations obs = sphereObservations(m, cmds, log);
+    fmt::print("{:<16} {:>6} {:>8} {:>22}  (sphere centres fitted with the known radius)\n", "run", "poses", "touches",
+               "worst fit rms um (pose)");
+    for (size_t i = 0; i < obs.size(); ++i) {
+        const auto& so = static_cast<const SphereObservation&>(*obs[i]);
+        const auto& rms = so.fitRms();
+        const auto w = std::max_element(rms.begin(), rms.end());
+        fmt::print("{:<16} {:>6} {:>8} {:>16.4f} ({:>3})\n", so.runName(), rms.size(),
+                   rms.size() * static_cast<size_t>(cmds.runs[i].run.touchesPerPose()), *w / kUm,
+                   cmds.runs[i].poses[static_cast<size_t>(w - rms.begin())].planPose);
+    }
+    const IdentifyOptions io = engineOptions(r, sphereDefaults(m, obs));
+    IdentificationResult res = identify(m, obs, io);
+    const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
+                                          [&](int i) { return res.deviations.present[static_cast<size_t>(i)] != 0; });
+    IdentifyOutcome out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};
+    out.result = std::move(res);
+    out.summary = fmt::format("identified {} of {} requested deviations of '{}' (sphere probing, least squares on the "
+                              "centres of {} poses, {} touches)",
+                              identified, io.deviations.size(), m.name, cmds.poseCount(), log.touches.size());
+    return out;
+}
+
 }  // namespace
 
 IdentifyOutcome runIdentification(const IdentifyRequest& r) {
@@ -455,6 +512,7 @@ IdentifyOutcome runIdentification(const IdentifyRequest& r) {
         case PlanMethod::RtestTables: return rtestTables(r);
         case PlanMethod::Dbb5: return dbb5(r);
         case PlanMethod::LinearCircle: return identifyLinearCircles(r);
+        case PlanMethod::Sphere: return sphereProbe(r);
     }
     throw ModelError("unknown plan method");
 }

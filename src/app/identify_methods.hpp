@@ -34,6 +34,7 @@ struct IdentifyRequest {
     std::string volumetricRun;              ///< R-test location: run to compare measured and modelled displacements
     bool components = false;                ///< DBB5: also the component errors of the table axis from its on-axis runs
     bool oneStage = false;                  ///< least squares: one fit of every run (no stage for the linear-axis runs)
+    std::string probeLog = "cnccomp-probe.txt";  ///< sphere plans: the probe result file in the traces folder
 };
 
 /// One extra output file (angles table, ISO 230-4 table, volumetric comparison, profiles), staged by the command.

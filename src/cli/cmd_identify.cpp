@@ -187,6 +187,8 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->check(CLI::ExistingFile);
     c->add_option("--traces", r.traces, "folder of the measured runs, one <run>.csv per run")->check(CLI::ExistingDirectory);
+    c->add_option("--probe-log", r.probeLog, "sphere plans: the probe result file in the --traces folder")
+        ->capture_default_str();
     c->add_option("--out", o->out, "deviation CSV to write (ISO names and values, paper aliases)")->required();
     c->add_option("--method", o->method,
                   "least-squares (exact model, every sample; the most accurate) or formulas (the paper's formulas of the "

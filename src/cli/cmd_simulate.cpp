@@ -27,12 +27,14 @@
 #include "cnccomp/io/trace_csv.hpp"
 #include "cnccomp/io/trace_export.hpp"
 #include "cnccomp/identification/dbb5_run.hpp"
+#include "cnccomp/identification/sphere_probe.hpp"
+#include "cnccomp/io/probe_log.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, plan, deviations, out, instrument;
+    std::string machine, plan, deviations, out, instrument, probeLog = "cnccomp-probe.txt";
     double noiseUm = 0.0;
     unsigned long seed = 1;
 };
@@ -109,6 +111,15 @@ void run(const Options& o) {
         pending.push_back({r.name + ".csv", r.name, "R-test", n,
                            [&m, t = std::move(t)](std::ostream& out) { writeRtestCsv(out, m, t); }});
     }
+    if (!plan.sphereRuns.empty()) {
+        // One result file for every sphere run, as the probing program's LOG lines give it (9 decimals instead of
+        // LinuxCNC's 6); noise moves each trigger along its probing move.
+        const SpherePlanCommands cmds = sphereCommands(m, plan.sphereRuns);
+        const ProbeLog log = simulateSphereProbing(k, cmds, o.noiseUm * kUm, o.seed);
+        std::string text = formatProbeLog(log, m, 9);
+        pending.push_back({o.probeLog, "(sphere)", "probe touches", log.touches.size(),
+                           [text = std::move(text)](std::ostream& out) { out << text; }});
+    }
     std::vector<EccentricityRow> rows;
     if (!plan.runs.empty() && o.instrument.empty()) {
         rows = eccentricitiesFromTraces(m, plan.runs, ballbar);
@@ -124,7 +135,7 @@ void run(const Options& o) {
     fmt::print("simulated {} runs on '{}' into {}\n", plan.runCount(), m.name, o.out);
     for (const Pending& p : pending)
         if (!p.run.empty())
-            fmt::print("{:<16} {:<14} {:>6} {}\n", p.run, p.kind, p.samples, p.kind == "R-test" ? "poses" : "samples");
+            fmt::print("{:<16} {:<14} {:>6} {}\n", p.run, p.kind, p.samples, p.kind == "R-test" ? "poses" : p.kind == "probe touches" ? "touches" : "samples");
     if (rows.empty()) return;
     fmt::print("{:<16} {:>10} {:>10} {:>10}   (eccentricity of the ball-bar runs, um)\n", "run", "ex", "ey", "ez");
     const auto cell = [](double v) { return std::isfinite(v) ? fmt::format("{:10.3f}", v / kUm) : fmt::format("{:>10}", "-"); };
@@ -135,14 +146,17 @@ void run(const Options& o) {
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
     auto* c = app.add_subcommand("simulate",
-                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5, linear-axis circle): one CSV per run "
-                                 "and eccentricities.csv for ball-bar runs; nothing is written unless every run succeeds");
+                                 "Simulate every run of a plan (ball bar, absolute ball bar, R-test, DBB5, linear-axis circle, sphere probing): "
+                                 "one CSV per run, eccentricities.csv for ball-bar runs, the probe result file for sphere runs; nothing is written unless every run succeeds");
     c->add_option("--machine", o->machine, "machine description XML")->required()->check(CLI::ExistingFile);
     c->add_option("--plan", o->plan, "measurement plan XML")->required()->check(CLI::ExistingFile);
     c->add_option("--deviations", o->deviations, "deviation set CSV (the truth); none = nominal machine")->check(CLI::ExistingFile);
     c->add_option("--out", o->out, "output folder")->required();
     c->add_option("--noise-um", o->noiseUm, "Gaussian noise on every ΔL sample / displacement component, σ in um");
     c->add_option("--seed", o->seed, "random seed for the noise");
+    c->add_option("--probe-log", o->probeLog, "sphere runs: the result file written in the output folder (as the probing "
+                                               "program's LOG lines)")
+        ->capture_default_str();
     c->add_option("--instrument", o->instrument,
                   "time or angle: write the ball-bar runs as a ball-bar instrument exports them (time- or angle-sampled, "
                   "the passes, directions, overshoot, columns and units of the plan's capture attributes), a simulated "

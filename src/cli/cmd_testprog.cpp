@@ -7,13 +7,15 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/output_set.hpp"
+#include "postproc/testprog/probe_program.hpp"
 #include "postproc/testprog/test_program.hpp"
 
 namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    std::string machine, plan, dialect = "linuxcnc", out;
+    std::string machine, plan, dialect = "linuxcnc", out, probeLog = "cnccomp-probe.txt";
     testprog::TestProgramOptions program;
 };
 
@@ -25,6 +27,29 @@ void run(Options o) {
     const MeasurementPlan plan = readPlanXml(o.plan);
     o.program.machineFile = std::filesystem::path(o.machine).filename().string();
     o.program.planFile = std::filesystem::path(o.plan).filename().string();
+    if (!plan.sphereRuns.empty()) {
+        if (plan.runCount() != plan.sphereRuns.size())
+            throw ModelError("the plan has sphere runs and other runs: put the <sphere> runs in a plan of their own");
+        testprog::ProbeProgramOptions po;
+        po.dialect = *d;
+        po.log = o.probeLog;
+        po.decimals = o.program.decimals;
+        po.machineFile = o.program.machineFile;
+        po.planFile = o.program.planFile;
+        const testprog::ProbeProgram p = testprog::makeProbeProgram(m, plan, po);
+        OutputSet staged({o.machine, o.plan});
+        staged.makeFolder(o.out);
+        for (const testprog::ProbeProgramFile& f : p.files) {
+            const std::string text = f.text;
+            staged.add(OutputSet::fileIn(o.out, f.file, o.plan), [text](std::ostream& s) { s << text; });
+        }
+        staged.commit();
+        fmt::print("probing program for '{}' ({}) in {}: {} poses, {} touches; it writes {}\n", m.name, o.dialect, o.out,
+                   p.poses, p.touches, o.probeLog);
+        for (const testprog::ProbeProgramFile& f : p.files) fmt::print("  {}\n", f.file);
+        return;
+    }
+    if (o.probeLog != "cnccomp-probe.txt") throw ModelError("--probe-log applies to plans with sphere runs");
     const testprog::TestProgramSet set = testprog::makeTestPrograms(m, plan, o.program);
     testprog::writeTestPrograms(set, o.out, {o.machine, o.plan});
     fmt::print("{} test programs for '{}' ({}) in {}:\n", set.programs.size(), m.name, o.dialect, o.out);
@@ -55,6 +80,8 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_option("--clearance", o->program.clearance, "retract along the tool axis, mm")->capture_default_str();
     c->add_option("--dwell", o->program.dwellSeconds, "R-test: dwell at each pose, s")->capture_default_str();
     c->add_option("--decimals", o->program.decimals, "digits after the point")->capture_default_str();
+    c->add_option("--probe-log", o->probeLog, "sphere plans: the result file the probing program writes")
+        ->capture_default_str();
     c->callback([o] { run(*o); });
 });
 

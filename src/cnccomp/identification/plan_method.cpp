@@ -20,6 +20,7 @@ const char* planMethodName(PlanMethod m) {
         case PlanMethod::Dbb5: return "dbb5";
         case PlanMethod::Mixed: return "mixed";
         case PlanMethod::LinearCircle: return "circle";
+        case PlanMethod::Sphere: return "sphere";
     }
     return "?";
 }
@@ -35,6 +36,8 @@ const char* planMethodMeasures(PlanMethod m) {
         case PlanMethod::LinearCircle:
             return "diagnostics of the linear axes (centring, squareness, scale mismatch, straightness, backlash, reversal "
                    "spikes, lateral play, cyclic error, servo mismatch) from ball-bar circles, ISO 230-4 figures";
+        case PlanMethod::Sphere:
+            return "location errors of the rotary axes from the centres of a calibration sphere probed at rotary-axis poses";
     }
     return "?";
 }
@@ -59,6 +62,7 @@ const char* planMethodFormulas(PlanMethod m) {
                    "measurements (1st report)' (DBB5)";
         case PlanMethod::Mixed: return "none (runs of several kinds)";
         case PlanMethod::LinearCircle: return "none (the diagnostics are least-squares parameters of the exact model)";
+        case PlanMethod::Sphere: return "none (the sphere centres are fitted by least squares on the exact model)";
     }
     return "?";
 }
@@ -89,6 +93,7 @@ std::string kindsOf(const MeasurementPlan& plan) {
     add(plan.rtestRuns.size(), "<rtest>");
     add(plan.dbb5Runs.size(), "<dbb5>");
     add(plan.circleRuns.size(), "<circle>");
+    add(plan.sphereRuns.size(), "<sphere>");
     return s;
 }
 
@@ -97,7 +102,12 @@ std::string kindsOf(const MeasurementPlan& plan) {
 PlanMethod classifyPlan(const MeasurementPlan& plan) {
     if (plan.runCount() == 0) throw ModelError("the plan has no runs");
     const int kinds = !plan.runs.empty() + !plan.absoluteRuns.empty() + !plan.rtestRuns.empty() + !plan.dbb5Runs.empty() +
-                      !plan.circleRuns.empty();
+                      !plan.circleRuns.empty() + !plan.sphereRuns.empty();
+    if (kinds > 1 && !plan.sphereRuns.empty())
+        throw ModelError(fmt::format("the plan has sphere probing runs (<sphere>) and other runs ({}): the probe's result "
+                                     "file is identified on its own; put the <sphere> runs in a plan of their own",
+                                     kindsOf(plan)));
+    if (!plan.sphereRuns.empty()) return PlanMethod::Sphere;
     if (kinds > 1 && !plan.circleRuns.empty())
         throw ModelError(fmt::format("the plan has circles of the linear axes (<circle>) and other runs ({}): the circles' "
                                      "diagnostics are identified on their own; put the <circle> runs in a plan of their own",
@@ -116,13 +126,14 @@ PlanMethod choosePlanMethod(const MeasurementPlan& plan, const std::string& name
     PlanMethod want = PlanMethod::Mixed;
     bool known = false;
     for (PlanMethod m : {PlanMethod::Ballbar, PlanMethod::HeadPatterns, PlanMethod::RtestLocation, PlanMethod::RtestTables,
-                         PlanMethod::Dbb5, PlanMethod::Mixed, PlanMethod::LinearCircle})
+                         PlanMethod::Dbb5, PlanMethod::Mixed, PlanMethod::LinearCircle, PlanMethod::Sphere})
         if (name == planMethodName(m)) want = m, known = true;
     if (!known)
         throw ModelError(fmt::format("unknown measurement '{}' (ball-bar, head-patterns, rtest-location, rtest-tables, "
-                                     "dbb5, mixed, circle)",
+                                     "dbb5, mixed, circle, sphere)",
                                      name));
-    if (want == fits || (want == PlanMethod::Mixed && fits != PlanMethod::LinearCircle)) return want;
+    if (want == fits || (want == PlanMethod::Mixed && fits != PlanMethod::LinearCircle && fits != PlanMethod::Sphere))
+        return want;
     // The two R-test methods read the same kind of run.
     if (fits == PlanMethod::RtestTables && want == PlanMethod::RtestLocation) return want;
     if (fits == PlanMethod::RtestLocation && want == PlanMethod::RtestTables)

@@ -17,6 +17,7 @@ enum class PlanMethod {
     Dbb5,           ///< DBB5 circles (<dbb5>): location errors of the rotary axes and squareness, ISO 230-4 figures
     Mixed,          ///< runs of several kinds: least squares only
     LinearCircle,   ///< ball-bar circles of the linear axes (<circle>, ISO 230-4): their diagnostics, any machine
+    Sphere,         ///< touch probe on a calibration sphere (<sphere>): location errors of the rotary axes
 };
 
 /// Short name used on the command line and in messages ("ball-bar", "head-patterns", "rtest-location", …).

@@ -246,6 +246,105 @@ RtestRun readRtestRun(const XMLElement& e, const std::string& path) {
     return r;
 }
 
+/// <sweep>/<hold> children of a <sphere> or its <group>.
+void readSphereAxes(const XMLElement& c, const std::string& path, std::vector<RotarySweep>& out) {
+    const std::string n = c.Name();
+    RotarySweep s;
+    s.axis = xml::text(c, path, "axis");
+    if (n == "hold") {
+        xml::allowAttributes(c, path, {"axis", "deg"});
+        s.startDeg = s.endDeg = xml::number(c, path, "deg");
+    } else {
+        xml::allowAttributes(c, path, {"axis", "start", "end"});
+        s.startDeg = xml::number(c, path, "start");
+        s.endDeg = xml::number(c, path, "end");
+    }
+    for (const RotarySweep& o : out)
+        if (o.axis == s.axis) xml::fail(c, path, fmt::format("axis '{}' is given twice", s.axis));
+    out.push_back(s);
+}
+
+SphereRun readSphereRun(const XMLElement& e, const std::string& path) {
+    xml::allowAttributes(e, path, {"name", "centre", "diameter", "stylus-diameter", "tool-length", "approach", "feed",
+                                   "clearance", "window", "latitude", "ring", "trigger-offset", "estimate-trigger", "steps",
+                                   "sphere-offset", "trigger-error"});
+    SphereRun r;
+    r.name = runName(e, path);
+    r.line = e.GetLineNum();
+    for (const char* a : {"centre", "diameter", "stylus-diameter"})
+        if (!xml::has(e, a)) xml::fail(e, path, fmt::format("missing attribute '{}'", a));
+    r.centre = xml::vec3(e, path, "centre", Vec3::Zero());
+    r.diameter = xml::number(e, path, "diameter");
+    r.stylusDiameter = xml::number(e, path, "stylus-diameter");
+    r.toolLength = xml::number(e, path, "tool-length", r.toolLength);
+    r.approach = xml::number(e, path, "approach", r.approach);
+    r.feed = xml::number(e, path, "feed", r.feed);
+    r.clearance = xml::number(e, path, "clearance", r.clearance);
+    if (xml::has(e, "window")) r.window = xml::number(e, path, "window");
+    r.latitudeDeg = xml::number(e, path, "latitude", r.latitudeDeg);
+    const double ring = xml::number(e, path, "ring", r.ringTouches);
+    if (ring != std::floor(ring) || ring < 4 || ring > 64) xml::fail(e, path, "'ring' must be a whole number 4 .. 64");
+    r.ringTouches = static_cast<int>(ring);
+    r.triggerOffset = xml::number(e, path, "trigger-offset", 0.0);
+    r.estimateTrigger = xml::boolean(e, path, "estimate-trigger", true);
+    r.sphereOffset = xml::vec3(e, path, "sphere-offset", Vec3::Zero());
+    r.triggerError = xml::number(e, path, "trigger-error", 0.0);
+    SpherePoseGroup direct;
+    direct.line = e.GetLineNum();
+    bool hasDirect = false;
+    for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
+        const std::string n = c->Name();
+        if (n == "sweep" || n == "hold") {
+            readSphereAxes(*c, path, direct.sweeps);
+            hasDirect = true;
+        } else if (n == "group") {
+            xml::allowAttributes(*c, path, {"steps"});
+            SpherePoseGroup g;
+            g.line = c->GetLineNum();
+            g.steps = wholeNumber(*c, path, "steps", 8);
+            for (const XMLElement* d = c->FirstChildElement(); d; d = d->NextSiblingElement()) {
+                const std::string dn = d->Name();
+                if (dn != "sweep" && dn != "hold") xml::unknownElement(*d, path, {"sweep", "hold"});
+                readSphereAxes(*d, path, g.sweeps);
+            }
+            bool moving = false;
+            for (const RotarySweep& s : g.sweeps) moving = moving || s.startDeg != s.endDeg;
+            if (!moving) xml::fail(*c, path, "a <group> needs a <sweep> whose start and end differ");
+            r.groups.push_back(g);
+        } else if (n == "pose") {
+            SpherePoseGroup g;
+            g.line = c->GetLineNum();
+            for (const tinyxml2::XMLAttribute* a = c->FirstAttribute(); a; a = a->Next()) {
+                RotarySweep s;
+                s.axis = a->Name();
+                const auto v = parseNumber(a->Value());
+                if (!v || !std::isfinite(*v))
+                    xml::fail(*c, path, fmt::format("<pose> {}=\"{}\": expected an angle in degrees", s.axis, a->Value()));
+                s.startDeg = s.endDeg = *v;
+                g.sweeps.push_back(s);
+            }
+            if (g.sweeps.empty()) xml::fail(*c, path, "a <pose> names the rotary axes' angles, e.g. <pose A=\"30\" C=\"90\"/>");
+            r.groups.push_back(g);
+        } else {
+            xml::unknownElement(*c, path, {"sweep", "hold", "group", "pose"});
+        }
+    }
+    if (hasDirect) {
+        bool moving = false;
+        for (const RotarySweep& s : direct.sweeps) moving = moving || s.startDeg != s.endDeg;
+        direct.steps = moving ? wholeNumber(e, path, "steps", 8) : 0;
+        r.groups.insert(r.groups.begin(), direct);
+    } else if (xml::has(e, "steps")) {
+        xml::fail(e, path, "'steps' applies to <sweep> children of <sphere> (a <group> has its own)");
+    }
+    try {
+        r.validate();
+    } catch (const ModelError& ex) {
+        xml::fail(e, path, ex.what());
+    }
+    return r;
+}
+
 Dbb5Run readDbb5Run(const XMLElement& e, const std::string& path) {
     xml::allowAttributes(e, path, {"name", "kind", "LB", "tool-length", "ball", "start", "end", "step", "plane", "cone-tilt",
                                    "tool-angle", "bar-angle", "setup", "axis", "direction"});
@@ -409,15 +508,19 @@ MeasurementPlan readPlanXml(const std::string& path) {
         } else if (kind == "circle") {
             plan.circleRuns.push_back(readCircleRun(*e, path, instrument));
             name = plan.circleRuns.back().name;
+        } else if (kind == "sphere") {
+            plan.sphereRuns.push_back(readSphereRun(*e, path));
+            name = plan.sphereRuns.back().name;
         } else {
-            xml::fail(*e, path, fmt::format("expected <run>, <absolute-run>, <rtest>, <dbb5> or <circle> (or one <instrument>); "
+            xml::fail(*e, path, fmt::format("expected <run>, <absolute-run>, <rtest>, <dbb5>, <circle> or <sphere> (or one "
+                                            "<instrument>); "
                                             "did you mean <{}>?",
-                                            xml::nearestName(kind, {"run", "absolute-run", "rtest", "dbb5", "circle", "instrument"})));
+                                            xml::nearestName(kind, {"run", "absolute-run", "rtest", "dbb5", "circle", "sphere", "instrument"})));
         }
         if (!names.insert(name).second) xml::fail(*e, path, fmt::format("run name '{}' is used twice", name));
     }
     if (plan.runCount() == 0)
-        xml::fail(root, path, "a plan needs at least one run (<run>, <absolute-run>, <rtest>, <dbb5> or <circle>)");
+        xml::fail(root, path, "a plan needs at least one run (<run>, <absolute-run>, <rtest>, <dbb5>, <circle> or <sphere>)");
     return plan;
 }
 
@@ -493,6 +596,33 @@ std::string formatPlanXml(const MeasurementPlan& plan) {
         o << ">\n";
         for (const auto& [axis, deg] : r.hold) o << fmt::format("    <hold axis=\"{}\" deg=\"{:g}\"/>\n", esc(axis), deg);
         o << "  </circle>\n";
+    }
+    for (const auto& r : plan.sphereRuns) {
+        o << fmt::format("  <sphere name=\"{}\" centre=\"{}\" diameter=\"{:g}\" stylus-diameter=\"{:g}\" tool-length=\"{:g}\" "
+                         "approach=\"{:g}\" feed=\"{:g}\" clearance=\"{:g}\" latitude=\"{:g}\" ring=\"{}\"",
+                         esc(r.name), vec(r.centre), r.diameter, r.stylusDiameter, r.toolLength, r.approach, r.feed,
+                         r.clearance, r.latitudeDeg, r.ringTouches);
+        if (r.window == r.window) o << fmt::format(" window=\"{:g}\"", r.window);
+        if (r.triggerOffset != 0) o << fmt::format(" trigger-offset=\"{:g}\"", r.triggerOffset);
+        if (!r.estimateTrigger) o << " estimate-trigger=\"false\"";
+        if (!r.sphereOffset.isZero()) o << fmt::format(" sphere-offset=\"{}\"", vec(r.sphereOffset));
+        if (r.triggerError != 0) o << fmt::format(" trigger-error=\"{:g}\"", r.triggerError);
+        o << ">\n";
+        for (const SpherePoseGroup& g : r.groups) {
+            if (g.steps == 0) {
+                o << "    <pose";
+                for (const RotarySweep& s : g.sweeps) o << fmt::format(" {}=\"{:g}\"", esc(s.axis), s.startDeg);
+                o << "/>\n";
+                continue;
+            }
+            o << fmt::format("    <group steps=\"{}\">\n", g.steps);
+            for (const RotarySweep& s : g.sweeps) {
+                if (s.startDeg == s.endDeg) o << fmt::format("      <hold axis=\"{}\" deg=\"{:g}\"/>\n", esc(s.axis), s.startDeg);
+                else o << fmt::format("      <sweep axis=\"{}\" start=\"{:g}\" end=\"{:g}\"/>\n", esc(s.axis), s.startDeg, s.endDeg);
+            }
+            o << "    </group>\n";
+        }
+        o << "  </sphere>\n";
     }
     o << "</plan>\n";
     return o.str();

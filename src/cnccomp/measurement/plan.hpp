@@ -9,6 +9,7 @@
 #include "cnccomp/linear_circle_run.hpp"
 #include "cnccomp/measurement/dbb5_run.hpp"
 #include "cnccomp/measurement/rtest_run.hpp"
+#include "cnccomp/measurement/sphere_run.hpp"
 
 namespace cnccomp {
 
@@ -24,9 +25,11 @@ struct MeasurementPlan {
     std::vector<RtestRun> rtestRuns;       ///< <rtest>
     std::vector<Dbb5Run> dbb5Runs;         ///< <dbb5>
     std::vector<LinearCircleRun> circleRuns;  ///< <circle>
+    std::vector<SphereRun> sphereRuns;     ///< <sphere> (touch probe on a calibration sphere)
     /// Total number of runs of every kind.
     size_t runCount() const {
-        return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size() + circleRuns.size();
+        return runs.size() + absoluteRuns.size() + rtestRuns.size() + dbb5Runs.size() + circleRuns.size() +
+               sphereRuns.size();
     }
 };
 

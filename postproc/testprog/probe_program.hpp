@@ -1,0 +1,70 @@
+#pragma once
+// `cnccomp testprog` for the sphere runs of a plan (measurement/sphere_run.hpp): ONE probing program for all of them,
+// in four dialects, and the result file it writes (io/probe_log.hpp: "TOUCH <pose> <touch> [<flag>] X Y Z A B C").
+// The moves are sphereCommands() (identification/sphere_probe.hpp) in the controller's machine coordinates
+// (MachineModel::toController), joint mode (no tool-tip transformation), work offset zero, no tool length offset.
+//
+// Per pose: the park axis (the tool axis, e.g. Z) up to the park value, the other axes to the pose (rotary axes at the
+// pose's angles, the stylus over the safe point), the park axis down to the safe point; per touch: rapid to the point
+// above the touch, rapid to the approach point, the probing move towards the target (the stylus ball centre `approach`
+// mm inside the nominal surface) at the plan's feed, the result line, rapid back to the approach point and up.
+//
+// LinuxCNC (the contract with tests/linuxcnc): (LOGOPEN,<log>) at the top; each touch
+//     G38.3 X.. Y.. Z.. F<feed>
+//     (LOG,TOUCH <pose> <touch> #5070 #5061 #5062 #5063 #5064 #5065 #5066)
+// G38.3 = probe towards the piece, stop on contact, NO error when the probe does not trip: #5070 = 1 tripped, 0 not,
+// #5061–#5069 = X Y Z A B C U V W of the controlled point where it tripped (the programmed point if it did not), in the
+// current work coordinate system (LinuxCNC docs/src/gcode/g-code.adoc "G38.n Straight Probe";
+// src/emc/rs274ngc/interp_parameter_def.hh G38_X=5061 … G38_TRIPPED=5070). A missed touch is logged with 0 and the
+// program goes on (it retracts along the same line), so the log names every miss; the reader refuses it.
+// (LOG,...) expands #n with "%lf" (six decimals; src/emc/rs274ngc/interp_convert.cc convert_param_comment);
+// LOGOPEN truncates the file, LOGCLOSE closes it (docs/src/gcode/overview.adoc "Logging").
+//
+// Fanuc: G31 skip move; the skip position #5061–#5063 (#5064… for the 4th… axis, in the order of the controlled axes),
+// written with POPEN / DPRNT / PCLOS (Fanuc 30i operator's manual B-64484EN, "Custom macro", "External output
+// commands"; CONTROLLERS.md); no trip flag: the reader takes a touch at the end of its move as missed.
+// Sinumerik: MEAS=1 G01 (measure with deletion of distance-to-go, probe 1), $AC_MEA[1] (probe 1 triggered) and
+// $AA_MM[axis] (measured position, machine coordinate system), written with WRITE to the file CNCCOMP_PROBE
+// (Sinumerik 840D sl Job planning 6FC5398-2BP40, "Measurements with touch-trigger probe", "WRITE"); [G] for details
+// marked in the program.
+// HEIDENHAIN: TCH PROBE 4 MEASURING IN 3-D along the touch normal (results in Q1–Q3) and FN 16: F-PRINT with the
+// format file PROBE.A to TNC:\CNCCOMP-PROBE.TXT (TNC 640 user's manuals: touch probe cycles 1303431, Klartext
+// 1303406 "FN 16: F-PRINT"); marked [G] where not confirmed.
+#include <string>
+#include <vector>
+
+#include "cnccomp/io/plan_xml.hpp"
+#include "postproc/testprog/program_syntax.hpp"
+
+namespace cnccomp::testprog {
+
+struct ProbeProgramOptions {
+    ProgramDialect dialect = ProgramDialect::LinuxCnc;
+    std::string log = "cnccomp-probe.txt";  ///< result file the program writes (LinuxCNC LOGOPEN, Sinumerik WRITE, …)
+    int decimals = 6;
+    std::string machineFile, planFile;      ///< for the header (file names only)
+};
+
+struct ProbeProgramFile {
+    std::string file, text;
+};
+
+struct ProbeProgram {
+    std::vector<ProbeProgramFile> files;  ///< the program first (HEIDENHAIN: also the FN 16 format file)
+    int poses = 0, touches = 0;
+    /// Commanded probing targets, in program order (description frame), with their pose and touch numbers.
+    struct Target {
+        int pose = 0, touch = 0;
+        AxisVector approach, target;
+    };
+    std::vector<Target> targets;
+};
+
+/// File name of the probing program: "probe" + the dialect's extension ("PROBE.h" for HEIDENHAIN).
+std::string probeProgramFileName(ProgramDialect d);
+
+/// The probing program of the plan's sphere runs. Throws ModelError (sphereCommands) naming the run, pose and touch
+/// for a point outside the travel; the plan must have sphere runs.
+ProbeProgram makeProbeProgram(const MachineModel& machine, const MeasurementPlan& plan, const ProbeProgramOptions& options);
+
+}  // namespace cnccomp::testprog
