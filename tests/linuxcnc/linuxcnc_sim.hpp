@@ -121,7 +121,7 @@ struct RunResult {
 /// Runs LinuxCNC on the configuration with a job (lines `mdi <G-code>` / `record <label>` / `auto <program file>` /
 /// `sample <program file>` / `setp <pin or parameter> <value>`, see driver.py) and returns the records. Throws std::runtime_error with the end of
 /// LinuxCNC's log when the run fails; a run that LinuxCNC aborted with "Queue is not empty after probing" (an upstream
-/// race after probe moves, see run()) starts again, at most 4 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
+/// race after probe moves, see run()) starts again, at most 6 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
 /// (INI, HAL, job, log) is copied there.
 RunResult run(const SimConfig& c, const std::vector<std::string>& job);
 /// The records of run() (the MDI tests).
