@@ -300,14 +300,18 @@ RunResult run(const SimConfig& c, const std::vector<std::string>& job) {
         // The linuxcnc script exits 0 even when stopped by a signal: the output file is the proof of success.
         if (const char* keep = std::getenv("CNCCOMP_LINUXCNC_KEEP"))  // debugging: a copy of the run's folder
             fs::copy(c.dir, keep, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
-        if (rc == 0 && fs::exists(out)) break;
+        const std::string text = readText(log.string());
+        // LinuxCNC's error channel holds one message: when another follows the race's error, the driver can miss it
+        // and finish the job with the aborted program's LOG lines lost (the likely cause of one run, after retries,
+        // whose LOG file had no lines). The race's message in LinuxCNC's own log is therefore checked too.
+        const bool raced = text.find("Queue is not empty after probing") != std::string::npos;
+        if (rc == 0 && fs::exists(out) && !raced) break;
         // A race of LinuxCNC's task with motion after a probe move aborts a program now and then ("Queue is not empty
         // after probing": LinuxCNC issues #263, #662, #3650, fix proposed in pull request #3971 — in AUTO the
         // read-ahead after a probe does not wait for motion's queue as MDI does), here about once in 100-250 G38.2
         // moves on a loaded machine, more often with the kinematics component (up to one run in two of 95 probe moves).
         // The run is LinuxCNC's, not ours: it starts again from scratch (at most 6 times in all).
-        const std::string text = readText(log.string());
-        if (attempt < 5 && text.find("Queue is not empty after probing") != std::string::npos) {
+        if (attempt < 5 && raced) {
             ++result.retries;
             continue;
         }
