@@ -44,8 +44,8 @@ constexpr int kServoPeriodNs = 100000;  // 0.1 ms
 constexpr double kFeed = 300;           // mm/min of the G38.2 moves: 0.5 um per servo cycle
 constexpr double kPerCycle = kFeed / 60.0 * kServoPeriodNs * 1e-9;
 // [TASK] CYCLE_TIME 10 ms instead of 1 ms: LinuxCNC's "Queue is not empty after probing" race (linuxcnc_sim.hpp, run())
-// aborted 2 of 5 runs of the compensated program's 24 G38.2 moves at 1 ms, none of 8 at 5 and 10 ms (this machine,
-// loaded); run() starts a run again when it happens all the same.
+// aborted 2 of 5 runs of the compensated program's 24 G38.2 moves at 1 ms, 1 of 9 at 5 and 10 ms (this machine, loaded;
+// few runs: a hint, not a measurement); run() starts a run again when it happens.
 constexpr double kTaskCycle = 0.01;
 
 /// The truth of the check: every location error of A and C the component has, a few tens of µm / arcsec.
