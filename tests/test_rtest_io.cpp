@@ -115,7 +115,7 @@ TEST(RtestIo, PlanErrorsNameFileAndLine) {
                        "<dbb5 name=\"a\" kind=\"linear\" plane=\"XY\" LB=\"100\" ball=\"0 0 0\"/>\n</plan>\n");
     expectInputError([&] { readPlanXml(f); }, {f + ":3", "used twice"});
     test::writeText(f, "<plan>\n<probe name=\"a\"/>\n</plan>\n");
-    expectInputError([&] { readPlanXml(f); }, {f + ":2", "expected <run>, <absolute-run>, <rtest>, <dbb5> or <circle>"});
+    expectInputError([&] { readPlanXml(f); }, {f + ":2", "expected <run>, <absolute-run>, <rtest>, <dbb5>, <circle> or <sphere>"});
 }
 
 TEST(RtestIo, TraceCsvRoundTripAndMismatchErrors) {

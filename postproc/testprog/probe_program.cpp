@@ -96,7 +96,7 @@ public:
                 const Kinematics nominal(m_);
                 (void)from;
                 block("TCH PROBE 4.0 MEASURING IN 3-D");
-                block("TCH PROBE 4.1 Q1");
+                block("TCH PROBE 4.1 Q20");
                 // The direction in the machine's linear axes: the commanded move from the approach to the target.
                 const AxisVector c0 = m_.toController(from), c1 = m_.toController(to);
                 std::string v;
@@ -144,7 +144,7 @@ public:
     }
     std::string sinumerikFile() const {
         std::string s;
-        for (char c : o_.log) s.push_back(std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::toupper(c)) : '_');
+        for (char c : o_.log) s.push_back(std::isalnum(static_cast<unsigned char>(c)) ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : '_');
         return s;
     }
 
@@ -182,8 +182,10 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     w.comment(fmt::format("cnccomp sphere probing: machine {} plan {}", o.machineFile.empty() ? m.name : o.machineFile,
                           o.planFile));
     w.comment(kKinematicsModeLine);
+    int touches = 0;
+    for (const SphereRunCommands& rc : cmds.runs) touches += static_cast<int>(rc.poses.size()) * rc.run.touchesPerPose();
     w.comment(fmt::format("{} poses, {} touches; result file {}: one line per touch TOUCH <pose> <touch> {}X Y Z A B C",
-                          cmds.poseCount(), 0, o.log, d == ProgramDialect::Fanuc || d == ProgramDialect::Heidenhain ? "" : "<flag 1 triggered 0 missed> "));
+                          cmds.poseCount(), touches, o.log, d == ProgramDialect::Fanuc || d == ProgramDialect::Heidenhain ? "" : "<flag 1 triggered 0 missed> "));
     for (const SphereRunCommands& rc : cmds.runs)
         w.comment(fmt::format("sphere {}: centre {:g} {:g} {:g} mm diameter {:g} stylus {:g} tool length {:g} approach {:g} "
                               "feed {:g} clearance {:g}",
@@ -218,7 +220,8 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
             w.block("CYCL DEF 7.1 X+0");
             w.block("CYCL DEF 7.2 Y+0");
             w.block("CYCL DEF 7.3 Z+0");
-            w.comment("[G] TCH PROBE 4 results (Q1..Q3) taken as the stylus ball centre at the trigger");
+            w.comment("[G] TCH PROBE 4 MEASURING IN 3-D block syntax (4.1 result Q, 4.2 incremental vector, 4.3 DIST F TL)");
+            w.comment("results from Q115-Q117: spindle position at the contact (TNC 640 preassigned Q parameters)");
             w.comment("[G] FN 16 appends each output to the file when the program writes it again");
             break;
     }
@@ -262,15 +265,14 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
         case ProgramDialect::Sinumerik: w.block("M30"); break;
         case ProgramDialect::Heidenhain: w.block(fmt::format("END PGM {} MM", name)); break;
     }
-    // The touch count in the header.
-    const std::string placeholder = fmt::format("{} poses, 0 touches", cmds.poseCount());
-    if (const size_t p = w.text.find(placeholder); p != std::string::npos)
-        w.text.replace(p, placeholder.size(), fmt::format("{} poses, {} touches", cmds.poseCount(), out.touches));
     out.files.push_back({probeProgramFileName(d), w.text});
     if (d == ProgramDialect::Heidenhain) {
         // FN 16 format file: the text with %-formats, then the Q parameters (TNC 640 Klartext manual, FN 16).
-        std::string a = "\"TOUCH %1.0LF %1.0LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF\", Q100, Q101, Q1, Q2, Q3, Q4, "
-                        "Q5, Q6;\n";
+        // Q115–Q117: the spindle position at the contact (stylus length and ball radius not compensated), i.e. the
+        // machine axes' values under TOOL CALL 0 and a zero datum (TNC 640 user's manual, "Preassigned Q parameters:
+        // coordinates after probing during program run"); Q4–Q6: the pose's A B C as commanded.
+        std::string a = "\"TOUCH %1.0LF %1.0LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF %10.6LF\", Q100, Q101, Q115, Q116, Q117, "
+                        "Q4, Q5, Q6;\n";
         out.files.push_back({"PROBE.A", a});
     }
     return out;

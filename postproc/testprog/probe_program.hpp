@@ -20,16 +20,20 @@
 // (LOG,...) expands #n with "%lf" (six decimals; src/emc/rs274ngc/interp_convert.cc convert_param_comment);
 // LOGOPEN truncates the file, LOGCLOSE closes it (docs/src/gcode/overview.adoc "Logging").
 //
-// Fanuc: G31 skip move; the skip position #5061–#5063 (#5064… for the 4th… axis, in the order of the controlled axes),
-// written with POPEN / DPRNT / PCLOS (Fanuc 30i operator's manual B-64484EN, "Custom macro", "External output
-// commands"; CONTROLLERS.md); no trip flag: the reader takes a touch at the end of its move as missed.
-// Sinumerik: MEAS=1 G01 (measure with deletion of distance-to-go, probe 1), $AC_MEA[1] (probe 1 triggered) and
-// $AA_MM[axis] (measured position, machine coordinate system), written with WRITE to the file CNCCOMP_PROBE
-// (Sinumerik 840D sl Job planning 6FC5398-2BP40, "Measurements with touch-trigger probe", "WRITE"); [G] for details
-// marked in the program.
-// HEIDENHAIN: TCH PROBE 4 MEASURING IN 3-D along the touch normal (results in Q1–Q3) and FN 16: F-PRINT with the
-// format file PROBE.A to TNC:\CNCCOMP-PROBE.TXT (TNC 640 user's manuals: touch probe cycles 1303431, Klartext
-// 1303406 "FN 16: F-PRINT"); marked [G] where not confirmed.
+// Fanuc: G31 skip move; the skip position #5061–#5063 (#5064… for the 4th… axis, in the order of the controlled axes
+// [G]), written with POPEN / DPRNT / PCLOS; DPRNT[TOUCH*#100[40]*…*#5061[44]…]: text A–Z and '*' (a blank), a variable
+// with [integer digits, fraction digits], at most 8 together, leading blanks, no point when the fraction has no digits
+// (Fanuc-compatible "Formatted Output (DPRNT)" as in the Haas mill operator's manual 96-8000 and the Fanuc custom macro
+// chapter); no trip flag: the reader takes a touch at the end of its move as missed.
+// Sinumerik: MEAS=1 G01 (measure with deletion of distance-to-go, probe 1: "the positions coinciding with the switching
+// edge of the probe are acquired for all axes programmed in the NC block", Job planning 6FC5398-2BP10 section 5.7
+// "Measurements with touch trigger probe (MEAS, MEAW)"), $AC_MEA[1] (probe 1 triggered) and $AA_MM[axis] (measured
+// position, machine coordinate system), written with WRITE to the file CNCCOMP_PROBE_TXT [G: WRITE's file naming and
+// the REAL-to-string form of '<<'].
+// HEIDENHAIN: TCH PROBE 4 MEASURING IN 3-D along the touch's move [G: block syntax], the contact position from Q115–Q117
+// ("coordinates of the spindle position at the moment of contact … length of the stylus and radius of the ball tip are
+// not compensated", TNC 640 user's manual, "Preassigned Q parameters"), written by FN 16: F-PRINT with the format file
+// PROBE.A to TNC:\<log> [G: format-file syntax, appending on repeated output].
 #include <string>
 #include <vector>
 

@@ -8,6 +8,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
 #include "postproc/klartext_correct.hpp"
+#include "postproc/lexer.hpp"
 #include "postproc/modal.hpp"
 #include "postproc/poses.hpp"
 
@@ -47,6 +48,72 @@ std::vector<PoseRow> readPoses(const MachineModel& m, std::string_view text, pp:
         rows.push_back(std::move(r));
     }
     return rows;
+}
+
+std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view text, pp::Dialect dialect,
+                                         const std::string& source) {
+    std::vector<AxisVector> out;
+    AxisVector cur = AxisVector::Zero(m.axisCount());  // controller coordinates (mm, rad)
+    const auto set = [&](char letter, double value) {
+        const int a = m.axisIndex(std::string(1, letter));
+        if (a >= 0) cur[a] = m.axisLink(a).kind == AxisKind::Rotary ? value * kDeg : value;
+    };
+    std::istringstream in{std::string(text)};
+    std::string raw;
+    long line = 0;
+    while (std::getline(in, raw)) {
+        ++line;
+        std::string_view l = trim(raw);
+        if (dialect == pp::Dialect::Heidenhain) {
+            // "<n> L X+1.0 Y+2.0 Z+3.0 R0 FMAX", "<n> TCH PROBE 4.2 IX+0.1 IY-0.2 IZ+0.0"
+            std::istringstream w{std::string(l)};
+            std::vector<std::string> t;
+            for (std::string s; w >> s;) t.push_back(s);
+            if (t.size() >= 2 && t[1] == "L") {
+                for (size_t i = 2; i < t.size(); ++i)
+                    if (t[i].size() > 1 && std::string_view("XYZABC").find(t[i][0]) != std::string_view::npos)
+                        if (const auto v = parseNumber(std::string_view(t[i]).substr(1))) set(t[i][0], *v);
+            } else if (t.size() >= 4 && t[1] == "TCH" && t[2] == "PROBE" && t[3] == "4.2") {
+                AxisVector target = cur;
+                for (size_t i = 4; i < t.size(); ++i) {
+                    const auto v = t[i].size() > 2 && t[i][0] == 'I' ? parseNumber(std::string_view(t[i]).substr(2)) : std::nullopt;
+                    const int a = t[i].size() > 2 ? m.axisIndex(std::string(1, t[i][1])) : -1;
+                    if (!v || a < 0) throw InputError(source, static_cast<int>(line), fmt::format("'{}' is not an incremental axis word", t[i]));
+                    target[a] += *v;
+                }
+                out.push_back(m.fromController(target));
+            }
+            continue;
+        }
+        std::string code(l);
+        bool probe = false;
+        if (dialect == pp::Dialect::Sinumerik && code.rfind("N", 0) == 0 && code.find(" MEAS=") != std::string::npos) {
+            const size_t p = code.find(" MEAS=");
+            const size_t e = code.find(' ', p + 1);
+            code.erase(p, e - p);  // the measuring keyword; the rest is a G01 block
+            probe = true;
+        }
+        pp::LexedBlock b;
+        pp::lexBlock(code, dialect, b, line == 1);
+        bool motion = false;
+        for (int i = 0; i < b.count; ++i) {
+            const pp::Word& w = b.words[static_cast<size_t>(i)];
+            if (w.letter != 'G' || w.kind != pp::ValueKind::Number) continue;
+            if (w.value == 0 || w.value == 1) motion = true;
+            if (dialect == pp::Dialect::Rs274ngc && w.value >= 38.15 && w.value <= 38.55) probe = true;
+            if (dialect == pp::Dialect::Fanuc && w.value == 31) probe = true;
+        }
+        if (!motion && !probe) continue;
+        if (b.flags & pp::kNotEvaluable)
+            throw InputError(source, static_cast<int>(line), fmt::format("a motion block that cannot be evaluated ({})",
+                                                                         pp::lexFlagReason(b.flags)));
+        for (int i = 0; i < b.count; ++i) {
+            const pp::Word& w = b.words[static_cast<size_t>(i)];
+            if (std::string_view("XYZABC").find(w.letter) != std::string_view::npos) set(w.letter, w.value);
+        }
+        if (probe) out.push_back(m.fromController(cur));
+    }
+    return out;
 }
 
 namespace {

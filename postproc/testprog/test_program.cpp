@@ -289,6 +289,8 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
 
 TestProgramSet makeTestPrograms(const MachineModel& m, const MeasurementPlan& plan, const TestProgramOptions& o) {
     const std::vector<RunMotion> motions = planMotions(m, plan);
+    if (motions.empty() && !plan.sphereRuns.empty())
+        throw ModelError("the plan's sphere runs are probed by one program (probe_program.hpp: makeProbeProgram)");
     if (motions.empty()) throw ModelError("the plan has no runs");
     TestProgramSet set;
     set.index = "order,run,kind,file,samples,first_pass,arcs,overshoot_start_deg,overshoot_end_deg\n";

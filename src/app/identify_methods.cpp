@@ -430,8 +430,10 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
 // ---- touch probe on a calibration sphere (issue 21)
 
 /// Default unknowns of a sphere plan: the location errors of every rotary axis the plan turns, except the two no
-/// sphere centre can show: the position along the axis' own line and its zero position (rotation about itself). For a
-/// table-table A/C machine: EY0A EZ0A EB0A EC0A EX0C EY0C EA0C EB0C.
+/// sphere centre can show: the position along the axis' own line and its zero position (rotation about itself); and
+/// the squareness of the linear axes (rotations of linear-axis links), which the stylus' travel over the poses
+/// determines (the sample plan: about 1″ for σ = 1 µm per touch). For a table-table A/C machine: EY0A EZ0A EB0A EC0A
+/// EX0C EY0C EA0C EB0C and EC0Y EB0Z EA0Z.
 std::vector<int> sphereDefaults(const MachineModel& m, const Observations& obs) {
     std::set<std::string> turning;
     for (const auto& o : obs)
@@ -441,6 +443,10 @@ std::vector<int> sphereDefaults(const MachineModel& m, const Observations& obs) 
         const DeviationDef& d = m.deviations[static_cast<size_t>(i)];
         if (d.kind != DeviationKind::Location) continue;
         const Link* l = &m.chain(d.side).links[static_cast<size_t>(d.link)];
+        if (l->kind == AxisKind::Linear && d.isAngle()) {
+            out.push_back(i);
+            continue;
+        }
         if (l->kind != AxisKind::Rotary || !turning.count(l->name)) continue;
         const Vec3 axis = l->direction.normalized();
         const int c = d.component;  // 0..2 translation x y z, 3..5 rotation a b c

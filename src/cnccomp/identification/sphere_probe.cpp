@@ -275,6 +275,16 @@ std::vector<std::vector<std::vector<AxisVector>>> checkedTouches(const MachineMo
                                  m.axisNames[static_cast<size_t>(a)], q[a] / kDeg, pc.safe[a] / kDeg));
             }
         }
+        // No flag in the file (Fanuc, HEIDENHAIN): a touch at the end of its probing move did not trigger.
+        if (t.triggered < 0) {
+            const AxisVector& end = pc.touches[static_cast<size_t>(t.touch)].target;
+            bool atEnd = true;
+            for (int a = 0; a < m.axisCount(); ++a)
+                if (m.axisLink(a).kind == AxisKind::Linear) atEnd = atEnd && std::abs(q[a] - end[a]) < 1e-4;
+            if (atEnd)
+                fail(fmt::format("missed: the probe stopped at the end of its probing move (sphere run '{}'); not fitted",
+                                 rc.run.name));
+        }
         const double dev = (nom.toolPointInWorkpiece(q, stylusPoint(m, rc.run)) - rc.run.centre).norm() - rc.run.fitRadius();
         if (std::abs(dev) > rc.run.touchWindow())
             fail(fmt::format("the stylus ball centre is {:+.4f} mm from the nominal surface, outside the expected window "

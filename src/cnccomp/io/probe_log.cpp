@@ -71,6 +71,7 @@ ProbeLog parseProbeLog(const std::string& text, const std::string& source, const
             const int i = m.axisIndex(kAxes[a]);
             if (i >= 0) t.q[i] = m.axisLink(i).kind == AxisKind::Rotary ? *v * kDeg : *v;
         }
+        t.q = m.fromController(t.q);  // the programs' coordinates are the controller's machine coordinates
         log.touches.push_back(t);
     }
     if (log.touches.empty())
@@ -90,9 +91,10 @@ std::string formatProbeLog(const ProbeLog& log, const MachineModel& m, int decim
     std::string out;
     for (const ProbeTouch& t : log.touches) {
         out += fmt::format("TOUCH {} {} {:.{}f}", t.pose, t.touch, t.triggered > 0 ? 1.0 : 0.0, decimals);
+        const AxisVector c = m.toController(t.q);
         for (const char* a : kAxes) {
             const int i = m.axisIndex(a);
-            double v = i >= 0 && i < t.q.size() ? t.q[i] : 0.0;
+            double v = i >= 0 && i < c.size() ? c[i] : 0.0;
             if (i >= 0 && m.axisLink(i).kind == AxisKind::Rotary) v /= kDeg;
             out += fmt::format(" {:.{}f}", v, decimals);
         }
