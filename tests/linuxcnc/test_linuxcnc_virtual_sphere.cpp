@@ -137,7 +137,9 @@ TEST(LinuxcncVirtualSphere, TouchesAtTheSphereAndMoveWithTheTrueErrors) {
     std::istringstream setps(vs::parameterHal(sphere, withErrors));
     for (std::string line; std::getline(setps, line);) job.push_back(line);
     job.push_back("auto " + (config.dir / "errors.ngc").string());
-    const sim::RunResult run = sim::run(config, job);
+    const sim::RunResult run = sim::run(config, job, [&] {
+        return vs::raceSuspect({config.dir / "touches-zero.txt", config.dir / "touches-errors.txt"});
+    });
 
     const DeviationSet truthSet = readDeviationCsv(dir.file("truth.csv"), m);
     const Kinematics nominal(m), actual(m, truthSet);
@@ -218,7 +220,8 @@ TEST(LinuxcncVirtualSphere, TheEmittedTrueSetPutsTheTouchesBackOnTheNominalSpher
     o.extraHal = [&](const std::string& coordinates) { return vs::hal(sphere, coordinates, s); };
     const sim::SimConfig config = sim::buildSimConfig(m, dir.path / "emitted", dir.path / "sim", {{1, 0.0}}, 0.0, o);
     writeText((config.dir / "compensated.ngc").string(), program(m, s, "touches.txt", true));
-    const sim::RunResult run = sim::run(config, {"mdi G90 G21 G94 G17 G40 G49 G54", "auto " + (config.dir / "compensated.ngc").string()});
+    const sim::RunResult run = sim::run(config, {"mdi G90 G21 G94 G17 G40 G49 G54", "auto " + (config.dir / "compensated.ngc").string()},
+                                        [&] { return vs::raceSuspect({config.dir / "touches.txt"}); });
     const std::vector<vs::Touch> touches = vs::readTouches(config.dir / "touches.txt");
     ASSERT_EQ(touches.size(), std::size(kPoses) * directions().size());
     const Kinematics nominal(m);

@@ -90,4 +90,13 @@ std::vector<Touch> readTouches(const std::filesystem::path& log) {
     return out;
 }
 
+std::string raceSuspect(const std::vector<std::filesystem::path>& logs) {
+    for (const auto& log : logs) {
+        if (!std::filesystem::exists(log)) return log.string() + " missing";
+        for (const Touch& t : readTouches(log))
+            if (!t.ok) return fmt::format("{}: pose {} touch {} logged without a trigger", log.string(), t.pose, t.touch);
+    }
+    return {};
+}
+
 }  // namespace cnccomp::test::virtual_sphere

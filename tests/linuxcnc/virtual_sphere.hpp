@@ -45,5 +45,8 @@ struct Touch {
 };
 /// Reads every TOUCH line of a log; throws std::runtime_error naming the line when one is malformed.
 std::vector<Touch> readTouches(const std::filesystem::path& log);
+/// For linuxcnc_sim::run's `suspect`: why the run looks hit by LinuxCNC's probing race (a log missing, or a touch logged
+/// with #5070 = 0 although every probing move of these programs ends inside the sphere), or empty.
+std::string raceSuspect(const std::vector<std::filesystem::path>& logs);
 
 }  // namespace cnccomp::test::virtual_sphere
