@@ -1,5 +1,5 @@
 // Uncertainty of the least-squares engine with ball-bar noise σ = 0.5 µm over 200 seeded trials on the six
-// seed-000 runs (10° steps to keep the test lean): the reported 95 % intervals cover the truth, and the
+// [MultiTasking] runs (10° steps to keep the test lean): the reported 95 % intervals cover the truth, and the
 // least-squares estimate beats the closed-form formulas (17)–(28) on the same noisy traces.
 #include <gtest/gtest.h>
 

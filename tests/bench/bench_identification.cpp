@@ -1,4 +1,4 @@
-// Least-squares identification of the 12 seed-000 deviations from the six ball-bar runs of section 5.3, on the exact
+// Least-squares identification of the 12 [MultiTasking] deviations from the six ball-bar runs of section 5.3, on the exact
 // model: each run a 360-sample trace (1° steps, the main job's; argument 360) or a 3600-sample one (0.1°). CPU time.
 #include <benchmark/benchmark.h>
 

@@ -14,6 +14,10 @@ and then works through the job file ($CNCCOMP_JOB), one command per line:
     auto <file>      runs the program in AUTO to its end (then back to MDI)
     sample <file>    the same with the HAL sampler (sampler.0, enabled only while the program runs) read by halsampler
                      into $CNCCOMP_OUT.samples: one line per servo cycle, "<cycle> <value> ..." (halsampler -t, %f)
+    setp <name> <value>
+                     sets a HAL pin or parameter (hal.set_p, as halcmd setp), between programs
+    setp <name> <value>
+                     sets a HAL pin or parameter (hal.set_p, as halcmd setp), between programs
 The output is written to $CNCCOMP_OUT.part and renamed when the whole job is done, so an output file means success.
 Any LinuxCNC error (error channel) or timeout ends the run with exit code 1 and the reason on stderr.
 Needs /usr/bin/python3 (the linuxcnc and hal modules of the Debian package live in the system dist-packages).
@@ -176,6 +180,12 @@ def main():
             run_program(rest)
         elif verb == "sample":
             sample_program(rest)
+        elif verb == "setp":
+            name, value = rest.split()
+            hal.set_p(name, value)
+        elif verb == "setp":
+            name, value = rest.split()
+            hal.set_p(name, value)
         else:
             raise RuntimeError("unknown job line: " + step)
     with open(OUT + ".part", "w") as f:

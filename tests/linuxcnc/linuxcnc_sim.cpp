@@ -70,7 +70,7 @@ COMM_TIMEOUT = 30.0
 
 [TASK]
 TASK = milltask
-CYCLE_TIME = 0.001
+CYCLE_TIME = {}
 
 [EMCIO]
 EMCIO = io
@@ -80,7 +80,7 @@ TOOL_TABLE = sim.tbl
 [HAL]
 # README.txt: the route's HAL file loaded after the machine's own HAL file (its setp lines win)
 HALFILE = base.hal
-HALFILE = {}
+HALFILE = {}{}
 
 [TRAJ]
 COORDINATES = {}
@@ -92,8 +92,9 @@ DEFAULT_LINEAR_ACCELERATION = 5000
 MAX_LINEAR_ACCELERATION = 100000
 MAX_ANGULAR_VELOCITY = 50000
 )",
-                                m.name, coordinates, coordinates.size(), o.servoPeriodNs,
-                                o.route == Route::Pins ? "cnccomp.hal" : "cnccomp-kins.hal", coordinates);
+                                m.name, coordinates, coordinates.size(), o.servoPeriodNs, o.taskCycle,
+                                o.route == Route::Pins ? "cnccomp.hal" : "cnccomp-kins.hal",
+                                o.extraHal ? "\nHALFILE = harness.hal" : "", coordinates);
     for (char c : coordinates)
         s += fmt::format("\n[AXIS_{}]\nMIN_LIMIT = -100000\nMAX_LIMIT = 100000\nMAX_VELOCITY = 50000\nMAX_ACCELERATION = 50000\n", c);
     for (size_t n = 0; n < coordinates.size(); ++n) {
@@ -221,6 +222,7 @@ SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const f
     c.ini = dir / "sim.ini";
     writeText(c.ini.string(), mergeIni(baseIni(m, c.coordinates, backlash, o), fragment));
     writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled, o.switchkins));
+    if (o.extraHal) writeText((dir / "harness.hal").string(), o.extraHal(c.coordinates));
     if (kins) {
         writeText((dir / "cnccomp-kins.hal").string(), routeText("cnccomp-kins.hal"));
     } else {
@@ -244,10 +246,10 @@ std::string componentUnavailableReason() {
     return {};
 }
 
-double installComponent(const fs::path& emitted, const std::string& module, const fs::path& work) {
+double installComp(const fs::path& source, const std::string& name, const std::string& module, const fs::path& work) {
     fs::create_directories(work);
-    std::string t = readText((emitted / "cnccomp_kins.comp").string());
-    for (size_t at = 0; (at = t.find("cnccomp_kins", at)) != std::string::npos; at += module.size()) t.replace(at, 12, module);
+    std::string t = readText(source.string());
+    for (size_t at = 0; (at = t.find(name, at)) != std::string::npos; at += module.size()) t.replace(at, name.size(), module);
     const fs::path src = work / (module + ".comp"), log = work / "halcompile.log";
     writeText(src.string(), t);
     const auto t0 = std::chrono::steady_clock::now();
@@ -259,18 +261,21 @@ double installComponent(const fs::path& emitted, const std::string& module, cons
     return seconds;
 }
 
+double installComponent(const fs::path& emitted, const std::string& module, const fs::path& work) {
+    return installComp(emitted / "cnccomp_kins.comp", "cnccomp_kins", module, work);
+}
+
 void uninstallComponent(const std::string& module) {
     std::error_code ec;
     for (const char* dir : {"/usr/lib/linuxcnc/modules/", "/usr/realtime/modules/"}) fs::remove(fs::path(dir) / (module + ".so"), ec);
 }
 
-RunResult run(const SimConfig& c, const std::vector<std::string>& job) {
+RunResult run(const SimConfig& c, const std::vector<std::string>& job, const std::function<std::string()>& suspect) {
     RunResult result;
     const fs::path jobFile = c.dir / "job.txt", out = c.dir / "records.txt", log = c.dir / "linuxcnc.log";
     std::string jobText;
     for (const std::string& l : job) jobText += l + "\n";
     writeText(jobFile.string(), jobText);
-    fs::remove(out);
     std::string env = "env -u DISPLAY CNCCOMP_JOB=" + shellQuote(jobFile.string()) + " CNCCOMP_OUT=" + shellQuote(out.string());
     if (geteuid() == 0) {
         // rtapi_app refuses root: it runs as 'nobody' and needs a fifo folder that user can reach and write
@@ -284,16 +289,40 @@ RunResult run(const SimConfig& c, const std::vector<std::string>& job) {
         fs::permissions(fifo, fs::perms::all | fs::perms::sticky_bit);
         env += " RTAPI_UID=65534 RTAPI_FIFO_PATH=" + shellQuote((fifo / "rtapi_fifo").string());
     }
-    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 900 linuxcnc -r " + shellQuote(c.ini.string()) +
+    // nice -10 (root only; otherwise nice warns and runs it as it is): LinuxCNC's threads are POSIX non-realtime here,
+    // the less other work preempts them the rarer the probing race below.
+    const std::string cmd = "cd " + shellQuote(c.dir.string()) + " && " + env + " timeout 900 nice -n -10 linuxcnc -r " + shellQuote(c.ini.string()) +
                             " > " + shellQuote(log.string()) + " 2>&1 < /dev/null";
     const auto t0 = std::chrono::steady_clock::now();
-    const int rc = std::system(cmd.c_str());
+    for (int attempt = 0;; ++attempt) {
+        fs::remove(out);
+        const int rc = std::system(cmd.c_str());
+        // The linuxcnc script exits 0 even when stopped by a signal: the output file is the proof of success.
+        if (const char* keep = std::getenv("CNCCOMP_LINUXCNC_KEEP"))  // debugging: a copy of the run's folder
+            fs::copy(c.dir, keep, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+        const std::string text = readText(log.string());
+        // LinuxCNC's error channel holds one message: when another follows the race's error, the driver can miss it
+        // and finish the job with the aborted program's LOG lines lost (the likely cause of one run, after retries,
+        // whose LOG file had no lines). The race's message in LinuxCNC's own log is therefore checked too.
+        bool raced = text.find("Queue is not empty after probing") != std::string::npos;
+        if (rc == 0 && fs::exists(out) && !raced) {
+            const std::string why = suspect ? suspect() : std::string();
+            if (why.empty()) break;
+            if (attempt == 5) throw std::runtime_error(fmt::format("LinuxCNC run: {} in every one of 6 runs", why));
+            raced = true;
+        }
+        // A race of LinuxCNC's task with motion after a probe move aborts a program now and then ("Queue is not empty
+        // after probing": LinuxCNC issues #263, #662, #3650, fix proposed in pull request #3971 — in AUTO the
+        // read-ahead after a probe does not wait for motion's queue as MDI does), here about once in 100-250 G38.2
+        // moves on a loaded machine, more often with the kinematics component (up to one run in two of 95 probe moves).
+        // The run is LinuxCNC's, not ours: it starts again from scratch (at most 6 times in all).
+        if (attempt < 5 && raced) {
+            ++result.retries;
+            continue;
+        }
+        throw std::runtime_error(fmt::format("LinuxCNC run failed (exit {}), end of {}:\n{}", rc, log.string(), tail(text, 120)));
+    }
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    // The linuxcnc script exits 0 even when stopped by a signal: the output file is the proof of success.
-    if (const char* keep = std::getenv("CNCCOMP_LINUXCNC_KEEP"))  // debugging: a copy of the run's folder
-        fs::copy(c.dir, keep, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
-    if (rc != 0 || !fs::exists(out))
-        throw std::runtime_error(fmt::format("LinuxCNC run failed (exit {}), end of {}:\n{}", rc, log.string(), tail(readText(log.string()), 120)));
     std::istringstream in(readText(out.string()));
     std::string line;
     while (std::getline(in, line)) {

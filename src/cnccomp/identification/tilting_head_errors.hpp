@@ -3,7 +3,7 @@
 // for the tilting head of five-axis machine tools based on double ball bar", [FanWuLi]): geometric errors of a tilting head B from a double ball bar in Y, X and Z patterns,
 // each with two tool lengths L1 < L2. The spindle turns about Ball 1 while X/Y/Z keep Ball 1 still; Ball 2 sits at
 // its nominal position O and Δd is the length change from the nominal bar length (absolute bar, section 3.1).
-// The patterns are the seed-000 runs B-Y, B-X, B-Z (RB = L, LB = d) simulated with Ball 2 at O.
+// The patterns are the [MultiTasking] runs B-Y, B-X, B-Z (RB = L, LB = d) simulated with Ball 2 at O.
 //
 // Formulas (first order, as derived in the paper, with the signs of this library's model):
 //   Y: L·Q_j + δy(B_j) = Δd_y (4)-(5);  Q_j = (Δd_y2 − Δd_y1)/(L2 − L1), δy = (L2 Δd_y1 − L1 Δd_y2)/(L2 − L1)  (7)

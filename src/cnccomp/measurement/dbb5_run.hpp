@@ -11,7 +11,7 @@
 //  - cone frustum: both rotary axes of a tilting table and the linear axes move as when a NAS 979 cone frustum is
 //    cut; the spindle ball circles the table ball on a cone (dbb5_cone_frustum.hpp).
 // The table ball is set where the spindle ball stands at the setup pose (sweep angle `setupDeg`, spindle ball on
-// the table ball), as for the seed-000 ball bar; ΔL = L − LB.
+// the table ball), as for the [MultiTasking] ball bar; ΔL = L − LB.
 // The run as planned (a measurement): its geometry and its sweep angles. The commands a machine runs for it, and its
 // simulation, are identification/dbb5_run.hpp.
 #include <string>
