@@ -70,11 +70,16 @@ TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
     const std::string& t = p.files[0].text;
     EXPECT_EQ(p.files[0].file, "probe.ngc");
     EXPECT_NE(t.find("(LOGOPEN,run1.txt)\n"), std::string::npos);
-    EXPECT_NE(t.find("\nG38.3 X100.000000 Y50.000000 Z154.500000 F100\n"
-                     "(LOG,TOUCH 0 0 #5070 #5061 #5062 #5063 #5064 #5065 #5066)\n"),
+    // The tool length (100 mm) is given with G43.1 and taken off every Z word, as the ball-bar programs do (the generated
+    // kinematics component keeps the point at that length exact); the log carries the machine's Z, #5063 + L.
+    EXPECT_NE(t.find("\nG43.1 Z100.000000\n"), std::string::npos);
+    EXPECT_LT(t.find("G43.1"), t.find("G38.3"));
+    EXPECT_NE(t.find("\nG38.3 X100.000000 Y50.000000 Z54.500000 F100\n"
+                     "#100=[#5063+100.000000]\n"
+                     "(LOG,TOUCH 0 0 #5070 #5061 #5062 #100 #5064 #5065 #5066)\n"),
               std::string::npos);
-    EXPECT_NE(t.find("(LOG,TOUCH 22 4 #5070 #5061 #5062 #5063 #5064 #5065 #5066)"), std::string::npos);
-    EXPECT_NE(t.find("(LOGCLOSE)\nM2\n"), std::string::npos);
+    EXPECT_NE(t.find("(LOG,TOUCH 22 4 #5070 #5061 #5062 #100 #5064 #5065 #5066)"), std::string::npos);
+    EXPECT_NE(t.find("G49\n(LOGCLOSE)\nM2\n"), std::string::npos);
     EXPECT_LT(t.find("(LOGOPEN"), t.find("G38.3"));
     o.log = "a,b";
     EXPECT_THROW(testprog::makeProbeProgram(tableTable(), samplePlan(), o), ModelError);
@@ -106,14 +111,20 @@ TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheRead
     const std::string canon = test::readText(out);
     const std::regex probe(R"(STRAIGHT_PROBE\(([-0-9.]+), ([-0-9.]+), ([-0-9.]+), ([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\))");
     const std::regex logLine(R"re(LOG\("(TOUCH [^"]*)"\))re");
+    // The canonical positions leave out the tool length offset (motion adds it): USE_TOOL_LENGTH_OFFSET gives it (G43.1).
+    const std::regex offset(R"(USE_TOOL_LENGTH_OFFSET\([-0-9.]+ [-0-9.]+ ([-0-9.]+),)");
+    double toolZ = 0;
     std::vector<std::array<double, 6>> probes;
     std::string logText;
     std::istringstream in(canon);
     for (std::string l; std::getline(in, l);) {
         std::smatch s;
-        if (std::regex_search(l, s, probe)) {
+        if (std::regex_search(l, s, offset)) {
+            toolZ = std::stod(s[1]);
+        } else if (std::regex_search(l, s, probe)) {
             std::array<double, 6> v{};
             for (int k = 0; k < 6; ++k) v[static_cast<size_t>(k)] = std::stod(s[k + 1]);
+            v[2] += toolZ;
             probes.push_back(v);
         } else if (std::regex_search(l, s, logLine)) {
             logText += s[1].str() + "\n";

@@ -19,6 +19,11 @@ public:
     ProbeWriter(const MachineModel& m, const ProbeProgramOptions& o) : m_(m), o_(o), d_(o.dialect) {}
 
     std::string text;
+    /// LinuxCNC under G43.1 Z<L>: L (mm) taken off every Z word, as the ball-bar and R-test programs do
+    /// (program_syntax.hpp, passToolLength): the joints stay where they were, and the generated kinematics component
+    /// keeps the tool tip at L exact where the tool axis cannot follow (at A = 0 on an A/C table: without it, only the
+    /// spindle reference point was exact and the stylus ball 120 mm below it was off by 8–10 µm on the real LinuxCNC).
+    double zShift = 0;
 
     std::string num(double v, bool plus = false) const {
         std::string s = fmt::format("{:.{}f}", v, o_.decimals);
@@ -35,7 +40,8 @@ public:
             if (a < 0 || !(mask & (1u << a))) continue;
             const bool rotary = m_.axisLink(a).kind == AxisKind::Rotary;
             if (!out.empty()) out += ' ';
-            out += fmt::format("{}{}", l, num(rotary ? c[a] / kDeg : c[a], d_ == ProgramDialect::Heidenhain));
+            const double v = rotary ? c[a] / kDeg : l == 'Z' ? c[a] - zShift : c[a];
+            out += fmt::format("{}{}", l, num(v, d_ == ProgramDialect::Heidenhain));
         }
         return out;
     }
@@ -78,7 +84,13 @@ public:
         switch (d_) {
             case ProgramDialect::LinuxCnc:
                 block(fmt::format("G38.3 {} F{}", words(to, linear()), f));
-                block(fmt::format("(LOG,TOUCH {} {} #5070 #5061 #5062 #5063 #5064 #5065 #5066)", pose, touch));
+                if (zShift != 0) {
+                    // #5063 is in the program's coordinates, i.e. less the tool length: the log carries the machine Z.
+                    block(fmt::format("#100=[#5063+{}]", num(zShift)));
+                    block(fmt::format("(LOG,TOUCH {} {} #5070 #5061 #5062 #100 #5064 #5065 #5066)", pose, touch));
+                } else {
+                    block(fmt::format("(LOG,TOUCH {} {} #5070 #5061 #5062 #5063 #5064 #5065 #5066)", pose, touch));
+                }
                 break;
             case ProgramDialect::Fanuc:
                 block(fmt::format("#100={} #101={}", pose, touch));
@@ -226,7 +238,13 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
             break;
     }
     const unsigned park = 1u << cmds.parkAxis;
+    const bool passToolLength = d == ProgramDialect::LinuxCnc && m.axisIndex("Z") >= 0;
     for (const SphereRunCommands& rc : cmds.runs) {
+        if (passToolLength && rc.run.toolLength != w.zShift) {
+            if (rc.run.toolLength != 0) w.block("G43.1 Z" + w.num(rc.run.toolLength));  // LinuxCNC G-code reference, G43.1
+            else w.block("G49");
+            w.zShift = rc.run.toolLength;
+        }
         for (const SpherePoseCommand& pc : rc.poses) {
             std::string angles;
             for (const auto& [axis, deg] : pc.angles) angles += fmt::format(" {}={:g}", axis, deg);
@@ -254,6 +272,7 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     }
     switch (d) {
         case ProgramDialect::LinuxCnc:
+            if (w.zShift != 0) w.block("G49");
             w.block("(LOGCLOSE)");
             w.block("M2");
             break;

@@ -2,16 +2,20 @@
 // `cnccomp testprog` for the sphere runs of a plan (measurement/sphere_run.hpp): ONE probing program for all of them,
 // in four dialects, and the result file it writes (io/probe_log.hpp: "TOUCH <pose> <touch> [<flag>] X Y Z A B C").
 // The moves are sphereCommands() (identification/sphere_probe.hpp) in the controller's machine coordinates
-// (MachineModel::toController), joint mode (no tool-tip transformation), work offset zero, no tool length offset.
+// (MachineModel::toController), joint mode (no tool-tip transformation), work offset zero; LinuxCNC with G43.1 (below).
 //
 // Per pose: the park axis (the tool axis, e.g. Z) up to the park value, the other axes to the pose (rotary axes at the
 // pose's angles, the stylus over the safe point), the park axis down to the safe point; per touch: rapid to the point
 // above the touch, rapid to the approach point, the probing move towards the target (the stylus ball centre `approach`
 // mm inside the nominal surface) at the plan's feed, the result line, rapid back to the approach point and up.
 //
-// LinuxCNC (the contract with tests/linuxcnc): (LOGOPEN,<log>) at the top; each touch
+// LinuxCNC (the contract with tests/linuxcnc): (LOGOPEN,<log>) at the top; the run's tool length L given with
+// G43.1 Z<L> and every Z word written as the machine coordinate minus L (as the ball-bar and R-test programs:
+// program_syntax.hpp passToolLength); each touch
 //     G38.3 X.. Y.. Z.. F<feed>
-//     (LOG,TOUCH <pose> <touch> #5070 #5061 #5062 #5063 #5064 #5065 #5066)
+//     #100=[#5063+L]
+//     (LOG,TOUCH <pose> <touch> #5070 #5061 #5062 #100 #5064 #5065 #5066)
+// (with L = 0: no G43.1, and #5063 itself)
 // G38.3 = probe towards the piece, stop on contact, NO error when the probe does not trip: #5070 = 1 tripped, 0 not,
 // #5061–#5069 = X Y Z A B C U V W of the controlled point where it tripped (the programmed point if it did not), in the
 // current work coordinate system (LinuxCNC docs/src/gcode/g-code.adoc "G38.n Straight Probe";

@@ -54,6 +54,7 @@ std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view
                                          const std::string& source) {
     std::vector<AxisVector> out;
     AxisVector cur = AxisVector::Zero(m.axisCount());  // controller coordinates (mm, rad)
+    double zOffset = 0;                                  // the active G43.1 tool length (LinuxCNC), mm
     const auto set = [&](char letter, double value) {
         const int a = m.axisIndex(std::string(1, letter));
         if (a >= 0) cur[a] = m.axisLink(a).kind == AxisKind::Rotary ? value * kDeg : value;
@@ -99,6 +100,12 @@ std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view
         for (int i = 0; i < b.count; ++i) {
             const pp::Word& w = b.words[static_cast<size_t>(i)];
             if (w.letter != 'G' || w.kind != pp::ValueKind::Number) continue;
+            if (dialect == pp::Dialect::Rs274ngc && std::abs(w.value - 43.1) < 1e-9) {
+                // G43.1 Z<L> (LinuxCNC dynamic tool length): L is added to every later Z word.
+                for (int k = 0; k < b.count; ++k)
+                    if (b.words[static_cast<size_t>(k)].letter == 'Z') zOffset = b.words[static_cast<size_t>(k)].value;
+            }
+            if (dialect == pp::Dialect::Rs274ngc && w.value == 49) zOffset = 0;
             if (w.value == 0 || w.value == 1) motion = true;
             if (dialect == pp::Dialect::Rs274ngc && w.value >= 38.15 && w.value <= 38.55) probe = true;
             if (dialect == pp::Dialect::Fanuc && w.value == 31) probe = true;
@@ -109,7 +116,7 @@ std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view
                                                                          pp::lexFlagReason(b.flags)));
         for (int i = 0; i < b.count; ++i) {
             const pp::Word& w = b.words[static_cast<size_t>(i)];
-            if (std::string_view("XYZABC").find(w.letter) != std::string_view::npos) set(w.letter, w.value);
+            if (std::string_view("XYZABC").find(w.letter) != std::string_view::npos) set(w.letter, w.letter == 'Z' ? w.value + zOffset : w.value);
         }
         if (probe) out.push_back(m.fromController(cur));
     }

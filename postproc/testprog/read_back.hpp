@@ -45,7 +45,8 @@ ProgramCommands readTestProgram(const MachineModel& machine, const RunMotion& mo
                                 pp::Dialect dialect, const std::string& source);
 
 /// The commanded end points of the probing moves of a probing program (probe_program.hpp), in program order
-/// (description frame; axes a block does not give keep the value the program last commanded): RS274NGC G38.2–G38.5,
+/// (description frame; axes a block does not give keep the value the program last commanded; a LinuxCNC G43.1 Z<L> adds L
+/// to later Z words until G49): RS274NGC G38.2–G38.5,
 /// Fanuc G31 and Sinumerik MEAS=… G01 blocks through the post-processor's lexer (postproc/lexer.hpp); HEIDENHAIN
 /// TCH PROBE 4.2 (incremental vector) from the position of the last L block (the Klartext reader does not read TCH
 /// PROBE cycles). Throws InputError (source:line) for a probing block whose words cannot be evaluated.

@@ -133,7 +133,7 @@ struct Probed {
 /// One LinuxCNC session: the configuration of the emitted folder (component route, module installed), the virtual
 /// sphere, the program in AUTO; the centres from its log.
 Probed probe(const MachineModel& m, const fs::path& emitted, const std::string& kinsModule, const std::string& sphereModule,
-             const fs::path& dir, const fs::path& programFile, double programToolLength) {
+             const fs::path& dir, const fs::path& programFile, double logToolLength) {
     vs::Setup s;
     s.toolLength = kToolLength;
     s.ballRadius = kBallRadius;
@@ -168,8 +168,8 @@ Probed probe(const MachineModel& m, const fs::path& emitted, const std::string& 
         if (t.pose >= static_cast<int>(balls.size())) balls.resize(t.pose + 1), p.angles.resize(t.pose + 1);
         p.angles[t.pose] = {t.a, t.c};
         AxisVector q(m.axisCount());
-        // Program coordinates: the work offset is zero, the tool length of G43.1 is taken off Z (LinuxCNC's #5063).
-        q[m.requireAxis("X")] = t.x, q[m.requireAxis("Y")] = t.y, q[m.requireAxis("Z")] = t.z + programToolLength;
+        // Machine coordinates: the work offset is zero; a log of #5063 under G43.1 lacks the tool length.
+        q[m.requireAxis("X")] = t.x, q[m.requireAxis("Y")] = t.y, q[m.requireAxis("Z")] = t.z + logToolLength;
         q[m.requireAxis("A")] = t.a * kDeg, q[m.requireAxis("C")] = t.c * kDeg;
         balls[t.pose].push_back(nominal.toolPointInWorkpiece(q, nominal.toolPoint(kToolLength)));
     }
@@ -213,6 +213,9 @@ TEST(LinuxcncProbeLoop, SphereProbingIdentifiesAndCompensatesTheRotaryAxesOnTheR
     EXPECT_TRUE(text.find("G38.2") != std::string::npos || text.find("G38.3") != std::string::npos) << "probing moves";
     double programToolLength = 0;  // G43.1 Z<L>: the program's Z words are the machine's minus L
     if (std::smatch g; std::regex_search(text, g, std::regex(R"(G43\.1\s*Z\s*([-+0-9.]+))"))) programToolLength = std::stod(g[1].str());
+    // The contract (postproc/testprog/probe_program.hpp): under G43.1 the program logs #100 = #5063 + L, the machine's
+    // Z; a program that logged #5063 itself would leave L to the reader.
+    const double logToolLength = text.find(" #5063 ") != std::string::npos ? programToolLength : 0.0;
 
     // 2. Before: the uncompensated machine (the component with every deviation 0).
     const CliResult emit0 = runCli(fmt::format("emit --controller linuxcnc --machine {} --deviations {} --out {} --date 2024-01-01",
@@ -224,7 +227,7 @@ TEST(LinuxcncProbeLoop, SphereProbingIdentifiesAndCompensatesTheRotaryAxesOnTheR
     const sim::InstalledModule sphereModule{sphere};
     install += sim::installComponent(dir.path / "emitted-zero", before, dir.path / "build-before");
     const sim::InstalledModule beforeModule{before};
-    const Probed p0 = probe(m, dir.path / "emitted-zero", before, sphere, dir.path / "sim-before", program, programToolLength);
+    const Probed p0 = probe(m, dir.path / "emitted-zero", before, sphere, dir.path / "sim-before", program, logToolLength);
     ASSERT_EQ(p0.touches, 13u * 5u);
     const fs::path log0 = dir.path / "sim-before" / "cnccomp-probe.txt";
     ASSERT_TRUE(fs::exists(log0)) << "the program's log (LOGOPEN,cnccomp-probe.txt)";
@@ -244,7 +247,7 @@ TEST(LinuxcncProbeLoop, SphereProbingIdentifiesAndCompensatesTheRotaryAxesOnTheR
     const sim::InstalledModule afterModule{after};
 
     // 5. The same program again.
-    const Probed p1 = probe(m, dir.path / "emitted", after, sphere, dir.path / "sim-after", program, programToolLength);
+    const Probed p1 = probe(m, dir.path / "emitted", after, sphere, dir.path / "sim-after", program, logToolLength);
     ASSERT_EQ(p1.touches, p0.touches);
 
     // Figures.
