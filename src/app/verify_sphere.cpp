@@ -13,27 +13,10 @@
 namespace cnccomp {
 namespace {
 
-/// Parameter t in [0, 1] where the stylus, driven to drive(t), is `radius` from `sphere` (Illinois regula falsi).
+/// Parameter t in [0, 1] where the stylus, driven to drive(t), is `radius` from `sphere`.
 template <typename Drive>
 std::optional<double> trigger(const Kinematics& k, const Vec3& tip, const Drive& drive, const Vec3& sphere, double radius) {
-    const auto f = [&](double t) { return (k.toolPointInWorkpiece(drive(t), tip) - sphere).norm() - radius; };
-    double a = 0, b = 1, fa = f(a), fb = f(b);
-    if (!(fa > 0 && fb <= 0)) return std::nullopt;
-    int side = 0;
-    for (int it = 0; it < 200; ++it) {
-        const double t = (a * fb - b * fa) / (fb - fa), ft = f(t);
-        if (std::abs(ft) < 1e-13 || b - a < 1e-15) return t;
-        if (ft > 0) {
-            a = t, fa = ft;
-            if (side == 1) fb *= 0.5;
-            side = 1;
-        } else {
-            b = t, fb = ft;
-            if (side == -1) fa *= 0.5;
-            side = -1;
-        }
-    }
-    return 0.5 * (a + b);
+    return bracketedRoot([&](double t) { return (k.toolPointInWorkpiece(drive(t), tip) - sphere).norm() - radius; }, 0.0, 1.0);
 }
 
 double componentSpan(const std::vector<Vec3>& d) {

@@ -20,32 +20,15 @@ std::string poseText(const SpherePose& p) {
     return s.empty() ? "rotary axes at 0" : s;
 }
 
-/// Parameter along the probing move where the stylus centre is `radius` from `sphere`: Illinois regula falsi on
-/// f(t) = |p(t) − sphere| − radius, bracketed in [lo, hi] with f(lo) > 0 ≥ f(hi).
+/// Parameter along the probing move where the stylus centre is `radius` from `sphere`, bracketed in [lo, hi].
 std::optional<double> triggerParameter(const Kinematics& k, const Vec3& stylus, const AxisVector& from, const AxisVector& to,
                                        const Vec3& sphere, double radius, double lo, double hi) {
-    const auto f = [&](double t) {
-        const AxisVector q = from + t * (to - from);
-        return (k.toolPointInWorkpiece(q, stylus) - sphere).norm() - radius;
-    };
-    double a = lo, b = hi, fa = f(a), fb = f(b);
-    if (!(fa > 0 && fb <= 0)) return std::nullopt;
-    int side = 0;
-    for (int it = 0; it < 200; ++it) {
-        const double t = (a * fb - b * fa) / (fb - fa);
-        const double ft = f(t);
-        if (std::abs(ft) < 1e-14 || std::abs(b - a) < 1e-15) return t;
-        if (ft > 0) {
-            a = t, fa = ft;
-            if (side == 1) fb *= 0.5;
-            side = 1;
-        } else {
-            b = t, fb = ft;
-            if (side == -1) fa *= 0.5;
-            side = -1;
-        }
-    }
-    return 0.5 * (a + b);
+    return bracketedRoot(
+        [&](double t) {
+            const AxisVector q = from + t * (to - from);
+            return (k.toolPointInWorkpiece(q, stylus) - sphere).norm() - radius;
+        },
+        lo, hi);
 }
 
 AxisVector setPoseAngles(const MachineModel& m, const SphereRun& run, const SpherePose& pose) {
@@ -372,6 +355,27 @@ Observations sphereObservations(const MachineModel& machine, const SpherePlanCom
     for (size_t r = 0; r < commands.runs.size(); ++r)
         obs.push_back(std::make_unique<SphereObservation>(machine, commands.runs[r], touches[r]));
     return obs;
+}
+
+std::optional<double> bracketedRoot(const std::function<double(double)>& f, double lo, double hi) {
+    double a = lo, b = hi, fa = f(a), fb = f(b);
+    if (!(fa > 0 && fb <= 0)) return std::nullopt;
+    int side = 0;
+    for (int it = 0; it < 200; ++it) {
+        const double t = (a * fb - b * fa) / (fb - fa);
+        const double ft = f(t);
+        if (std::abs(ft) < 1e-14 || std::abs(b - a) < 1e-15) return t;
+        if (ft > 0) {
+            a = t, fa = ft;
+            if (side == 1) fb *= 0.5;
+            side = 1;
+        } else {
+            b = t, fb = ft;
+            if (side == -1) fa *= 0.5;
+            side = -1;
+        }
+    }
+    return 0.5 * (a + b);
 }
 
 }  // namespace cnccomp

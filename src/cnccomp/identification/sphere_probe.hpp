@@ -16,6 +16,7 @@
 //     half a clearance clear of every sphere of the plan.
 // Every command is checked against the travel; errors name the run, the pose (number from 0 in the plan and angles)
 // and the touch.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,11 @@ struct SpherePlanCommands {
     double parkValue = 0;         ///< its value for the moves between poses (mm)
     int poseCount() const;
 };
+
+/// Root of f in [lo, hi] with f(lo) > 0 >= f(hi) (Illinois regula falsi: the retained end's value halved when the same
+/// end is kept twice; |f| < 1e-14 or an interval under 1e-15 ends it); nullopt when f does not change sign there. The
+/// point of a probing move where the stylus ball reaches the sphere: f(t) = |ball(t) - sphere| - radius.
+std::optional<double> bracketedRoot(const std::function<double(double)>& f, double lo, double hi);
 
 /// Commands of every sphere run of a plan (pose numbers continue from run to run). Throws ModelError naming the run,
 /// pose and touch for a command outside the travel or a move between poses that would come near a sphere.
