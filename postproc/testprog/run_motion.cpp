@@ -64,8 +64,8 @@ RunMotion ballbarMotion(const MachineModel& m, const Kinematics& k, const Ballba
     r.toolLength = run.RB;
     const std::string axis = rotatesHead(run.test) ? run.headAxis : run.tableAxis;
     r.parameter = axis + " angle (deg)";
-    r.notes.push_back(fmt::format("run type {} ([MultiTasking] Table 2){}", testName(run.test),
-                                  absolute ? ", absolute bar: Ball 2 at its nominal position ([FanWuLi] section 3.1)" : ""));
+    r.notes.push_back(fmt::format("run type {}, [MultiTasking] Table 2{}", testName(run.test),
+                                  absolute ? "; absolute bar: Ball 2 at its nominal position, [FanWuLi] section 3.1" : ""));
     r.notes.push_back(fmt::format("LB = {:g} mm (bar length), RB = {:g} mm (tool length), RC = {:g} mm, ZC = {:g} mm", run.LB,
                                   run.RB, run.RC, run.ZC));
     if (!run.toolBallOffset.isZero() || !run.workBallOffset.isZero())
@@ -92,8 +92,8 @@ RunMotion dbb5Motion(const MachineModel& m, const Kinematics& k, const Dbb5Run& 
     r.toolLength = run.toolLength;
     const bool linear = run.kind == Dbb5Run::Kind::LinearCircle;
     r.parameter = linear ? run.plane + " circle angle (deg)" : run.axis + " angle (deg)";
-    r.notes.push_back(linear ? fmt::format("run type DBB5 linear circle in {} ([IbarakiDBB5], ISO 230-4)", run.plane)
-                             : fmt::format("run type DBB5 rotary circle: {} turns, bar along {} in the bed frame ([IbarakiDBB5])",
+    r.notes.push_back(linear ? fmt::format("run type DBB5 linear circle in {}, [IbarakiDBB5], ISO 230-4", run.plane)
+                             : fmt::format("run type DBB5 rotary circle: {} turns, bar along {} in the bed frame, [IbarakiDBB5]",
                                            run.axis, vec(run.barDirection.normalized())));
     std::string hold;
     for (const auto& [axis, deg] : run.hold) hold += fmt::format(" {}={:g}", axis, deg);
@@ -127,7 +127,7 @@ RunMotion rtestMotion(const MachineModel& m, const Kinematics& k, const RtestRun
     r.continuous = false;
     r.toolLength = run.nestLength;
     r.parameter = "pose";
-    r.notes.push_back("run type R-test ([Moravek2019] / [RotaryTableModel]): stop-and-go poses, the nest follows the ball on the nominal machine");
+    r.notes.push_back("run type R-test, [Moravek2019] / [RotaryTableModel]: stop-and-go poses, the nest follows the ball on the nominal machine");
     r.notes.push_back(fmt::format("ball {} mm (workpiece frame), nest {:g} mm along the tool direction, {} poses", vec(run.ball),
                                   run.nestLength, r.sampleCount));
     for (const RotarySweep& s : run.sweeps)
