@@ -66,13 +66,21 @@ void run(const Options& o) {
     const auto t0 = std::chrono::steady_clock::now();
     const VolumetricMap map = computeMap(req);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const MapCsvInfo info{m.name, o.deviations};
+    MapCsvInfo info{m.name, o.deviations, {}};
+    // The map is direction-free: the reversal values (backlash) of the set depend on the approach direction.
+    std::string reversals;
+    for (int a = 0; a < m.axisCount(); ++a)
+        if (d.reversalPresent[static_cast<size_t>(a)]) reversals += (reversals.empty() ? "B" : ", B") + m.axisNames[static_cast<size_t>(a)];
+    if (!reversals.empty())
+        info.reversalNote = fmt::format("reversal values ({}) left out: the map is direction-free, backlash depends on the "
+                                        "approach direction", reversals);
     std::string svgText;
     if (!o.svg.empty())
         svgText = renderMapSvg(map, m, plane, {fmt::format("machine {}, deviations {}", m.name, o.deviations)});
     writeMapCsv(o.out, map, m, info);
     if (!o.svg.empty()) writeFileAtomically(o.svg, [&](std::ostream& out) { out << svgText; });
     fmt::print("volumetric map of '{}' with {} ({} points, {:.3f} s)\n", m.name, o.deviations, map.points.size(), seconds);
+    if (!info.reversalNote.empty()) fmt::print("  {}\n", info.reversalNote);
     for (const std::string& l : formatMapStatistics(map, m)) fmt::print("  {}\n", l);
     fmt::print("wrote {}{}\n", o.out, o.svg.empty() ? "" : " and " + o.svg);
     if (map.stats.failed > 0)
