@@ -91,8 +91,8 @@ std::string readme(const LinuxcncPlan& plan, const std::string& module, const st
          "   BACKLASH: LinuxCNC does not apply [JOINT_n] BACKLASH to a joint with a COMP_FILE (ini-config.adoc).\n"
          "   A table carries the deviation set's reversal value B<axis> (ISO 230-2 mean reversal) in its columns:\n"
          "   forward trim - reverse trim = -B; without B<axis> forward = reverse. A joint without a table gets\n"
-         "   BACKLASH = -B<axis> in cnccomp.ini. If a joint with a table and no B<axis> has BACKLASH = b today, add\n"
-         "   +b/2 to every forward trim and -b/2 to every reverse trim of its table, or that backlash compensation is lost.\n";
+         "   BACKLASH = -B<axis> in cnccomp.ini. If a joint with a table and no B<axis> has BACKLASH = b today,\n"
+         "   add +b/2 to every forward trim and -b/2 to every reverse trim of its table, or that backlash compensation is lost.\n";
     if (plan.trt) {
         r += fmt::format(
             "3. HAL: cnccomp.hal holds ABSOLUTE values in LinuxCNC's frame (mm; the joints are the tool control point at\n"
@@ -183,7 +183,7 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
                         "sin(B) offset terms (README-pins.txt)");
     if (!tables.empty() && !r.deviations.hasReversal())
         notes.push_back("WARNING: LinuxCNC ignores BACKLASH for a joint with COMP_FILE; forward = reverse here (no reversal "
-                        "value in the deviation set): put the joint's backlash into the columns (README-pins.txt)");
+                        "error in the deviation set): put the joint's backlash into the columns (README-pins.txt)");
     else if (!tables.empty())
         notes.push_back("LinuxCNC ignores BACKLASH for a joint with COMP_FILE: a joint with a table carries the deviation set's "
                         "reversal value in its columns (forward - reverse = -B), the others get BACKLASH = -B (README-pins.txt)");
