@@ -1,5 +1,7 @@
 #include "controllers/common/header.hpp"
 
+#include "cnccomp/geometry.hpp"
+
 #include "controllers/common/controller_model.hpp"
 
 #include <algorithm>
@@ -38,6 +40,24 @@ void list(std::string& out, std::string_view prefix, std::string_view suffix, st
 
 }  // namespace
 
+std::vector<Coverage> reversalsNotHeld(const EmitRequest& request, const std::vector<Coverage>& compensated) {
+    std::vector<Coverage> out;
+    const MachineModel& m = request.machine;
+    const DeviationSet& d = request.deviations;
+    for (int a = 0; a < m.axisCount() && a < static_cast<int>(d.reversalPresent.size()); ++a) {
+        if (!d.reversalPresent[static_cast<size_t>(a)]) continue;
+        const std::string name = "B" + m.axisNames[static_cast<size_t>(a)];
+        if (std::any_of(compensated.begin(), compensated.end(), [&](const Coverage& c) { return c.deviation == name; }))
+            continue;
+        out.push_back({name, fmt::format("reversal value {:.3f} um (ISO 230-2 mean reversal): these files hold no "
+                                         "backlash; set backlash = {:.3f} um by hand or write it from the laser runs "
+                                         "with cnccomp laser --controller (Fanuc 1851, Sinumerik MD32450, HEIDENHAIN "
+                                         "MP710, ISG bilateral LSEC)",
+                                         d.reversal[static_cast<size_t>(a)] / kUm, -d.reversal[static_cast<size_t>(a)] / kUm)});
+    }
+    return out;
+}
+
 HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controller, const EmitResult& coverage,
                           std::vector<std::string> notes) {
     HeaderInfo h;
@@ -48,6 +68,10 @@ HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controlle
     h.date = request.date;
     h.compensated = coverage.compensated;
     h.notCompensated = coverage.notCompensated;
+    for (Coverage& c : reversalsNotHeld(request, coverage.compensated))
+        if (std::none_of(h.notCompensated.begin(), h.notCompensated.end(),
+                         [&](const Coverage& n) { return n.deviation == c.deviation; }))
+            h.notCompensated.push_back(std::move(c));
     h.notes = std::move(notes);
     // What the caller says of the values themselves (e.g. fitted to this controller over which workspace).
     h.notes.insert(h.notes.end(), request.headerNotes.begin(), request.headerNotes.end());

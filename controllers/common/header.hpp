@@ -22,6 +22,12 @@ struct HeaderInfo {
 };
 
 /// Header info from an emit request and the coverage found so far.
+/// The reversal values of the request's set (DeviationSet::reversal, rows B<axis>) that `compensated` does not list,
+/// as NOT-compensated entries: these files hold no backlash; the laser route (`cnccomp laser --controller …`, from the
+/// ISO 230-2 runs) writes it as backlash β = −B̄ (controllers/common/laser_axis.hpp: Fanuc 1851, Sinumerik MD32450,
+/// HEIDENHAIN MP710, ISG bilateral LSEC). makeHeaderInfo adds them to every header; `emit` prints them.
+std::vector<Coverage> reversalsNotHeld(const EmitRequest& request, const std::vector<Coverage>& compensated);
+
 HeaderInfo makeHeaderInfo(const EmitRequest& request, std::string_view controller, const EmitResult& coverage,
                           std::vector<std::string> notes = {});
 

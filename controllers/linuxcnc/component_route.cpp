@@ -8,10 +8,12 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
+#include "controllers/common/controller_model.hpp"
 #include "controllers/common/files.hpp"
 #include "controllers/common/header.hpp"
 #include "controllers/linuxcnc/config_files.hpp"
 #include "controllers/linuxcnc/kins_component.hpp"
+#include "controllers/linuxcnc/laser_comp.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
 namespace {
@@ -42,6 +44,12 @@ EmitResult emitComponentRoute(const EmitRequest& r) {
         if (r.deviations.present[k])
             out.compensated.push_back({m.deviations[k].name, fmt::format("exact model in the kinematics component {} (HAL pin {}.{})",
                                                                           kKinsName, kKinsName, pinOf(m.deviations[k], 0))});
+    for (int a = 0; a < m.axisCount(); ++a)
+        if (r.deviations.reversalPresent[static_cast<size_t>(a)])
+            out.compensated.push_back({"B" + m.axisNames[static_cast<size_t>(a)],
+                                       fmt::format("[JOINT_{}] BACKLASH = {} mm in {}", a,
+                                                   fixed(backlashFromReversal(r.deviations.reversal[static_cast<size_t>(a)]), 6),
+                                                   kKinsIniFile)});
     const std::string source = kinematicsComponent(m, r.deviations, KinsComponentOptions{});
     const std::string coordinates = coordinatesOf(m);
     std::vector<std::string> notes{
@@ -73,6 +81,16 @@ EmitResult emitComponentRoute(const EmitRequest& r) {
             const double v = r.deviations.values[def.offset + k];
             hal += fmt::format("setp {}.{} {:.17g}\n", kKinsName, pinOf(def, k), v == 0.0 ? 0.0 : v);
         }
+    // Reversal values → [JOINT_n] BACKLASH (joint n = machine axis n here; no COMP_FILE on this route).
+    for (int a = 0; a < m.axisCount(); ++a) {
+        if (!r.deviations.reversalPresent[static_cast<size_t>(a)]) continue;
+        const double b = backlashFromReversal(r.deviations.reversal[static_cast<size_t>(a)]);
+        ini += fmt::format("\n[JOINT_{}]\n# axis {}: BACKLASH = -B{} (the reversal value of the deviation set, laser_comp.hpp){}\n"
+                           "BACKLASH = {}\n",
+                           a, m.axisNames[static_cast<size_t>(a)], m.axisNames[static_cast<size_t>(a)],
+                           b < 0 ? "; negative: the slide overshoots on reversal, a negative BACKLASH is untested [G]" : "",
+                           fixed(b, 6));
+    }
     out.files.push_back({kKinsSourceFile, source});
     out.files.push_back({kKinsIniFile, ini});
     out.files.push_back({kKinsHalFile, hal});

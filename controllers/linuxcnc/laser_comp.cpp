@@ -19,7 +19,7 @@ CompTable compTableFromLaser(const LaserPositioningResult& r) {
     return t;
 }
 
-double backlashFromLaser(const LaserPositioningResult& r) { return -r.meanReversal / 1000.0; }
+double backlashFromLaser(const LaserPositioningResult& r) { return backlashFromReversal(r.meanReversal / 1000.0); }
 
 std::string laserCompIniLines(const LaserPositioningResult& r, int joint, const std::string& fileName) {
     const double backlash = backlashFromLaser(r);

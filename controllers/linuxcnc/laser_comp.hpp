@@ -29,6 +29,8 @@ CompTable compTableFromLaser(const LaserPositioningResult& r);
 /// moving + and −BACKLASH/2 while moving − (control.c, compute_screw_comp without a table), which raises every B_i by
 /// BACKLASH, so BACKLASH = −B̄ / 1000 (B̄ < 0 for the usual lost motion: the slide lags behind the motor).
 double backlashFromLaser(const LaserPositioningResult& r);
+/// The same from a reversal value B̄ in mm (DeviationSet::reversal: ISO 230-2's B̄ in the laser's frame): −B̄.
+inline double backlashFromReversal(double reversalMm) { return -reversalMm; }
 
 /// The lines the user adds to the INI file for joint `joint` with the table written as `fileName` (to be placed beside
 /// the INI file: usrmotintf.cc opens the name as given and scripts/linuxcnc.in runs LinuxCNC in the INI's folder), with

@@ -17,6 +17,7 @@
 #include "controllers/linuxcnc/comp_table.hpp"
 #include "controllers/linuxcnc/component_route.hpp"
 #include "controllers/linuxcnc/config_files.hpp"
+#include "controllers/linuxcnc/laser_comp.hpp"
 #include "controllers/linuxcnc/linuxcnc_apply.hpp"
 #include "controllers/linuxcnc/linuxcnc_plan.hpp"
 
@@ -88,9 +89,10 @@ std::string readme(const LinuxcncPlan& plan, const std::string& module, const st
          "2. INI: copy every KEY = value of cnccomp.ini into the section of the same name of your machine INI, replacing\n"
          "   the key where it is already there; keep everything else (limits, homing, scales).\n"
          "   BACKLASH: LinuxCNC does not apply [JOINT_n] BACKLASH to a joint with a COMP_FILE (ini-config.adoc).\n"
-         "   These tables carry no reversal error (forward = reverse): the deviation set has none. If a joint has\n"
-         "   BACKLASH = b today, add +b/2 to every forward trim and -b/2 to every reverse trim of its table, or that\n"
-         "   backlash compensation is lost.\n";
+         "   A table carries the deviation set's reversal value B<axis> (ISO 230-2 mean reversal) in its columns:\n"
+         "   forward trim - reverse trim = -B; without B<axis> forward = reverse. A joint without a table gets\n"
+         "   BACKLASH = -B<axis> in cnccomp.ini. If a joint with a table and no B<axis> has BACKLASH = b today,\n"
+         "   add +b/2 to every forward trim and -b/2 to every reverse trim of its table, or that backlash compensation is lost.\n";
     if (plan.trt) {
         r += fmt::format(
             "3. HAL: cnccomp.hal holds ABSOLUTE values in LinuxCNC's frame (mm; the joints are the tool control point at\n"
@@ -131,8 +133,34 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
     std::string iniJoints;
     for (size_t n = 0; n < plan.joints.size(); ++n) {
         const JointPlan& j = plan.joints[n];
-        if (!j.hasTable()) continue;
-        const JointTable t = jointTable(m, r.deviations, j);
+        // The reversal value B̄ (DeviationSet::reversal, mm, the joint's own direction): alone, BACKLASH = −B̄
+        // (laser_comp.hpp); with a table (LinuxCNC ignores BACKLASH then), the table's columns carry it as the laser
+        // route's do (forward trim −x̄↑ = −x̄ − B̄/2, reverse trim −x̄↓ = −x̄ + B̄/2).
+        const bool hasReversal = !j.rotary && r.deviations.reversalPresent[static_cast<size_t>(j.axis)];
+        const double reversal = hasReversal ? r.deviations.reversal[static_cast<size_t>(j.axis)] : 0.0;
+        const std::string reversalName = "B" + j.name;
+        if (!j.hasTable()) {
+            if (hasReversal) {
+                const double b = backlashFromReversal(reversal);
+                iniJoints += fmt::format("\n[JOINT_{}]\n# axis {}: BACKLASH = -{} (the reversal value of the deviation set){}\n"
+                                         "BACKLASH = {}\n",
+                                         n, j.name, reversalName,
+                                         b < 0 ? "; negative: the slide overshoots on reversal, a negative BACKLASH is untested [G]" : "",
+                                         fixed(b, 6));
+                out.compensated.push_back({reversalName, fmt::format("[JOINT_{}] BACKLASH = {} mm", n, fixed(b, 6))});
+            }
+            continue;
+        }
+        JointTable t = jointTable(m, r.deviations, j);
+        if (hasReversal) {
+            for (size_t i = 0; i < t.table.nominal.size(); ++i) {
+                t.table.forward[i] -= 0.5 * reversal;
+                t.table.reverse[i] += 0.5 * reversal;
+            }
+            out.compensated.push_back({reversalName, fmt::format("{}: forward trims {} mm, reverse trims {} mm (the reversal "
+                                                                 "value in the columns; BACKLASH does not act with a COMP_FILE)",
+                                                                 compFileName(j), fixed(-0.5 * reversal, 6), fixed(0.5 * reversal, 6))});
+        }
         const std::string unit = unitName(j.rotary);
         tableNotes.push_back(fmt::format("{}: {} points, joint {} .. {} {} (the whole travel); largest interpolation error {:.2e} {}",
                                          compFileName(j), t.table.nominal.size(), fixed(t.table.nominal.front(), 3),
@@ -153,9 +181,12 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
     if (plan.trt && *plan.trt == TrtType::BC)
         notes.push_back("NOT for LinuxCNC 2.10/master: its xyzbc-trt-kins inverse differs from 2.9's in the sign of the "
                         "sin(B) offset terms (README-pins.txt)");
-    if (!tables.empty())
+    if (!tables.empty() && !r.deviations.hasReversal())
         notes.push_back("WARNING: LinuxCNC ignores BACKLASH for a joint with COMP_FILE; forward = reverse here (no reversal "
                         "error in the deviation set): put the joint's backlash into the columns (README-pins.txt)");
+    else if (!tables.empty())
+        notes.push_back("LinuxCNC ignores BACKLASH for a joint with COMP_FILE: a joint with a table carries the deviation set's "
+                        "reversal value in its columns (forward - reverse = -B), the others get BACKLASH = -B (README-pins.txt)");
     notes.insert(notes.end(), tableNotes.begin(), tableNotes.end());
     if (plan.trt) {
         const TrtPins &p = plan.pins, &n = plan.nominalPins;

@@ -46,6 +46,7 @@ IdentifyOutcome identifyLinearCircles(const IdentifyRequest& r) {
     for (const LinearCircleRunResult& run : id.runs) samples += run.fit.observations;
     std::string written;
     for (const LinearCircleDeviation& d : id.written) written += fmt::format("{}{}", written.empty() ? "" : ", ", d.name);
+    for (const LinearCircleReversal& v : id.reversals) written += fmt::format("{}B{}", written.empty() ? "" : ", ", v.axis);
     out.summary = fmt::format("identified the diagnostics of {} circle(s) of the linear axes of '{}' (ISO 230-4 ball bar, "
                               "least squares on the exact circle model, {} samples); deviation set: {}",
                               id.runs.size(), m.name, samples, written.empty() ? "nothing written" : written);
@@ -113,6 +114,12 @@ void printLinearCircles(const LinearCircleIdentification& id) {
         for (const std::string& n : d.runs) runs += (runs.empty() ? "" : ", ") + n;
         fmt::print("deviation set: {} = {:.4f} arcsec (95 %: {:.4f} .. {:.4f}; {:.4f} um/m per arcsec; from {})\n", d.name,
                    d.value, d.lower95, d.upper95, d.perArcsec, runs);
+    }
+    for (const LinearCircleReversal& v : id.reversals) {
+        std::string from;
+        for (const std::string& n : v.from) from += (from.empty() ? "" : ", ") + n;
+        fmt::print("deviation set: B{} = {:.4f} um, reversal value (ISO 230-2 B = -backlash; 95 %: {:.4f} .. {:.4f}; from {})\n",
+                   v.axis, v.value, v.lower95, v.upper95, from);
     }
     for (const std::string& n : id.notes) fmt::print("note: {}\n", n);
 }

@@ -52,6 +52,20 @@ void run(const Options& o) {
         fmt::print("{:<8} {:<6} {:12.4f} {:12.4f} {:10.4f}  {}\n", d.name, d.alias, e, t, e - t,
                    d.isAngle() ? "arcsec" : "um");
     }
+    // Reversal values (B<axis>, um): compared where both sets have one, listed where one has.
+    bool reversalHeader = false;
+    for (int a = 0; a < m.axisCount(); ++a) {
+        const size_t k = static_cast<size_t>(a);
+        const std::string name = "B" + m.axisNames[k];
+        if (truth.reversalPresent[k] && !est.reversalPresent[k]) missing.push_back(name);
+        if (!truth.reversalPresent[k] && est.reversalPresent[k]) extra.push_back(name);
+        if (!truth.reversalPresent[k] || !est.reversalPresent[k]) continue;
+        if (!reversalHeader) fmt::print("reversal values (ISO 230-2 mean reversal; estimate, truth, difference):\n");
+        reversalHeader = true;
+        const double e = est.reversal[k] / kUm, t = truth.reversal[k] / kUm;
+        len = std::max(len, std::abs(e - t));
+        fmt::print("{:<8} {:<6} {:12.4f} {:12.4f} {:10.4f}  um\n", name, "", e, t, e - t);
+    }
     const auto both = std::count_if(m.deviations.begin(), m.deviations.end(), [&](const DeviationDef& d) {
         const int i = static_cast<int>(&d - m.deviations.data());
         return truth.present[i] && est.present[i];

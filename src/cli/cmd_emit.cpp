@@ -188,7 +188,11 @@ void run(const Options& o) {
         req.fitWorkspace = &w;
         req.headerNotes = fit.notes;
     }
-    const controllers::EmitResult r = b.emit(req);
+    controllers::EmitResult r = b.emit(req);
+    for (controllers::Coverage& c : controllers::reversalsNotHeld(req, r.compensated))
+        if (std::none_of(r.notCompensated.begin(), r.notCompensated.end(),
+                         [&](const controllers::Coverage& n) { return n.deviation == c.deviation; }))
+            r.notCompensated.push_back(std::move(c));
     // All or none (io/output_set.hpp): a full disk or a read-only folder leaves no file and no new folder.
     OutputSet out({o.machine, o.deviations, o.plan});
     out.makeFolder(o.out);

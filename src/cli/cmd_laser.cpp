@@ -59,11 +59,11 @@ void run(const Options& o) {
         out.add(o.deviationsOut, formatDeviationCsv(set));
         deviationNote = fmt::format(
             "deviation set: {} = the mean bidirectional deviation (sign from the machine's kinematics: {:+.0f}), largest "
-            "residual at the targets {:.3f} um{}{}; the reversal (B = {:.3f} um, mean {:.3f} um) depends on the approach "
-            "direction and is not in the set (it goes to the controllers' backlash / two-column tables)\n",
+            "residual at the targets {:.3f} um{}{}; B{} = the mean reversal value B-bar = {:.3f} um (ISO 230-2; the axis "
+            "reversal B = max |B_i| = {:.3f} um: B_i target by target only the two-column tables of --comp-out hold)\n",
             c.component, c.sensitivity, c.largestResidualUm,
             c.nodesOutside ? fmt::format(", {} table node(s) outside the targets hold the end targets' value", c.nodesOutside) : "",
-            o.merge.empty() ? "" : fmt::format(", merged into {}", o.merge), c.reversalUm, c.meanReversalUm);
+            o.merge.empty() ? "" : fmt::format(", merged into {}", o.merge), r.axis, c.meanReversalUm, c.reversalUm);
     }
     std::string ini;
     if (!o.json.empty()) out.add(o.json, formatLaserJson(r, in.environmentStated, o.file));

@@ -69,7 +69,14 @@ void run(const Options& o) {
     std::vector<long> planeIndices;
     if (!o.svg.empty()) planeIndices = planePointIndices(map, plane);
     std::vector<MapPoint> planePoints;
-    const MapCsvInfo info{m.name, o.deviations};
+    MapCsvInfo info{m.name, o.deviations, {}};
+    // The map is direction-free: the reversal values (backlash) of the set depend on the approach direction.
+    std::string reversals;
+    for (int a = 0; a < m.axisCount(); ++a)
+        if (d.reversalPresent[static_cast<size_t>(a)]) reversals += (reversals.empty() ? "B" : ", B") + m.axisNames[static_cast<size_t>(a)];
+    if (!reversals.empty())
+        info.reversalNote = fmt::format("reversal values ({}) left out: the map is direction-free, backlash depends on the "
+                                        "approach direction", reversals);
     map.stats = streamMapCsv(o.out, req, info, planeIndices, &planePoints);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!o.svg.empty()) {
@@ -78,6 +85,7 @@ void run(const Options& o) {
         writeFileAtomically(o.svg, [&](std::ostream& out) { out << svgText; });
     }
     fmt::print("volumetric map of '{}' with {} ({} points, {:.3f} s)\n", m.name, o.deviations, req.grid.size(), seconds);
+    if (!info.reversalNote.empty()) fmt::print("  {}\n", info.reversalNote);
     for (const std::string& l : formatMapStatistics(map, m)) fmt::print("  {}\n", l);
     fmt::print("wrote {}{}\n", o.out, o.svg.empty() ? "" : " and " + o.svg);
     if (map.stats.failed > 0)

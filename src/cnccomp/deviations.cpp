@@ -9,6 +9,8 @@ namespace cnccomp {
 DeviationSet::DeviationSet(const MachineModel& machine)
     : values(Eigen::VectorXd::Zero(machine.parameterCount())),
       present(machine.deviations.size(), 0),
+      reversal(static_cast<size_t>(machine.axisCount()), 0.0),
+      reversalPresent(static_cast<size_t>(machine.axisCount()), 0),
       machine_(&machine) {}
 
 int DeviationSet::require(std::string_view nameOrAlias) const {
@@ -72,6 +74,21 @@ void DeviationSet::setLinkValue(std::string_view nameOrAlias, double value) {
     const int i = require(nameOrAlias);
     values[location(*machine_, i).offset] = value;
     present[static_cast<size_t>(i)] = 1;
+}
+
+void DeviationSet::setReversal(std::string_view axis, double valueMm) {
+    const int a = machine_->requireAxis(axis);
+    if (machine_->axisLink(a).kind != AxisKind::Linear)
+        throw ModelError(fmt::format("axis {} of machine '{}' is not linear: a reversal value (ISO 230-2) is of a linear axis",
+                                     axis, machine_->name));
+    reversal[static_cast<size_t>(a)] = valueMm;
+    reversalPresent[static_cast<size_t>(a)] = 1;
+}
+
+bool DeviationSet::hasReversal() const {
+    for (char p : reversalPresent)
+        if (p) return true;
+    return false;
 }
 
 }  // namespace cnccomp

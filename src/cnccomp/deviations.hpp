@@ -42,6 +42,22 @@ public:
     /// Sets the link value of a location deviation by name or alias and marks it present.
     void setLinkValue(std::string_view nameOrAlias, double value);
 
+    /// Reversal value of each controlled axis (index = AxisVector index), mm: the mean reversal value B̄ of ISO
+    /// 230-2:2014 clause 2 (B_i = x̄_i↑ − x̄_i↓, the mean positional deviation reached approaching the target in the
+    /// positive direction minus that reached approaching it in the negative direction; B̄ = the mean of B_i over the
+    /// targets), with x the deviation of the tool relative to the workpiece along the direction in which a positive
+    /// command of the axis moves the tool relative to the workpiece (laser_deviation.hpp). Lost motion (the slide lags
+    /// its motor on a reversal) gives B̄ < 0. Linear axes only (setReversal refuses a rotary one). It depends on the
+    /// approach direction, so the kinematics, the volumetric map and the direction-free tables leave it out; the
+    /// controllers take it as backlash. CSV row name B<axis> (io/deviation_csv.hpp).
+    std::vector<double> reversal;
+    std::vector<char> reversalPresent;
+    /// Sets the reversal value (mm) of axis `axis` (by name) and marks it present; ModelError for an unknown or a
+    /// non-linear axis.
+    void setReversal(std::string_view axis, double valueMm);
+    /// True when some axis has a reversal value.
+    bool hasReversal() const;
+
 private:
     const MachineModel* machine_;
 };

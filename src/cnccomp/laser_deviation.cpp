@@ -131,6 +131,7 @@ LaserComponentResult setPositioningComponent(DeviationSet& set, const LaserPosit
         r.largestResidualUm = std::max(r.largestResidualUm,
                                        std::abs(x[i] - s * d.basis.evaluate(q[i], coef.data(), link.modulo)) / kUm);
     set.present[static_cast<size_t>(index)] = 1;
+    set.setReversal(laser.axis, laser.meanReversal * kUm);
     return r;
 }
 
@@ -149,6 +150,11 @@ DeviationSet mergeDeviations(const DeviationSet& base, const DeviationSet& updat
             out.present[i] = 1;
         }
     }
+    for (size_t a = 0; a < update.reversalPresent.size(); ++a)
+        if (update.reversalPresent[a]) {
+            out.reversal[a] = update.reversal[a];
+            out.reversalPresent[a] = 1;
+        }
     return out;
 }
 

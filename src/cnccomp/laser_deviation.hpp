@@ -5,9 +5,11 @@
 // the volumetric map (volumetric_map.hpp).
 //
 // What goes in: the mean bidirectional positional deviation x̄(P) = (x̄↑(P) + x̄↓(P)) / 2 (ISO 230-2 clause 2), as a
-// function of position (linear between the targets, constant beyond them). The reversal B_i = x̄_i↑ − x̄_i↓ depends on
-// the approach direction and has no place in a direction-free deviation set or map: it is returned (B̄, B) for the
-// output and goes to the controllers' backlash / two-column pitch tables.
+// function of position (linear between the targets, constant beyond them), and the axis' mean reversal value
+// B̄ = mean of B_i = x̄_i↑ − x̄_i↓ (ISO 230-2 clause 2) as its reversal value (DeviationSet::reversal, row B<axis>), in
+// the laser's frame (the reading below: no sign from the kinematics). The reversal depends on the approach direction:
+// the kinematics and the volumetric map leave it out; the controllers take it as backlash. What one value cannot hold,
+// B_i target by target (max |B_i − B̄|), stays in the laser route's two-column tables.
 //
 // Sign and scale come from the machine's own kinematics (as the circle route's squareness, linear_circle_identify):
 // the laser reads the tool's displacement relative to the workpiece along the direction in which a positive command of
@@ -29,7 +31,7 @@ struct LaserComponentResult {
     std::string component;        ///< deviation name set, e.g. EXX
     double sensitivity = 0;       ///< s: laser reading per unit component value (±1 for the usual descriptions)
     double largestResidualUm = 0; ///< max |x̄_i − s·e(P_i)| over the targets, µm (0 for a table with nodes at the targets)
-    double meanReversalUm = 0;    ///< B̄, µm (not in the set)
+    double meanReversalUm = 0;    ///< B̄, µm (also the set's reversal value of the axis)
     double reversalUm = 0;        ///< B = max |B_i|, µm (not in the set)
     int nodesOutside = 0;         ///< table nodes outside the measured targets (given the end targets' value)
 };
@@ -43,7 +45,8 @@ struct PositioningComponent {
 };
 PositioningComponent positioningComponent(const MachineModel& m, const std::string& axis, double atCommand);
 
-/// Sets the positioning component of the laser's axis (E<axis><axis>) in `set` from the laser result. Throws
+/// Sets the positioning component of the laser's axis (E<axis><axis>) and its reversal value (B̄) in `set` from the
+/// laser result. Throws
 /// ModelError when the machine has no such axis or component, the component is not of that axis' link or has a
 /// Fourier basis, or does not move the tool along the axis (|s| < 0.5); InputError (file = the laser's source) when a
 /// target is outside the axis' travel.
@@ -51,7 +54,7 @@ LaserComponentResult setPositioningComponent(DeviationSet& set, const LaserPosit
                                              const std::string& laserSource = {});
 
 /// `base` with every deviation present in `update` replaced by update's: location errors by their ISO value (the
-/// others keep theirs), component errors coefficient by coefficient. Both sets must be of the same machine object.
+/// others keep theirs), component errors coefficient by coefficient, reversal values axis by axis. Both sets must be of the same machine object.
 DeviationSet mergeDeviations(const DeviationSet& base, const DeviationSet& update);
 
 }  // namespace cnccomp

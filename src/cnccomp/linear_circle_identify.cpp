@@ -1,10 +1,12 @@
 #include "cnccomp/linear_circle_identify.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/linear_circle_trace.hpp"
@@ -56,7 +58,7 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
                                                     const std::string& dir, const LinearCircleSettings& base) {
     using namespace linear_circle_identify_detail;
     if (runs.empty()) throw ModelError("the plan has no circle runs (<circle>)");
-    LinearCircleIdentification out{{}, DeviationSet(m), {}, {}};
+    LinearCircleIdentification out{{}, DeviationSet(m), {}, {}, {}};
     for (const LinearCircleRun& run : runs) {
         run.validate();
         linearCircleCentreCommands(m, run);  // the machine has the axes
@@ -167,9 +169,55 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const
         out.deviations.set(name, d.value * kArcsec);
         out.written.push_back(d);
     }
-    out.notes.push_back("scale mismatch, straightness, backlash, reversal spikes, lateral play, cyclic error and servo "
-                        "mismatch have no place in the deviation set yet (positioning tables, reversal values: issue 20, "
-                        "later): they are reported, not written");
+    // Backlash → the reversal value of each axis (LinearCircleReversal: B = −b), inverse-variance mean of the steps.
+    struct Step {
+        double value, stddev, half;
+        std::string from;
+    };
+    std::map<char, std::vector<Step>> steps;
+    for (size_t i = 0; i < runs.size(); ++i)
+        for (const char axis : linearPlaneAxes(runs[i].plane))
+            for (const char* end : {"+", "-"}) {
+                const std::string pname = fmt::format("backlash {}{}", axis, end);
+                const LinearCircleParameter* p = lcParameter(out.runs[i].fit, pname);
+                if (!p || !p->identified || !std::isfinite(p->value)) continue;
+                steps[axis].push_back({p->value, p->stddev, std::abs(p->upper95 - p->lower95) / 2,
+                                       fmt::format("{}: {}", runs[i].name, pname)});
+            }
+    for (const auto& [axis, list] : steps) {
+        LinearCircleReversal rv;
+        rv.axis = std::string(1, axis);
+        double sw = 0, swv = 0, lo = 0, hi = 0;
+        for (const Step& st : list) {
+            const double w = st.stddev > 0 ? 1.0 / (st.stddev * st.stddev) : 1e30;
+            sw += w;
+            swv += w * st.value;
+            rv.from.push_back(st.from);
+        }
+        const double b = swv / sw;
+        rv.value = -b;
+        rv.stddev = 1.0 / std::sqrt(sw);
+        if (list.size() == 1) {  // one step: its own interval (Student t of the fit)
+            lo = -list[0].value - list[0].half;
+            hi = -list[0].value + list[0].half;
+        } else {  // combined: the combined σ with the normal quantile
+            lo = rv.value - 1.96 * rv.stddev;
+            hi = rv.value + 1.96 * rv.stddev;
+        }
+        rv.lower95 = lo;
+        rv.upper95 = hi;
+        if (m.axisIndex(rv.axis) < 0) continue;  // the run's validation already needs the axis
+        out.deviations.setReversal(rv.axis, rv.value * kUm);
+        double spread = 0;
+        for (const Step& st : list) spread = std::max(spread, std::abs(st.value - b));
+        if (list.size() > 1)
+            out.notes.push_back(fmt::format("B{} = {:.3f} um from {} backlash steps ({}); the steps differ from their mean by up "
+                                            "to {:.3f} um, which one reversal value cannot hold",
+                                            rv.axis, rv.value, list.size(), fmt::join(rv.from, ", "), spread));
+        out.reversals.push_back(std::move(rv));
+    }
+    out.notes.push_back("scale mismatch, straightness, reversal spikes, lateral play, cyclic error and servo mismatch have "
+                        "no place in the deviation set: they are reported, not written");
     return out;
 }
 

@@ -8,7 +8,8 @@
 // downstream slide of the pair in the machine's chain): value = squareness / s, with s the
 // squareness the same circle identifies on the nominal machine with that deviation at 1″ (the machine's own
 // kinematics give the sign and the scale, table-moving axes included). Several circles of one plane are combined
-// by inverse variance. Nothing else of the diagnostics has a place in the deviation set yet: they are reported.
+// by inverse variance. The backlash steps of each axis go in as its reversal value (LinearCircleReversal). Nothing else
+// of the diagnostics has a place in the deviation set: they are reported.
 #include <limits>
 #include <string>
 #include <vector>
@@ -57,10 +58,26 @@ struct LinearCircleDeviation {
     std::vector<std::string> runs;
 };
 
+/// A reversal value of the set written from the circles' backlash (DeviationSet::reversal): B = −b, with b the
+/// inverse-variance mean of the identified backlash steps of the axis (both ends, every circle that has the axis).
+/// Why −b: the circle model's step b_{u+} (linear_circle_model.hpp) is the jump of the axis' actual position in its
+/// command coordinate when it reverses from + to − at the + end (b > 0: it lags its command), so after the reversal
+/// the positional deviation x = actual − command is b higher than before: x̄↓ − x̄↑ = b_{u+}, i.e. ISO 230-2's
+/// B = x̄↑ − x̄↓ = −b_{u+}; at the − end (− to +, u_a −= b_{u−}) likewise B = −b_{u−}. The circle's commands are the
+/// axes' commands (linear_circle_run.hpp) and the bar reads the tool relative to the workpiece, as the laser does, so
+/// the value is in the laser's frame with no sign from the kinematics. A difference b_{u+} − b_{u−} (a reversal that
+/// depends on the position) has no place in one value: it is in the note.
+struct LinearCircleReversal {
+    std::string axis;          ///< X, Y or Z; the set's row is B<axis>
+    double value = 0, stddev = 0, lower95 = 0, upper95 = 0;  ///< µm (B = −b)
+    std::vector<std::string> from;  ///< "run: backlash X+" of every step combined
+};
+
 struct LinearCircleIdentification {
     std::vector<LinearCircleRunResult> runs;
     DeviationSet deviations;
     std::vector<LinearCircleDeviation> written;
+    std::vector<LinearCircleReversal> reversals;
     std::vector<std::string> notes;  ///< what was not written into the deviation set, and why
 };
 

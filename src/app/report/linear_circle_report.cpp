@@ -116,6 +116,8 @@ ReportData linearCircleReportData(const std::string& machine, const LinearCircle
     }
     for (const LinearCircleDeviation& w : id.written)
         d.deviations.push_back({w.name, "", "arcsec", true, w.value, w.lower95, w.upper95, kUnknown});
+    for (const LinearCircleReversal& v : id.reversals)
+        d.deviations.push_back({"B" + v.axis, "", "um", true, v.value, v.lower95, v.upper95, kUnknown});
     for (const std::string& n : id.notes) d.facts.push_back({"deviation set", n});
     return d;
 }

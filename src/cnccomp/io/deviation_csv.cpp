@@ -1,6 +1,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/deviation_range.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -103,6 +104,44 @@ void refuseOldMeaning(const std::string& path, const CsvTable& t, bool aliasValu
                     machine.name, fmt::join(changed, ", "), kFormatLine, rows.empty() ? "\n    (every location error zero)" : rows));
 }
 
+/// A reversal row: `B<axis>` (one letter after the B) that is not a deviation of the machine. ISO 230-1 names all begin
+/// with E (EXX, EC0Y, EB0Z), so B + an axis letter cannot be one of them; nor is it an axis name.
+bool isReversalName(const MachineModel& machine, const std::string& name) {
+    return name.size() == 2 && name[0] == 'B' && std::isupper(static_cast<unsigned char>(name[1])) &&
+           machine.deviationIndex(name) < 0;
+}
+
+void readReversalRow(const std::string& path, const CsvTable& t, const CsvRow& row, const std::string& name,
+                     const std::string& other, int cValue, int cUnit, DeviationSet& set, std::map<int, int>& lines) {
+    const MachineModel& machine = set.machine();
+    const std::string axis = name.substr(1);
+    const int a = machine.axisIndex(axis);
+    if (a < 0)
+        throw InputError(path, row.line,
+                         fmt::format("'{}': machine '{}' has no axis {} (a row B<axis> is the reversal value of a linear "
+                                     "axis; axes: {})", name, machine.name, axis, fmt::join(machine.axisNames, ", ")));
+    if (machine.axisLink(a).kind != AxisKind::Linear)
+        throw InputError(path, row.line,
+                         fmt::format("'{}': axis {} of machine '{}' is rotary; reversal values (ISO 230-2) are read for "
+                                     "linear axes only", name, axis, machine.name));
+    if (!other.empty() && other != name)
+        throw InputError(path, row.line, fmt::format("reversal row '{}' takes no alias ('{}')", name, other));
+    const std::string& unitText = t.cell(row, cUnit);
+    const auto unit = parseUnit(unitText);
+    if (!unit || unit->quantity != Quantity::Length)
+        throw InputError(path, row.line, fmt::format("'{}' is a length (reversal value); unit '{}' does not fit (um, mm)",
+                                                     name, unitText));
+    const double value = t.requireNumber(row, cValue) * unit->toInternal;
+    if (!std::isfinite(value) || std::abs(value) > kMaxDeviationLength)
+        throw InputError(path, row.line, fmt::format("'{}' = {:g} mm is beyond any machine's reversal (at most ±{:g} mm); "
+                                                     "check the value and its unit", name, value, kMaxDeviationLength));
+    if (const auto it = lines.find(a); it != lines.end())
+        throw InputError(path, row.line, fmt::format("{} is given twice (first on line {}); which value is meant?", name,
+                                                     it->second));
+    lines[a] = row.line;
+    set.setReversal(axis, value);
+}
+
 }  // namespace
 
 std::string deviationRangeProblem(const DeviationDef& d, double value) {
@@ -124,11 +163,16 @@ DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machi
     const int cValue = t.requireColumn("value"), cUnit = t.requireColumn("unit");
     DeviationSet set(machine);
     std::map<std::pair<int, int>, Given> given;  // (deviation, coefficient) → row
+    std::map<int, int> reversalLines;            // axis → line of its reversal row
     int isoRows = 0, aliasRows = 0;
     for (const CsvRow& row : t.rows) {
         const std::string& rawName = t.cell(row, cName);
         const std::string& rawAlias = t.cell(row, cAlias);
         if (rawName.empty() && rawAlias.empty()) throw InputError(path, row.line, "row has neither name nor alias");
+        if (const std::string& rn = rawName.empty() ? rawAlias : rawName; isReversalName(machine, rn)) {
+            readReversalRow(path, t, row, rn, rawName.empty() ? rawName : rawAlias, cValue, cUnit, set, reversalLines);
+            continue;
+        }
         int index = -1, coef = -1;
         bool iso = true;
         for (const std::string* s : {&rawName, &rawAlias}) {
@@ -260,6 +304,12 @@ std::string formatDeviationCsv(const DeviationSet& set, bool all) {
                                    set.values[d.offset + k] * scale, unit, aliasCell(k));
         }
     }
+    // Reversal values (DeviationSet::reversal) after the deviations, only the present ones (also with `all`): a set
+    // without them is written as before.
+    for (int a = 0; a < m.axisCount(); ++a)
+        if (set.reversalPresent[static_cast<size_t>(a)])
+            out << fmt::format("B{},,{:.6f},um,\n", m.axisNames[static_cast<size_t>(a)],
+                               set.reversal[static_cast<size_t>(a)] / kUm);
     return out.str();
 }
 

@@ -102,6 +102,12 @@ std::string formatLinearCircleJson(const std::string& machine, const LinearCircl
                                 lcStr(d.name), lcNum(d.value), lcNum(d.stddev), lcNum(d.lower95), lcNum(d.upper95), lcNum(d.perArcsec),
                                 lcArray(d.runs, lcStr));
          });
+    o += ",\n  \"reversals\": " + lcArray(id.reversals, [](const LinearCircleReversal& v) {
+             return fmt::format("{{\"name\": {}, \"unit\": \"um\", \"value\": {}, \"std\": {}, \"low95\": {}, \"high95\": {}, "
+                                "\"from\": {}}}",
+                                lcStr("B" + v.axis), lcNum(v.value), lcNum(v.stddev), lcNum(v.lower95), lcNum(v.upper95),
+                                lcArray(v.from, lcStr));
+         });
     o += ",\n  \"notes\": " + lcArray(id.notes, lcStr) + "\n}\n";
     return o;
 }

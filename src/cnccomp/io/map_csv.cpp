@@ -64,6 +64,7 @@ std::string mapHeader(const VolumetricMap& map, const MachineModel& m, const Map
     out += "# cnccomp volumetric error map (errors = actual - nominal, in the workpiece frame)\n";
     out += fmt::format("# machine: {}\n", info.machine.empty() ? m.name : info.machine);
     out += fmt::format("# deviation set: {}\n", info.deviationSource.empty() ? "-" : info.deviationSource);
+    if (!info.reversalNote.empty()) out += "# " + info.reversalNote + "\n";
     std::string grid;
     for (const GridAxis& g : map.grid.axes)
         grid += fmt::format("{}{}={}", grid.empty() ? "" : " ", g.name,

@@ -13,6 +13,8 @@ namespace cnccomp {
 struct MapCsvInfo {
     std::string machine;         ///< machine name
     std::string deviationSource; ///< deviation file
+    /// Non-empty when the set has reversal values: the line saying the map leaves them out (it is direction-free).
+    std::string reversalNote{};
 };
 
 /// Text of the map file.
