@@ -73,7 +73,8 @@ TEST(ControllerFit, ChosenFilesNeverLeaveMoreThanNoneOnEverySampleMachineAndBack
         const DeviationSet d = readDeviationCsv(src("samples/deviations/" + set), m);
         // The travel's ends (2 per axis): the emits of the fit's Jacobian cost more than the poses.
         const controllers::FitWorkspace w = smallWorkspace(m, 2);
-        const controllers::FitFigures none = noCompensation(m, d, w);
+        // No compensation over the poses the candidates are judged on (the grid and each axis' sweep, fit.hpp).
+        const controllers::FitFigures none = noCompensation(m, d, controllers::judgedWorkspace(m, w));
         for (const controllers::Backend* b : controllers::backends()) {
             try {
                 (void)b->emit(controllers::EmitRequest{m, d, "x", "2000-01-01"});
