@@ -49,13 +49,19 @@ inline constexpr double kHoldsAllFraction = 0.02;
 /// Whether `a` leaves more tool-tip error than `b` (largest or RMS) beyond kFitTolerance.
 bool leavesMore(const FitFigures& a, const FitFigures& b);
 
-/// Tool-tip error of the identified machine over the workspace with `b`'s files for `written` loaded.
+/// The poses the candidates are judged on (and the fit looks at besides its subset of the workspace): the workspace and
+/// each axis alone swept through its travel, the others at 0 (fit.cpp explains why: a grid of a few samples per axis
+/// misses what a table-basis fit does between them).
+FitWorkspace judgedWorkspace(const MachineModel& m, const FitWorkspace& workspace);
+
+/// Tool-tip error of the identified machine over judgedWorkspace(workspace) with `b`'s files for `written` loaded.
 FitFigures fitFigures(const Backend& b, const MachineModel& m, const DeviationSet& identified, const DeviationSet& written,
                       const FitWorkspace& workspace);
 
 /// Fits the values `b` writes: every entry of the deviation vector the backend's files respond to is a free value, the
 /// others are zero; least squares on the tool-tip error of `identified` over `workspace` (every pose at every tool
-/// length) through b.emit() and b.apply(). Candidates: none (all zero), the identified values copied, the fit; the
+/// length) through b.emit() and b.apply(). Candidates (their figures over judgedWorkspace(workspace), on the files
+/// emitted and read back): none (all zero), the identified values copied, the fit; the
 /// written one has the smallest RMS among those whose largest error is not above none's. When the copy leaves at most
 /// kHoldsAllFraction of none's largest error the controller holds everything and the copy is the fit (written ==
 /// identified exactly).

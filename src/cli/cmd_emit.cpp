@@ -120,7 +120,7 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
             }
         }
         const std::string spanName = rtest ? "largest R-test displacement (um)" : "largest span (um)";
-        fmt::print("predictions on the identified machine over the fit workspace ({}):\n", w.description);
+        fmt::print("predictions on the identified machine over the fit workspace ({}):\n", controllers::judgedWorkspace(m, w).description);
         fmt::print("  {:<26} {:>28}{}\n", "candidate", "tool tip max / RMS (um)", plan ? fmt::format("  {:>34}", spanName) : "");
         for (int i = 0; i < 3; ++i) {
             if (i == 2 && !fitted) {
