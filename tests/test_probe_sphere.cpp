@@ -1,4 +1,4 @@
-// Touch probe and calibration sphere (issue 21): the known-radius sphere fit, the plan's commands, the probe result
+// Touch probe and calibration sphere: the known-radius sphere fit, the plan's commands, the probe result
 // file, the centre observations and their identification.
 #include <gtest/gtest.h>
 

@@ -427,7 +427,7 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
 }
 
 
-// ---- touch probe on a calibration sphere (issue 21)
+// ---- touch probe on a calibration sphere
 
 /// Default unknowns of a sphere plan: the location errors of every rotary axis the plan turns, except the two no
 /// sphere centre can show: the position along the axis' own line and its zero position (rotation about itself); and

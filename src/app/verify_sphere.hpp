@@ -1,5 +1,5 @@
 #pragma once
-// verify for the sphere runs of a plan (issue 21): the probing program (generated in memory, its probing targets read
+// verify for the sphere runs of a plan: the probing program (generated in memory, its probing targets read
 // back by cnccomp's reader) run on the simulated machine without and with the compensation; the recorded positions
 // (programmed coordinates, as #5061… give them) fitted per pose with the nominal model; the spread of the sphere centres
 // over the poses before and after. A perfect compensation puts every centre on the sphere's true position.

@@ -1,5 +1,5 @@
 #pragma once
-// Touch-probe runs on a calibration sphere (issue 21): a precision sphere fixed on the table, a touch probe in the
+// Touch-probe runs on a calibration sphere: a precision sphere fixed on the table, a touch probe in the
 // spindle. At each pose of the rotary axes the probe touches the sphere at a pole (along the tool axis) and at a ring of
 // points at one latitude; the touches give the sphere's centre at that pose (measurement/sphere_fit.hpp). The centres
 // against the sphere's nominal position observe the tool–table error, as the R-test's displacements do (HEIDENHAIN
