@@ -26,11 +26,6 @@ std::string_view trim(std::string_view s) {
     return s;
 }
 
-std::string_view withoutByteOrderMark(std::string_view firstLine) {
-    if (firstLine.substr(0, 3) == "\xef\xbb\xbf") firstLine.remove_prefix(3);
-    return firstLine;
-}
-
 std::optional<double> parseNumber(std::string_view s) {
     s = trim(s);
     if (s.empty()) return std::nullopt;
