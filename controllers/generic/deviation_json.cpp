@@ -5,6 +5,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_range.hpp"
 #include "controllers/generic/json_text.hpp"
+#include "cnccomp/io/markup.hpp"
 #include "cnccomp/io/json.hpp"
 
 namespace cnccomp::controllers::generic {

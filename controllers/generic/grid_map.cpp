@@ -14,6 +14,7 @@
 #include "controllers/common/controller_model.hpp"
 #include "controllers/common/files.hpp"
 #include "controllers/generic/json_text.hpp"
+#include "cnccomp/io/markup.hpp"
 
 namespace cnccomp::controllers::generic {
 namespace {

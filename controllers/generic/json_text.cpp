@@ -5,11 +5,8 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
-#include "cnccomp/io/markup.hpp"
 
 namespace cnccomp::controllers::generic {
-
-std::string jsonString(std::string_view s) { return cnccomp::jsonString(s); }
 
 std::string jsonNumber(double v) {
     if (!std::isfinite(v)) throw ModelError("JSON cannot hold a number that is not finite");

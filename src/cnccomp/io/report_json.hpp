@@ -3,10 +3,7 @@
 // singular values, parameters with 95 % intervals (display units: um, arcsec), unidentified names, identifiable
 // combinations and unobservable directions, covariance (internal units: mm, rad). NaN is written as null.
 // The one JSON reader (io/json.hpp) reads it back for tests and tools.
-#include <map>
-#include <memory>
 #include <string>
-#include <vector>
 
 #include "cnccomp/identification/report.hpp"
 
