@@ -79,6 +79,10 @@ public:
     /// The files of a folder that are this backend's (a folder may hold several routes of one controller, e.g.
     /// LinuxCNC's component and pins-and-tables routes): verify reads the coverage lists from these. Default: all.
     virtual std::vector<OutputFile> ownFiles(const std::vector<OutputFile>& files) const { return files; }
+    /// Whether fitting the deviation values to this controller (controllers/common/fit.hpp) can leave less than copying
+    /// them. False where the files hold the error itself, sampled (the generic grid map): what the copy leaves there is
+    /// the sampling's (the node budget), and moving deviation values only bends the sampled error elsewhere. Default: true.
+    virtual bool fitsDeviationValues() const { return true; }
 };
 
 /// All registered backends, sorted by name.

@@ -114,6 +114,8 @@ public:
     }
 
     EmitResult emit(const EmitRequest& r) const override { return emitFiles(r, GridMapOptions{}); }
+    /// The map holds the tip error of every deviation given; what it leaves is its interpolation (GridMapOptions).
+    bool fitsDeviationValues() const override { return false; }
 
     std::vector<std::string> checks() const override {
         return {"the map's axis columns are the controller's machine coordinates: compare one node with the machine "

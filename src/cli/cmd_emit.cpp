@@ -107,11 +107,14 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
         DeviationSet zero = d;
         zero.values.setZero();
         const Row rows[] = {{"none", &fit.none, &zero}, {"identified values copied", &fit.copied, &d}, {"fitted", &fit.fitted, fit.fittedValues ? &*fit.fittedValues : &fit.written}};
+        // Files holding the sampled error (the generic map) are not fitted unless the copy leaves next to nothing (then
+        // the fit is the copy, "fitted"): the fitted row is not computed (fit.cpp).
+        const bool sampled = fitted && !b.fitsDeviationValues() && fit.chosen != "fitted";
         bool rtest = false;
         std::vector<double> spans(3, NAN);
         if (plan) {
             for (int i = 0; i < 3; ++i) {
-                if (i == 2 && !fitted) continue;
+                if (i == 2 && (!fitted || sampled)) continue;
                 const controllers::EmitRequest req{m, *rows[i].values, "prediction", "2000-01-01"};
                 // The candidates' spans only (their volumetric figure is the fit's own, above): one volumetric point.
                 const VerifyResult v = verifyFiles(b, m, *plan, d, b.emit(req), rows[i].name, 1);
@@ -123,8 +126,9 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
         fmt::print("predictions on the identified machine over the fit workspace ({}):\n", controllers::judgedWorkspace(m, w).description);
         fmt::print("  {:<26} {:>28}{}\n", "candidate", "tool tip max / RMS (um)", plan ? fmt::format("  {:>34}", spanName) : "");
         for (int i = 0; i < 3; ++i) {
-            if (i == 2 && !fitted) {
-                fmt::print("  {:<26} {:>28}\n", rows[i].name, "not computed (--copy-identified)");
+            if (i == 2 && (!fitted || sampled)) {
+                fmt::print("  {:<26} {:>28}\n", rows[i].name,
+                           sampled ? "not computed (the files hold the error itself, sampled)" : "not computed (--copy-identified)");
                 continue;
             }
             const std::string tip = fmt::format("{:.3f} / {:.3f}", rows[i].f->maxTip / kUm, rows[i].f->rmsTip / kUm);
@@ -136,8 +140,10 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                                      : chosenFitted                 ? (fit.heldValues < 0 ? "the fitted values (= the identified values: "
                                                                                             "the controller holds them all)"
                                                                                           : "the fitted values")
-                                     : fit.chosen == "identified"   ? "the identified values copied (the fit left more)"
-                                                                    : "zero values (every other candidate left more than none)");
+                                     : fit.chosen == "identified"   ? (sampled ? "the identified values copied"
+                                                                               : "the identified values copied (the fit left more)")
+                                                                    : sampled ? "zero values (the copy left more than none)"
+                                                                              : "zero values (every other candidate left more than none)");
         if (plan) {
             VerifyResult v = verifyFiles(b, m, *plan, d, written, fmt::format("{} files just written", b.name()));
             fmt::print("predicted residual on the identified machine (cnccomp verify, {}): largest span {:.3f} um (before {:.3f} um); "
