@@ -5,13 +5,13 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/markup.hpp"
 
 namespace cnccomp::controllers::generic {
 
 std::string jsonNumber(double v) {
     if (!std::isfinite(v)) throw ModelError("JSON cannot hold a number that is not finite");
-    if (v == 0) return "0";
-    return fmt::format("{}", v);
+    return cnccomp::jsonNumber(v);
 }
 
 std::string jsonNumbers(const std::vector<double>& v) {

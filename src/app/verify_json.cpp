@@ -12,7 +12,6 @@ namespace {
 
 std::string str(std::string_view s) { return jsonString(s); }
 
-std::string jsonNumber(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
 
 std::string um(double mm) { return jsonNumber(mm / kUm); }
 

@@ -18,6 +18,8 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string esc(std::string_view s) { return escapeXml(s, "report text"); }
+/// Numbers in the report's embedded JSON: 9 significant digits.
+std::string reportNumber(double v) { return jsonNumber(v, 9); }
 
 /// Largest |e| over every map's plane, µm: the shared top of the colour scale.
 double sharedScaleUm(const ReportData& d) {
@@ -28,8 +30,8 @@ double sharedScaleUm(const ReportData& d) {
 
 std::string isoJson(const IsoFigures& f) {
     return fmt::format(R"({{"G_um": {}, "F_max_um": {}, "F_min_um": {}, "mean_radius_mm": {}, "H_um": {}}})",
-                       jsonNumber(f.G / kUm), jsonNumber(f.Fmax / kUm), jsonNumber(f.Fmin / kUm), jsonNumber(f.meanRadius),
-                       jsonNumber(f.H / kUm));
+                       reportNumber(f.G / kUm), reportNumber(f.Fmax / kUm), reportNumber(f.Fmin / kUm), reportNumber(f.meanRadius),
+                       reportNumber(f.H / kUm));
 }
 
 template <class T, class F>
@@ -120,9 +122,9 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
         for (const PolarPass& p : r.passes) samples += static_cast<int>(p.before.size());
         return fmt::format("{{\"name\": {}, \"test\": {}, \"LB_mm\": {}, \"samples\": {}, \"passes\": {}, \"before\": {}, "
                            "\"after\": {}, \"rms_before_um\": {}, \"rms_after_um\": {}, \"plot\": {}}}",
-                           jsonString(r.name), jsonString(r.test), jsonNumber(r.LB), samples,
+                           jsonString(r.name), jsonString(r.test), reportNumber(r.LB), samples,
                            jsonArray(r.passes, [](const PolarPass& p) { return jsonString(p.direction > 0 ? "ccw" : "cw"); }),
-                           isoJson(r.before), isoJson(r.after), jsonNumber(r.rmsBefore / kUm), jsonNumber(r.rmsAfter / kUm),
+                           isoJson(r.before), isoJson(r.after), reportNumber(r.rmsBefore / kUm), reportNumber(r.rmsAfter / kUm),
                            jsonString(i < files.plots.size() ? fileName(files.plots[i]) : ""));
     });
     appendRows(o, "tables", d.tables, [](const TableSection& t, size_t) {
@@ -134,25 +136,25 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
         return fmt::format("{{\"run\": {}, \"type\": {}, \"pass\": {}, \"quantity\": {}, \"before_um\": {}, \"after_um\": {}, "
                            "\"warning\": {}}}",
                            jsonString(p.run), jsonString(p.type), jsonString(p.pass), jsonString(p.quantity),
-                           jsonNumber(p.before / kUm), jsonNumber(p.after / kUm), p.warning.empty() ? "null" : jsonString(p.warning));
+                           reportNumber(p.before / kUm), reportNumber(p.after / kUm), p.warning.empty() ? "null" : jsonString(p.warning));
     });
     appendRows(o, "deviations", d.deviations, [](const DeviationRow& r, size_t) {
         return fmt::format("{{\"name\": {}, \"alias\": {}, \"unit\": {}, \"identified\": {}, \"value\": {}, \"low95\": {}, "
                            "\"high95\": {}, \"truth\": {}}}",
                            jsonString(r.name), jsonString(r.alias), jsonString(r.unit), r.identified ? "true" : "false",
-                           jsonNumber(r.value), jsonNumber(r.low95), jsonNumber(r.high95), jsonNumber(r.truth));
+                           reportNumber(r.value), reportNumber(r.low95), reportNumber(r.high95), reportNumber(r.truth));
     });
     std::vector<std::string> unidentified;
     for (const DeviationRow& r : d.deviations)
         if (!r.identified) unidentified.push_back(r.name);
     o += "  \"unidentified\": " + jsonArray(unidentified, [](const std::string& s) { return jsonString(s); }) + ",\n";
     o += "  \"combinations\": " + jsonArray(d.combinations, [](const std::string& s) { return jsonString(s); }) + ",\n";
-    o += fmt::format("  \"map_scale_max_um\": {},\n", jsonNumber(d.maps.empty() ? kUnknown : sharedScaleUm(d)));
+    o += fmt::format("  \"map_scale_max_um\": {},\n", reportNumber(d.maps.empty() ? kUnknown : sharedScaleUm(d)));
     appendRows(o, "maps", d.maps, [&](const MapPicture& m, size_t k) {
         const size_t plot = d.runs.size() + k;
         return fmt::format("{{\"title\": {}, \"plane_max_um\": {}, \"max_um\": {}, \"rms_um\": {}, \"points\": {}, \"plot\": {}}}",
-                           jsonString(m.title), jsonNumber(planeMaxError(m.map, m.plane) / kUm),
-                           jsonNumber(m.map.stats.norm.maxAbs / kUm), jsonNumber(m.map.stats.norm.rms / kUm), m.map.stats.points,
+                           jsonString(m.title), reportNumber(planeMaxError(m.map, m.plane) / kUm),
+                           reportNumber(m.map.stats.norm.maxAbs / kUm), reportNumber(m.map.stats.norm.rms / kUm), m.map.stats.points,
                            jsonString(plot < files.plots.size() ? fileName(files.plots[plot]) : ""));
     });
     appendRows(o, "controllers", d.controllers, [](const ControllerSection& c, size_t) {
@@ -162,16 +164,16 @@ std::string formatReportSummaryJson(const ReportData& d, const ReportFiles& file
         const std::string remaining = jsonArray(c.notCompensated, [](const CoverageRow& r) {
             return fmt::format("{{\"deviation\": {}, \"value\": {}, \"unit\": {}, \"alias\": {}, \"alias_value\": {}, "
                                "\"reason\": {}}}",
-                               jsonString(r.deviation), jsonNumber(r.value), jsonString(r.unit),
-                               r.alias.empty() ? "null" : jsonString(r.alias), jsonNumber(r.aliasValue), jsonString(r.note));
+                               jsonString(r.deviation), reportNumber(r.value), jsonString(r.unit),
+                               r.alias.empty() ? "null" : jsonString(r.alias), reportNumber(r.aliasValue), jsonString(r.note));
         });
         return fmt::format("{{\"name\": {}, \"files\": {}, \"compensated\": {}, \"not_compensated\": {}, "
                            "\"before_max_um\": {}, \"before_rms_um\": {}, \"after_max_um\": {}, \"after_rms_um\": {}, \"points\": {}, "
                            "\"span_before_um\": {}, \"span_after_um\": {}, \"basis\": {},\n     \"remaining\": {}}}",
                            jsonString(c.name), jsonArray(c.files, [](const std::string& s) { return jsonString(s); }),
-                           names(c.compensated), names(c.notCompensated), jsonNumber(c.beforeMax / kUm),
-                           jsonNumber(c.beforeRms / kUm), jsonNumber(c.afterMax / kUm), jsonNumber(c.afterRms / kUm), c.points,
-                           jsonNumber(c.spanBefore / kUm), jsonNumber(c.spanAfter / kUm), jsonString(c.basis), remaining);
+                           names(c.compensated), names(c.notCompensated), reportNumber(c.beforeMax / kUm),
+                           reportNumber(c.beforeRms / kUm), reportNumber(c.afterMax / kUm), reportNumber(c.afterRms / kUm), c.points,
+                           reportNumber(c.spanBefore / kUm), reportNumber(c.spanAfter / kUm), jsonString(c.basis), remaining);
     });
     o += "  \"files\": {\"html\": " + jsonString(fileName(files.html)) + ", \"plots\": " +
          jsonArray(files.plots, [](const std::string& s) { return jsonString(fileName(s)); }) + "}\n}\n";

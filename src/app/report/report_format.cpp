@@ -20,10 +20,4 @@ std::string fixed(double v, int decimals) {
     return fmt::format("{:.{}f}", v, decimals);
 }
 
-std::string jsonNumber(double v) {
-    if (!std::isfinite(v)) return "null";
-    if (v == 0) return "0";
-    return fmt::format("{:.9g}", v);
-}
-
 }  // namespace cnccomp::report

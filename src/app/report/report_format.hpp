@@ -12,7 +12,5 @@ double niceNumber(double x);
 /// `v` with `decimals` decimals; "–" when not finite.
 std::string fixed(double v, int decimals);
 using cnccomp::jsonString;  // io/markup.hpp
-/// JSON number with 9 significant digits, or null when not finite.
-std::string jsonNumber(double v);
 
 }  // namespace cnccomp::report

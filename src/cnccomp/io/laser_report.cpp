@@ -15,7 +15,7 @@ std::string environmentText(const LaserPositioningResult& r, bool stated) {
     return r.environmentCompensated ? "done (stated in the file)" : "not done (stated in the file)";
 }
 
-std::string lrNum(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "null"; }
+std::string lrNum(double v) { return jsonNumber(v, 6); }
 
 }  // namespace laser_report_detail
 

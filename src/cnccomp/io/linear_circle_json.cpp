@@ -12,7 +12,7 @@ namespace cnccomp {
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_json_detail {
 
-std::string lcNum(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
+std::string lcNum(double v) { return jsonNumber(v, 9); }
 std::string lcStr(const std::string& s) { return jsonString(s); }
 
 template <class T, class F>

@@ -1,5 +1,7 @@
 #include "cnccomp/io/markup.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
@@ -27,6 +29,12 @@ std::string escapeXml(std::string_view text, std::string_view what) {
         }
     }
     return o;
+}
+
+std::string jsonNumber(double v, int significant) {
+    if (!std::isfinite(v)) return "null";
+    if (v == 0) return "0";
+    return significant > 0 ? fmt::format("{:.{}g}", v, significant) : fmt::format("{}", v);
 }
 
 std::string jsonString(std::string_view s) {

@@ -15,4 +15,9 @@ std::string escapeXml(std::string_view text, std::string_view what = "text");
 /// also sit inside an HTML <script> element.
 std::string jsonString(std::string_view s);
 
+/// A number as JSON text, the one writer of every JSON file cnccomp writes: with `significant` = 0 the shortest text that
+/// reads back to the same double, else that many significant digits (printf %.<n>g); zero of either sign as 0; NaN and
+/// infinities, which JSON cannot hold, as null (a writer that must refuse them checks before: the generic backend).
+std::string jsonNumber(double v, int significant = 0);
+
 }  // namespace cnccomp

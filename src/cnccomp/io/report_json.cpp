@@ -20,7 +20,7 @@ namespace {
 
 std::string quote(const std::string& s) { return jsonString(s); }
 
-std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : "null"; }
+std::string num(double v) { return jsonNumber(v, 17); }
 
 class Writer {
 public:
