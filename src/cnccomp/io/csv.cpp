@@ -124,6 +124,7 @@ const CsvRow& CsvReader::header() {
     std::string_view raw;
     while (nextLine(raw)) {
         const std::string_view s = trim(raw);
+        if (!s.empty() && s.front() == '#') preamble_.push_back({line_, {std::string(s)}});
         if (skipBlankOrComment(s)) continue;
         // The separator: ';' or a tab outside quotes, else ','.
         bool inQuote = false, semicolon = false, tab = false;
@@ -222,6 +223,7 @@ CsvTable readAll(CsvReader& r) {
     t.separator = r.separator();
     CsvRow row;
     while (r.next(row)) t.rows.push_back(row);
+    t.preamble = r.preamble();
     return t;
 }
 

@@ -57,6 +57,8 @@ public:
     bool next(CsvRow& row);
     char separator() const { return separator_; }
     const std::vector<CsvComment>& comments() const { return comments_; }
+    /// The comment lines before the header as they are (trimmed, from the '#'), with or without a key.
+    const std::vector<CsvRow>& preamble() const { return preamble_; }
     const std::string& path() const { return path_; }
     /// Last line number read.
     int line() const { return line_; }
@@ -77,6 +79,7 @@ private:
     char separator_ = ',';
     CsvRow header_;
     std::vector<CsvComment> comments_;
+    std::vector<CsvRow> preamble_;  ///< one cell each
 };
 
 /// "tab" or the separator itself, for messages.
@@ -87,6 +90,8 @@ struct CsvTable {
     CsvRow header;
     std::vector<CsvRow> rows;
     char separator = ',';
+    /// The comment lines before the header (CsvReader::preamble): one cell each, the line from its '#'.
+    std::vector<CsvRow> preamble{};
     /// Column index by header name, or -1.
     int column(const std::string& name) const;
     /// Column index by header name; throws InputError naming the file when missing.

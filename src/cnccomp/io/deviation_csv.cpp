@@ -1,6 +1,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/deviation_range.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -37,16 +38,8 @@ constexpr const char* kFormatLine = "# cnccomp-deviations/2: location errors und
 constexpr const char* kFormatTag = "# cnccomp-deviations/";
 
 /// True when one of the comment lines before the header is the format line (any version tag).
-bool hasFormatLine(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::string line;
-    for (bool first = true; std::getline(in, line); first = false) {
-        const std::string_view t = trim(first ? withoutByteOrderMark(line) : std::string_view(line));
-        if (t.empty()) continue;
-        if (t.front() != '#') return false;  // the header: no format line before it
-        if (t.rfind(kFormatTag, 0) == 0) return true;
-    }
-    return false;
+bool hasFormatLine(const CsvTable& t) {
+    return std::any_of(t.preamble.begin(), t.preamble.end(), [](const CsvRow& c) { return c.cells[0].rfind(kFormatTag, 0) == 0; });
 }
 
 struct Given {
@@ -62,7 +55,7 @@ struct Given {
 /// component, unlisted ones zero) is refused with the conversion: the ISO values of the old geometry.
 void refuseOldMeaning(const std::string& path, const CsvTable& t, bool aliasValueColumn, const MachineModel& machine,
                       const std::map<std::pair<int, int>, Given>& given, const DeviationSet& set) {
-    if (aliasValueColumn || given.empty() || hasFormatLine(path)) return;
+    if (aliasValueColumn || given.empty() || hasFormatLine(t)) return;
     DeviationSet old(machine);
     old.values = set.values;
     bool anyLocationName = false;
