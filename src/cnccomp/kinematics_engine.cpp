@@ -1,8 +1,11 @@
 #include "cnccomp/kinematics_engine.hpp"
 
 #include <atomic>
-
 #include <cmath>
+
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
 
 namespace cnccomp {
 
@@ -130,7 +133,10 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
         op.axis = l.axisIndex;
         op.dir = l.direction;
         op.modulo = l.modulo;
-        if (op.kind == OpKind::Rotary) op.slot = slots++;
+        if (op.kind == OpKind::Rotary) {
+            if (slots >= kMaxAxes) throw ModelError(fmt::format("machine '{}' has more than {} rotary axes", machine_->name, kMaxAxes));
+            op.slot = slots++;
+        }
         for (int k = 0; k < 3; ++k)
             if (l.direction == Vec3::Unit(k)) op.unit = k, op.ui = (k + 1) % 3, op.uj = (k + 2) % 3;
         ops.push_back(op);
