@@ -58,7 +58,9 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
     : machine_(machine),
       nominal_(machine, nullptr),
       actual_(machine, &deviations),
-      tcp_(nominal_),
+      nominalData_(nominal_),
+      actualData_(actual_),
+      tcp_(nominal_, nominalData_),
       options_(options) {
     identity_ = deviations.values.size() == 0 || deviations.values.cwiseAbs().maxCoeff() == 0.0;
     affine_ = true;
@@ -72,15 +74,15 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
     zeroIsZero_ = (zero_.array() == 0.0).all();
 }
 
-Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) const {
+Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) {
     Vec3 tip, axis;
     AxisVector scratch;
-    actual_.toolPoseOnce(model(c, scratch), toolLength, tip, axis);
+    actual_.toolPoseOnce(actualData_, model(c, scratch), toolLength, tip, axis);
     return tip;
 }
-Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) const {
+Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) {
     AxisVector scratch;
-    return nominal_.toolTip(model(c, scratch), toolLength);
+    return nominal_.toolTip(nominalData_, model(c, scratch), toolLength);
 }
 
 const AxisVector& Corrector::model(const AxisVector& c, AxisVector& scratch) const {
@@ -89,12 +91,12 @@ const AxisVector& Corrector::model(const AxisVector& c, AxisVector& scratch) con
     return scratch;
 }
 
-Vec3 Corrector::tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const {
+Vec3 Corrector::tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) {
     return nominalTip(cNom, toolLength) - actualTip(c, toolLength);
 }
 
 bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c,
-                         NominalPose* pose) const {
+                         NominalPose* pose) {
     if (pose) pose->known = false;
     switch (s.mode) {
         case ProgramMode::Joints:
@@ -102,10 +104,10 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
             return true;
         case ProgramMode::TcpAngles:
             if (pose) {
-                pose->known = tcp_.toJoints(p.p, s.controlLength, c, &pose->tip, &pose->axis);
+                pose->known = tcp_.toJoints(nominalData_, p.p, s.controlLength, c, &pose->tip, &pose->axis);
                 pose->length = s.controlLength;
             } else {
-                tcp_.toJoints(p.p, s.controlLength, c);
+                tcp_.toJoints(nominalData_, p.p, s.controlLength, c);
             }
             return c.allFinite();
         case ProgramMode::TcpVector: {
@@ -117,7 +119,7 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
                 PoseJacobian J;
                 Vec3 tip, axis;
                 for (int it = 0; it < 60; ++it) {
-                    nominal_.jacobian(q + zero_, s.controlLength, J, tip, axis);
+                    nominal_.jacobian(nominalData_, q + zero_, s.controlLength, J, tip, axis);
                     const Vec3 r = target - axis;
                     if (r.norm() < 1e-13) return true;
                     Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxAxes> Jr(3, 0);
@@ -134,7 +136,7 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
                     for (int k = 0; k < m; ++k) q[cols[k]] += d[k];
                     if (big < 1e-14) break;
                 }
-                nominal_.toolPose(q + zero_, s.controlLength, tip, axis);
+                nominal_.toolPose(nominalData_, q + zero_, s.controlLength, tip, axis);
                 return (target - axis).norm() < 1e-9;
             };
             // The controller takes the solution nearest its position (the branch of the previous block) [G]: Newton
@@ -166,24 +168,24 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
             AxisVector withAngles = p.p;
             for (int i = 0; i < n; ++i)
                 if (rotary_ & (1u << i)) withAngles[i] = best[i];
-            tcp_.toJoints(withAngles, s.controlLength, c);
+            tcp_.toJoints(nominalData_, withAngles, s.controlLength, c);
             return c.allFinite();
         }
     }
     return false;
 }
 
-void Corrector::toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) const {
+void Corrector::toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) {
     switch (s.mode) {
         case ProgramMode::Joints:
             p.p = c;
             return;
         case ProgramMode::TcpAngles:
-            tcp_.toProgram(c, s.controlLength, p.p);
+            tcp_.toProgram(nominalData_, c, s.controlLength, p.p);
             return;
         case ProgramMode::TcpVector: {
             Vec3 point, axis;
-            tcp_.forward(c, s.controlLength, point, axis);
+            tcp_.forward(nominalData_, c, s.controlLength, point, axis);
             p.p = c;
             for (int k = 0; k < 3; ++k) p.p[tcp_.linearAxis(k)] = point[k];
             p.v = axis;
@@ -303,11 +305,11 @@ bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, dou
     return true;
 }
 
-void Corrector::refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q,
+void Corrector::refreshJacobian(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const AxisVector& q,
                                 double toolLength) const {
     const int n = static_cast<int>(q.size());
     Vec3 tip, axis;
-    k.jacobian(q, toolLength, cache.J, tip, axis);
+    k.jacobian(kd, q, toolLength, cache.J, tip, axis);
     cache.J.bottomRows<3>() *= options_.axisWeight;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j <= i; ++j) cache.JtJ[i][j] = cache.JtJ[j][i] = cache.J.col(i).dot(cache.J.col(j));
@@ -353,7 +355,7 @@ void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask fr
 }
 
 void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev, const AxisVector& deltaPrev,
-                             double toolLength, AxisVector& start) const {
+                             double toolLength, AxisVector& start) {
     start = cNom + deltaPrev;
     JacobianCache& cache = cache_;
     if (identity_) return;
@@ -365,7 +367,7 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
         // The nominal machine where it was aimed: the kept commands less the correction (its Jacobian differs from
         // the erroneous one at the same commands by the deviations, and from itself at cNom by the correction's
         // turn — both of the same order).
-        nominal_.jacobian(cache.q - deltaPrev, toolLength, Jn, tip, axis);
+        nominal_.jacobian(nominalData_, cache.q - deltaPrev, toolLength, Jn, tip, axis);
         Jn.bottomRows<3>() *= options_.axisWeight;
         for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j) {
@@ -406,7 +408,7 @@ bool Corrector::factorUsable(const JacobianCache& cache, const Damping& damping,
 }
 
 void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask free, const AxisVector* neighbourDelta,
-                           Damping& damping, AxisVector& reference) const {
+                           Damping& damping, AxisVector& reference) {
     const int n = static_cast<int>(cNom.size());
     damping.any = false;  // D is read only when `any`; it is zeroed below before the first term is added
     reference = cNom;
@@ -443,7 +445,7 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
     // that damping and continuity act only in the ill-conditioned directions and fade smoothly into the exact solution.
     PoseJacobian Jn;
     Vec3 tip, axis;
-    nominal_.jacobian(cNom + zero_, toolLength, Jn, tip, axis);
+    nominal_.jacobian(nominalData_, cNom + zero_, toolLength, Jn, tip, axis);
     gram(Jn, 1.0);
     double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
     symmetricEigen(G, k, lambda, V);
@@ -470,10 +472,10 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
         for (int a = 0; a < k; ++a) reference[axes[a]] += (lc2 / lam2) * (*neighbourDelta)[axes[a]];
 }
 
-SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip,
+SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const Vec3& targetTip,
                                const Vec3& targetAxis, double toolLength, const AxisVector& start,
                                const AxisVector& reference, const Damping& damping, AxisMask free,
-                               AxisVector& c) const {
+                               AxisVector& c) {
     SolveResult res;
     const int n = static_cast<int>(start.size());
     AxisVector q = start, refScratch;
@@ -481,7 +483,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
     const AxisVector& ref = model(reference, refScratch);
     const double w = options_.axisWeight;
     double step[kMaxAxes], g[kMaxAxes], r[6];
-    if (!cacheUsable(cache, q, toolLength)) refreshJacobian(k, cache, q, toolLength);
+    if (!cacheUsable(cache, q, toolLength)) refreshJacobian(k, kd, cache, q, toolLength);
     bool fresh = cache.q == q;  // evaluated at this very start (here or by solve())
     if (!factorUsable(cache, damping, free)) factor(cache, damping, free);
     double lastStep = HUGE_VAL, linStep = 0.0, rotStep = 0.0;
@@ -509,7 +511,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
     };
     Vec3 tip, axis;
     for (res.iterations = 0; res.iterations < options_.maxIterations; ++res.iterations) {
-        k.toolPoseOnce(q, toolLength, tip, axis);
+        k.toolPoseOnce(kd, q, toolLength, tip, axis);
         const Vec3 et = targetTip - tip, ea = targetAxis - axis;
         for (int j = 0; j < 3; ++j) r[j] = et[j], r[3 + j] = ea[j] * w;
         res.tipError = et.norm();
@@ -518,7 +520,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
         double size = newtonStep();
         // Chord method: the kept Jacobian while the steps shrink fast, a fresh one when they do not.
         if (!fresh && size > 0.25 * lastStep) {
-            refreshJacobian(k, cache, q, toolLength);
+            refreshJacobian(k, kd, cache, q, toolLength);
             factor(cache, damping, free);
             fresh = true;
             size = newtonStep();
@@ -544,7 +546,7 @@ SolveResult Corrector::solveOn(const CompiledKinematics& k, JacobianCache& cache
 }
 
 SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
-                             const AxisVector* neighbourDelta, const Vec3& tipShift, const NominalPose* target) const {
+                             const AxisVector* neighbourDelta, const Vec3& tipShift, const NominalPose* target) {
     const int n = static_cast<int>(cNom.size());
     if (identity_) {
         c = cNom;
@@ -562,7 +564,7 @@ SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const Ax
     // The kept Jacobian near the start first: it tells whether the pose is well conditioned (no damping at all).
     AxisVector scratch;
     const AxisVector& sModel = model(s, scratch);
-    if (!cacheUsable(cache_, sModel, toolLength)) refreshJacobian(actual_, cache_, sModel, toolLength);
+    if (!cacheUsable(cache_, sModel, toolLength)) refreshJacobian(actual_, actualData_, cache_, sModel, toolLength);
     Damping damping;
     AxisVector reference;
     dampingFor(cNom, toolLength, free, neighbourDelta, damping, reference);
@@ -572,14 +574,14 @@ SolveResult Corrector::solve(const AxisVector& cNom, double toolLength, const Ax
         tip = target->tip + (toolLength - target->length) * target->axis;
         axis = target->axis;
     } else {
-        nominal_.toolPose(cNom + zero_, toolLength, tip, axis);
+        nominal_.toolPose(nominalData_, cNom + zero_, toolLength, tip, axis);
     }
-    return solveOn(actual_, cache_, tip + tipShift, axis, toolLength, s, reference, damping, free, c);
+    return solveOn(actual_, actualData_, cache_, tip + tipShift, axis, toolLength, s, reference, damping, free, c);
 }
 
 SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess,
                                const AxisVector& start, const AxisVector* neighbourDelta, AxisVector& cNom, AxisVector& c,
-                               ProgramPoint& out, const Vec3& tipShift) const {
+                               ProgramPoint& out, const Vec3& tipShift) {
     SolveResult res;
     if (!toJoints(s, nominal, guess, cNom)) {
         c = guess;
@@ -598,7 +600,7 @@ SolveResult Corrector::correct(const MoveSpace& s, const ProgramPoint& nominal, 
     return res;
 }
 
-Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
+Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) {
     if (s.mode == ProgramMode::Joints) return nominalTip(p.p, s.toolLength);
     // TCP: the programmed point is the controlled point (world frame), the nominal tip lies along the tool axis from
     // it; the axis depends on the rotary angles only (or is the programmed vector). No inverse kinematics needed.
@@ -610,13 +612,13 @@ Vec3 Corrector::nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const {
         axis = tcp_.axisFromWorld(p.v.normalized());
     } else {
         AxisVector scratch;
-        axis = nominal_.toolAxisOnce(model(p.p, scratch));
+        axis = nominal_.toolAxisOnce(nominalData_, model(p.p, scratch));
     }
     return point + (s.toolLength - s.controlLength) * axis;
 }
 
 double Corrector::deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected,
-                              double t) const {
+                              double t) {
     AxisVector cc;
     if (!toJoints(ctx.space, corrected, ctx.guess, cc)) return HUGE_VAL;
     const Vec3 e = actualTip(cc, ctx.space.toolLength) - nominalTipOf(ctx.space, nominal) - (1.0 - t) * ctx.startOffset;
@@ -624,7 +626,7 @@ double Corrector::deviationAt(const PathContext& ctx, const ProgramPoint& nomina
 }
 
 void Corrector::correctedAt(const MovePath& path, const PathContext& ctx, double t, const ProgramPoint& near,
-                            ProgramPoint& out, SplitStats& stats) const {
+                            ProgramPoint& out, SplitStats& stats) {
     ProgramPoint pn;
     path.at(t, pn);
     AxisVector cNom, c, start;
@@ -638,7 +640,7 @@ void Corrector::correctedAt(const MovePath& path, const PathContext& ctx, double
 }
 
 void Corrector::split(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool subdivide,
-                      std::vector<Piece>& pieces, SplitStats& stats) const {
+                      std::vector<Piece>& pieces, SplitStats& stats) {
     if (identity_) {
         pieces.push_back({1.0, end});
         return;
@@ -669,7 +671,7 @@ void Corrector::split(const MovePath& path, const PathContext& ctx, const Progra
 
 void Corrector::splitRecursive(const MovePath& path, const PathContext& ctx, double t0, const ProgramPoint& q0,
                                double t1, const ProgramPoint& q1, int depth, std::vector<Piece>& pieces,
-                               SplitStats& stats) const {
+                               SplitStats& stats) {
     const double tm = 0.5 * (t0 + t1);
     ProgramPoint pn, pc;
     path.at(tm, pn);
@@ -687,7 +689,7 @@ void Corrector::splitRecursive(const MovePath& path, const PathContext& ctx, dou
     splitRecursive(path, ctx, tm, qm, t1, q1, depth + 1, pieces, stats);
 }
 
-ArcFit Corrector::fitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool closed) const {
+ArcFit Corrector::fitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool closed) {
     ArcFit fit;
     const int a0 = path.axis0, a1 = path.axis1;
     if (identity_) {
@@ -757,7 +759,7 @@ ArcFit Corrector::fitArc(const MovePath& path, const PathContext& ctx, const Pro
 }
 
 void Corrector::splitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end,
-                         std::vector<Piece>& pieces, SplitStats& stats) const {
+                         std::vector<Piece>& pieces, SplitStats& stats) {
     // Chords whose sagitta stays below half the tolerance; the midpoint checks split further where needed.
     const double r = std::max(path.r0, path.r1);
     const double tol = ctx.tolerance * 0.5;

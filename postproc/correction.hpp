@@ -9,7 +9,7 @@
 // commands are machine coordinates + machine-zero (MachineModel::fromController), converted here where they meet it.
 #include <vector>
 
-#include "postproc/compiled_kinematics.hpp"
+#include "cnccomp/kinematics_engine.hpp"
 #include "postproc/modal.hpp"
 #include "postproc/tcp_model.hpp"
 
@@ -117,16 +117,16 @@ public:
     /// True when every deviation is zero: corrected positions are the positions, nothing is solved.
     bool identity() const { return identity_; }
     const CorrectorOptions& options() const { return options_; }
-    const CompiledKinematics& nominal() const { return nominal_; }
-    const CompiledKinematics& actual() const { return actual_; }
+    const KinematicsModel& nominal() const { return nominal_; }
+    const KinematicsModel& actual() const { return actual_; }
     const TcpModel& tcp() const { return tcp_; }
 
     /// Machine coordinates of a program position (nominal controller). false when the TCP inverse fails. `pose`
     /// (optional): the nominal tool point and axis there, when the inverse gives them on the way (TCP angles mode).
     bool toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVector& guess, AxisVector& c,
-                  NominalPose* pose = nullptr) const;
+                  NominalPose* pose = nullptr);
     /// Program position of machine coordinates c.
-    void toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p) const;
+    void toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint& p);
 
     /// Machine coordinates `c` near `start` at which the erroneous machine puts the point at `toolLength` along the
     /// tool, and the tool axis, where the nominal machine puts them at `cNom`. Gauss–Newton on the exact model: the tip
@@ -141,7 +141,7 @@ public:
     /// `target` (optional): the nominal pose at cNom as toJoints gave it (else it is evaluated).
     SolveResult solve(const AxisVector& cNom, double toolLength, const AxisVector& start, AxisVector& c,
                       const AxisVector* neighbourDelta = nullptr, const Vec3& tipShift = Vec3::Zero(),
-                      const NominalPose* target = nullptr) const;
+                      const NominalPose* target = nullptr);
 
     /// Start for solve() at cNom from the solution at the previous end point (nominal cNomPrev, correction deltaPrev =
     /// its c − cNom): cNom + deltaPrev + S (cNom − cNomPrev), S = ∂(c − cNom)/∂cNom = (JᵀJ + D)⁻¹ Jᵀ (Jnom − J) from the
@@ -150,43 +150,43 @@ public:
     /// range costs little). Only a start: solve() converges from it as from any other; without a kept Jacobian near
     /// cNom it is cNom + deltaPrev.
     void predictStart(const AxisVector& cNom, const AxisVector& cNomPrev, const AxisVector& deltaPrev, double toolLength,
-                      AxisVector& start) const;
+                      AxisVector& start);
 
     /// Tip (at `toolLength`) of the nominal machine at cNom minus that of the erroneous machine at c.
-    Vec3 tipError(const AxisVector& cNom, const AxisVector& c, double toolLength) const;
-    double tipDeviation(const AxisVector& cNom, const AxisVector& c, double toolLength) const {
+    Vec3 tipError(const AxisVector& cNom, const AxisVector& c, double toolLength);
+    double tipDeviation(const AxisVector& cNom, const AxisVector& c, double toolLength) {
         return tipError(cNom, c, toolLength).norm();
     }
     /// Tip of the erroneous machine at c.
-    Vec3 actualTip(const AxisVector& c, double toolLength) const;
-    Vec3 nominalTip(const AxisVector& c, double toolLength) const;
+    Vec3 actualTip(const AxisVector& c, double toolLength);
+    Vec3 nominalTip(const AxisVector& c, double toolLength);
     /// Tip (at s.toolLength) of the nominal machine at program position p, in the workpiece frame.
-    Vec3 nominalTipOf(const MoveSpace& s, const ProgramPoint& p) const;
+    Vec3 nominalTipOf(const MoveSpace& s, const ProgramPoint& p);
 
     /// Corrected program position for the nominal one: joints `cNom` (out), solved joints `c` (start `start`,
     /// reference rotary positions `reference`), the program position `out`.
     SolveResult correct(const MoveSpace& s, const ProgramPoint& nominal, const AxisVector& guess, const AxisVector& start,
                         const AxisVector* neighbourDelta, AxisVector& cNom, AxisVector& c, ProgramPoint& out,
-                        const Vec3& tipShift = Vec3::Zero()) const;
+                        const Vec3& tipShift = Vec3::Zero());
 
     /// Appends pieces (ending at t = 1 with `end`) so that the controller's interpolation between consecutive
     /// corrected positions, starting from ctx.outStart, stays within ctx.tolerance of `path` at every checked
     /// midpoint. `subdivide` false: one piece, deviation still measured at the midpoint.
     void split(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool subdivide,
-               std::vector<Piece>& pieces, SplitStats& stats) const;
+               std::vector<Piece>& pieces, SplitStats& stats);
 
     /// Corrected arc from ctx.outStart to `end` that stays a circle in the same plane: its centre is the nominal
     /// centre corrected, moved onto the bisector of the corrected end points; ok when every sampled point is within
     /// the tolerance of the nominal arc.
-    ArcFit fitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool closed) const;
+    ArcFit fitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, bool closed);
 
     /// Arc → straight pieces: chords short enough for the tolerance, each checked and split like a line.
     void splitArc(const MovePath& path, const PathContext& ctx, const ProgramPoint& end, std::vector<Piece>& pieces,
-                  SplitStats& stats) const;
+                  SplitStats& stats);
 
     /// Tip deviation of the corrected interpolation at program point `corrected` from the nominal path point `nominal`
     /// at parameter t (with the context's start offset blended out).
-    double deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected, double t) const;
+    double deviationAt(const PathContext& ctx, const ProgramPoint& nominal, const ProgramPoint& corrected, double t);
 
 private:
     /// Jacobian of the erroneous machine and its factorised normal matrix, kept from one solve to the next while the
@@ -216,24 +216,26 @@ private:
         bool any = false;
         double D[kMaxAxes][kMaxAxes];  ///< read only when `any` (left unset otherwise)
     };
-    SolveResult solveOn(const CompiledKinematics& k, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
+    SolveResult solveOn(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
                         double toolLength, const AxisVector& start, const AxisVector& reference, const Damping& damping,
-                        AxisMask free, AxisVector& c) const;
-    void refreshJacobian(const CompiledKinematics& k, JacobianCache& cache, const AxisVector& q, double toolLength) const;
+                        AxisMask free, AxisVector& c);
+    void refreshJacobian(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const AxisVector& q,
+                         double toolLength) const;
     bool cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength) const;
     void factor(JacobianCache& cache, const Damping& damping, AxisMask free) const;
     bool factorUsable(const JacobianCache& cache, const Damping& damping, AxisMask free) const;
     /// The damping of a solve at target cNom, and the rotary reference it pulls towards (cNom + the neighbour's share).
     void dampingFor(const AxisVector& cNom, double toolLength, AxisMask free, const AxisVector* neighbourDelta,
-                    Damping& damping, AxisVector& reference) const;
+                    Damping& damping, AxisVector& reference);
     void splitRecursive(const MovePath& path, const PathContext& ctx, double t0, const ProgramPoint& q0, double t1,
-                        const ProgramPoint& q1, int depth, std::vector<Piece>& pieces, SplitStats& stats) const;
+                        const ProgramPoint& q1, int depth, std::vector<Piece>& pieces, SplitStats& stats);
     /// Corrected program position of the nominal path at t, started near `near` (program space).
     void correctedAt(const MovePath& path, const PathContext& ctx, double t, const ProgramPoint& near,
-                     ProgramPoint& out, SplitStats& stats) const;
+                     ProgramPoint& out, SplitStats& stats);
 
     const MachineModel& machine_;
-    CompiledKinematics nominal_, actual_;
+    KinematicsModel nominal_, actual_;
+    KinematicsData nominalData_, actualData_;  ///< the workspaces of nominal_ (shared with tcp_) and actual_
     TcpModel tcp_;
     CorrectorOptions options_;
     AxisVector zero_;      ///< model commands of the controller's machine zero (machine-zero per axis)
@@ -243,8 +245,8 @@ private:
     bool identity_ = false;
     bool affine_ = false;  ///< no component errors: with rotary axes fixed, the error is affine in the linear axes
     AxisMask rotary_ = 0;
-    mutable JacobianCache cache_;  ///< not thread-safe: one Corrector per thread
-    mutable bool lastDamped_ = false;  ///< the last solve was damped (near a singular pose)
+    JacobianCache cache_;  ///< kept from one solve to the next (with the workspaces: one Corrector per thread)
+    bool lastDamped_ = false;  ///< the last solve was damped (near a singular pose)
 };
 
 }  // namespace cnccomp::pp

@@ -48,7 +48,7 @@ public:
     void run(LineReader& reader);
 
 private:
-    AxisMask convert(ProgramMode from, ProgramMode to, double lc, AxisVector& pos, AxisMask known) const {
+    AxisMask convert(ProgramMode from, ProgramMode to, double lc, AxisVector& pos, AxisMask known) {
         if ((known & all_) != all_ || (from != ProgramMode::Joints && !corrector_.tcp().supported()) ||
             (to != ProgramMode::Joints && !corrector_.tcp().supported()))
             return known & rotary_;

@@ -35,7 +35,7 @@ void addNotice(CorrectSummary& summary, std::ostream* report, bool warning, uint
     if (list.size() < CorrectSummary::kMaxNotices) list.push_back({line, std::move(message)});
 }
 
-double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
+double digitsTolerance(Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
                        int rotDecimals, bool inch, int linearAxes, int rotaryAxes) {
     const double linStep = tenTo(-linDecimals) * (inch ? 25.4 : 1.0);
     double floor = 0.5 * linStep * std::sqrt(static_cast<double>(std::max(linearAxes, 1)));
@@ -62,7 +62,7 @@ double toleranceWithin(double tolMm, double floorMm, int linDecimals, CorrectSum
     return floorMm;
 }
 
-void refuseAssumedToolLength(const Corrector& corrector, const AxisLayout& layout, const AxisVector& cNom,
+void refuseAssumedToolLength(Corrector& corrector, const AxisLayout& layout, const AxisVector& cNom,
                              const AxisVector& cEnd, double toolLength, double toleranceMm, const std::string& name,
                              uint64_t line) {
     bool rotaryOff = false;
@@ -166,13 +166,13 @@ struct Where {
     bool vectorValid = false;
 };
 
-bool jointsOf(const Corrector& corrector, Where& w, const AxisVector& guess) {
+bool jointsOf(Corrector& corrector, Where& w, const AxisVector& guess) {
     if (!w.known) return false;
     if (!w.jointsValid) w.jointsValid = corrector.toJoints(w.space, w.point, guess, w.joints);
     return w.jointsValid;
 }
 
-bool vectorOf(const Corrector& corrector, Where& w, const AxisVector& guess) {
+bool vectorOf(Corrector& corrector, Where& w, const AxisVector& guess) {
     if (!w.known) return false;
     if (w.vectorValid) return true;
     if (w.space.mode == ProgramMode::TcpVector) {
@@ -188,7 +188,7 @@ bool vectorOf(const Corrector& corrector, Where& w, const AxisVector& guess) {
 }
 
 /// After a TCP mode switch: the same machine position read in the new mode (false when it is not known).
-bool convertWhere(const Corrector& corrector, Where& w, const MoveSpace& space, const AxisVector& guess) {
+bool convertWhere(Corrector& corrector, Where& w, const MoveSpace& space, const AxisVector& guess) {
     if (!jointsOf(corrector, w, guess)) {
         w.known = false;
         return false;

@@ -97,7 +97,7 @@ void addNotice(CorrectSummary& summary, std::ostream* report, bool warning, uint
 /// The finest path tolerance the written digits can hold at a move ending at `end` (program space): each end point is
 /// off by up to half a digit per axis — √(linear axes) half-digits of `linDecimals` (mm, or inch digits), and in joint
 /// mode √(rotary axes) half-digits of `rotDecimals` (degrees) times the rotary axes' lever arm at the pose.
-double digitsTolerance(const Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
+double digitsTolerance(Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
                        int rotDecimals, bool inch, int linearAxes, int rotaryAxes);
 /// --tol-um (tolMm), or that bound when the tolerance is finer than the digits hold: then counted in the summary and
 /// said once (a warning at `line`; `warned` remembers it).
@@ -113,7 +113,7 @@ constexpr double kToolLengthProbeMm = 100.0;
 /// `toleranceMm` off its nominal place (`cNom`), the correction depends on that length: throws InputError naming
 /// `name`:`line` and asking for --tool-length (0 when meant). On a five-axis machine whose rotary axes match the tool
 /// axis exactly the whole tool line is corrected and nothing is refused.
-void refuseAssumedToolLength(const Corrector& corrector, const AxisLayout& layout, const AxisVector& cNom,
+void refuseAssumedToolLength(Corrector& corrector, const AxisLayout& layout, const AxisVector& cNom,
                              const AxisVector& cEnd, double toolLength, double toleranceMm, const std::string& name,
                              uint64_t line);
 

@@ -4,7 +4,7 @@
 
 namespace cnccomp::pp {
 
-TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
+TcpModel::TcpModel(const KinematicsModel& nominal, KinematicsData& data) : nominal_(nominal) {
     const MachineModel& m = nominal.machine();
     const int n = m.axisCount();
     zero_ = m.fromController(AxisVector::Zero(n));
@@ -43,39 +43,39 @@ TcpModel::TcpModel(const CompiledKinematics& nominal) : nominal_(nominal) {
         fixedSlides_ = fixedSlides_ && std::fabs(D.determinant()) > 1e-6;
         if (fixedSlides_) slidesInverse_ = D.inverse();
     }
-    const Frame w = nominal.baseToWorkpiece(zero_);
-    const Frame t = nominal.baseToTool(zero_);
+    const Frame w = nominal.baseToWorkpiece(data, zero_);
+    const Frame t = nominal.baseToTool(data, zero_);
     R0_ = w.R;
     t0_ = w.t - t.t;
 }
 
-void TcpModel::forward(const AxisVector& c, double length, Vec3& point, Vec3& axis) const {
+void TcpModel::forward(KinematicsData& d, const AxisVector& c, double length, Vec3& point, Vec3& axis) const {
     AxisVector scratch;
     const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);
     Vec3 pw, aw;
-    nominal_.toolPoseOnce(q, length, pw, aw);
+    nominal_.toolPoseOnce(d, q, length, pw, aw);
     point = R0_ * pw + t0_;
     axis = R0_ * aw;
 }
 
-void TcpModel::toProgram(const AxisVector& c, double length, AxisVector& p) const {
+void TcpModel::toProgram(KinematicsData& d, const AxisVector& c, double length, AxisVector& p) const {
     Vec3 point, axis;
-    forward(c, length, point, axis);
+    forward(d, c, length, point, axis);
     p = c;
     for (int k = 0; k < 3; ++k) p[lin_[k]] = point[k];
 }
 
-bool TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c, Vec3* tipOut, Vec3* axisOut) const {
+bool TcpModel::toJoints(KinematicsData& d, const AxisVector& p, double length, AxisVector& c, Vec3* tipOut, Vec3* axisOut) const {
     c = p;  // rotary angles as programmed; linear axes start at the world coordinates
     AxisVector scratch;
     const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);  // (may be c itself: read before c changes below)
     const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
     if (fixedSlides_) {
         Vec3 tip, axis;
-        nominal_.toolPoseOnce(q, length, tip, axis);
+        nominal_.toolPoseOnce(d, q, length, tip, axis);
         // A = R0 · w.Rᵀ · D, A⁻¹ = D⁻¹ · w.R · R0ᵀ
-        const Vec3 d = slidesInverse_ * nominal_.workpieceToBase(q, R0_.transpose() * (want - (R0_ * tip + t0_)));
-        for (int k = 0; k < 3; ++k) c[lin_[k]] += d[k];
+        const Vec3 dq = slidesInverse_ * nominal_.workpieceToBase(d, q, R0_.transpose() * (want - (R0_ * tip + t0_)));
+        for (int k = 0; k < 3; ++k) c[lin_[k]] += dq[k];
         if (!tipOut || !axisOut) return false;
         *tipOut = pointFromWorld(want);  // where the slides just put it (the point is affine in them)
         *axisOut = axis;                 // the slides do not turn the tool
@@ -83,11 +83,11 @@ bool TcpModel::toJoints(const AxisVector& p, double length, AxisVector& c, Vec3*
     }
     Mat3 J;
     Vec3 tip;
-    nominal_.pointJacobian(q, length, lin_, J, tip);
+    nominal_.pointJacobian(d, q, length, lin_, J, tip);
     const Mat3 A = R0_ * J;
     const Vec3 have = R0_ * tip + t0_;
-    const Vec3 d = A.inverse() * (want - have);  // 3 x 3, well conditioned (the slides are orthogonal nominally)
-    for (int k = 0; k < 3; ++k) c[lin_[k]] += d[k];
+    const Vec3 dq = A.inverse() * (want - have);  // 3 x 3, well conditioned (the slides are orthogonal nominally)
+    for (int k = 0; k < 3; ++k) c[lin_[k]] += dq[k];
     return false;
 }
 

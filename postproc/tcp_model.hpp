@@ -14,27 +14,30 @@
 // p_w, v_w in the model's workpiece frame, gauge(qz) = where the tool frame origin (tool length 0) is in the bed.
 // Program-space vectors use the machine's axis layout: the X, Y, Z slots hold the world x, y, z of the controlled
 // point, the rotary slots the rotary angles (rad).
-#include "postproc/compiled_kinematics.hpp"
+#include "cnccomp/kinematics_engine.hpp"
 
 namespace cnccomp::pp {
 
 class TcpModel {
 public:
-    explicit TcpModel(const CompiledKinematics& nominal);
+    /// `data`: the workspace of `nominal` the constructor evaluates with (the machine zero's frames).
+    TcpModel(const KinematicsModel& nominal, KinematicsData& data);
 
     /// False when the machine has no linear X, Y and Z axes (TCP programs cannot be read for it); why() says so.
     bool supported() const { return supported_; }
     const char* why() const { return why_; }
 
+    // The evaluations below use `d`, a workspace of the nominal model given to the constructor.
+
     /// World controlled point (tool length `length`) and world tool axis (spindle → tip) at machine coordinates c.
-    void forward(const AxisVector& c, double length, Vec3& point, Vec3& axis) const;
+    void forward(KinematicsData& d, const AxisVector& c, double length, Vec3& point, Vec3& axis) const;
     /// Program-space position of machine coordinates c (angles mode and the point of vector mode).
-    void toProgram(const AxisVector& c, double length, AxisVector& p) const;
+    void toProgram(KinematicsData& d, const AxisVector& c, double length, AxisVector& p) const;
     /// Machine coordinates of program-space p in angles mode: rotary axes at p's angles, linear axes solved
     /// (exact: with the rotary axes fixed the nominal point is affine in the linear axes). `c` may alias nothing.
     /// With `tip` and `axis`: the nominal point at `length` and tool axis there (model workpiece frame) when the solve
     /// gives them on the way (returns true), else false and they are not set.
-    bool toJoints(const AxisVector& p, double length, AxisVector& c, Vec3* tip = nullptr, Vec3* axis = nullptr) const;
+    bool toJoints(KinematicsData& d, const AxisVector& p, double length, AxisVector& c, Vec3* tip = nullptr, Vec3* axis = nullptr) const;
     /// World tool axis (spindle → tip) in the world frame → model workpiece frame, and back.
     Vec3 axisToWorld(const Vec3& axisW) const { return R0_ * axisW; }
     Vec3 axisFromWorld(const Vec3& axisWorld) const { return R0_.transpose() * axisWorld; }
@@ -43,7 +46,7 @@ public:
     const int* linearAxes() const { return lin_; }
 
 private:
-    const CompiledKinematics& nominal_;
+    const KinematicsModel& nominal_;
     AxisVector zero_;  ///< model commands of the controller's machine zero
     bool zeroIsZero_ = true;
     Mat3 R0_ = Mat3::Identity();

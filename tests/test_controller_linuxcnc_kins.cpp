@@ -24,7 +24,7 @@
 #include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "controllers/linuxcnc/kins_component.hpp"
-#include "postproc/compiled_kinematics.hpp"
+#include "cnccomp/kinematics_engine.hpp"
 #include "postproc/tcp_model.hpp"
 #include "test_support.hpp"
 
@@ -192,8 +192,9 @@ void checkMachine(const Sample& s, int poses, Figures& fig) {
     test::ScratchDir dir(std::string("kins-") + s.machine);
     LoadedKins k(compileComponent(dir, comp));
     const Kinematics nominal(m), real(m, d);
-    const pp::CompiledKinematics compiledNominal(m, nullptr);
-    const pp::TcpModel tcp(compiledNominal);
+    const KinematicsModel compiledNominal(m, nullptr);
+    KinematicsData kd(compiledNominal);
+    const pp::TcpModel tcp(compiledNominal, kd);
     const int n = m.axisCount();
     std::mt19937 rng(20261126);
     const IkOptions ik = referenceOptions(o);
@@ -218,7 +219,7 @@ void checkMachine(const Sample& s, int poses, Figures& fig) {
                 // at length L, rotary words = the angles).
                 AxisVector cc(n), p;
                 for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
-                tcp.toProgram(cc, L, p);
+                tcp.toProgram(kd, cc, L, p);
                 p[m.requireAxis("Z")] += L;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                 for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
                 target = toolPose(nominal, q, tipInTool);  // the nominal machine at those joints
@@ -393,11 +394,12 @@ TEST(LinuxcncKinsComponent, SingularPoseOfTheMultitaskingMachine) {
             if (mode == 0) {
                 for (int i = 0; i < m.axisCount(); ++i) slot(world, m.axisNames[i]) = cj[i];
             } else {
-                const pp::CompiledKinematics compiledNominal(m, nullptr);
-                const pp::TcpModel tcp(compiledNominal);
+                const KinematicsModel compiledNominal(m, nullptr);
+                KinematicsData kd(compiledNominal);
+                const pp::TcpModel tcp(compiledNominal, kd);
                 AxisVector cc(m.axisCount()), p;
                 for (int i = 0; i < m.axisCount(); ++i) cc[i] = cj[i] * unitOf(m, i);
-                tcp.toProgram(cc, L, p);
+                tcp.toProgram(kd, cc, L, p);
                 p[m.requireAxis("Z")] += L;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                 for (int i = 0; i < m.axisCount(); ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
             }
@@ -427,8 +429,9 @@ TEST(LinuxcncKinsComponent, SolvesFromFarAwayJoints) {
         test::ScratchDir dir(std::string("kins-jumps-") + s.machine);
         LoadedKins k(compileComponent(dir, kinematicsComponent(m, d, {})));
         const Kinematics nominal(m), real(m, d);
-        const pp::CompiledKinematics compiledNominal(m, nullptr);
-        const pp::TcpModel tcp(compiledNominal);
+        const KinematicsModel compiledNominal(m, nullptr);
+        KinematicsData kd(compiledNominal);
+        const pp::TcpModel tcp(compiledNominal, kd);
         const int n = m.axisCount();
         std::mt19937 rng(99);
         std::vector<double> joints(n, 0.0);
@@ -450,7 +453,7 @@ TEST(LinuxcncKinsComponent, SolvesFromFarAwayJoints) {
                 if (mode == 0) {
                     p = cc;
                 } else {
-                    tcp.toProgram(cc, L, p);
+                    tcp.toProgram(kd, cc, L, p);
                     p[m.requireAxis("Z")] += L;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                 }
                 for (int i = 0; i < n; ++i) slot(world, m.axisNames[i]) = p[i] / unitOf(m, i);
@@ -546,8 +549,9 @@ TEST(LinuxcncKinsComponent, InverseCostPerCall) {
             ASSERT_EQ(k.kinsSwitch(mode), 0);
             const int calls = 100000;
             std::vector<CPose> words(calls);
-            const pp::CompiledKinematics compiledNominal(m, nullptr);
-            const pp::TcpModel tcp(compiledNominal);
+            const KinematicsModel compiledNominal(m, nullptr);
+            KinematicsData kd(compiledNominal);
+            const pp::TcpModel tcp(compiledNominal, kd);
             for (int t = 0; t < calls; ++t) {
                 const AxisVector q = a + (b - a) * (double(t) / calls);
                 const std::vector<double> c = toJoints(m, q);
@@ -556,7 +560,7 @@ TEST(LinuxcncKinsComponent, InverseCostPerCall) {
                 } else {
                     AxisVector cc(n), p;
                     for (int i = 0; i < n; ++i) cc[i] = c[i] * unitOf(m, i);
-                    tcp.toProgram(cc, 80.0, p);
+                    tcp.toProgram(kd, cc, 80.0, p);
                     p[m.requireAxis("Z")] += 80.0;  // G43: LinuxCNC adds the tool length to the Z word (emccanon.cc)
                     for (int i = 0; i < n; ++i) slot(words[t], m.axisNames[i]) = p[i] / unitOf(m, i);
                 }

@@ -42,7 +42,7 @@ class PostprocSolver : public ::testing::TestWithParam<const char*> {};
 TEST_P(PostprocSolver, AgreesWithSolveToolPoseAwayFromSingularities) {
     const MachineModel m = readMachineXml(test::sourcePath(std::string("samples/machines/") + GetParam() + ".xml"));
     const DeviationSet d = randomDeviations(m, 7);
-    const Corrector corrector(m, d);
+    Corrector corrector(m, d);
     const Kinematics nominal(m), actual(m, d);
     std::mt19937_64 rng(3);
     double worstAxis = 0, worstRotary = 0, worstLinear = 0;
@@ -83,7 +83,7 @@ TEST(PostprocSolverSingular, ExactJustOutsideTheIllConditionedZone) {
     const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
     DeviationSet d = randomDeviations(m, 21);
     d.values *= 20.0;
-    const Corrector corrector(m, d);
+    Corrector corrector(m, d);
     const Kinematics nominal(m), actual(m, d);
     std::mt19937_64 rng(8);
     std::uniform_real_distribution<double> u(0, 1);
@@ -116,7 +116,7 @@ TEST(PostprocSolverSingular, ToolAxisParallelToCKeepsCBoundedAndTheTipExact) {
     DeviationSet d(m);
     d.set("aBT", 6.5 * kArcsec);
     d.set("dxBT", 0.012);
-    const Corrector corrector(m, d);
+    Corrector corrector(m, d);
     const Kinematics nominal(m), actual(m, d);
     AxisVector q = AxisVector::Zero(m.axisCount());
     q[m.requireAxis("X")] = 30;
@@ -138,7 +138,7 @@ TEST(PostprocSolverSingular, TipOnlyKeepsRotaryCommands) {
     const DeviationSet d = randomDeviations(m, 9);
     CorrectorOptions o;
     o.tipOnly = true;
-    const Corrector corrector(m, d, o);
+    Corrector corrector(m, d, o);
     std::mt19937_64 rng(4);
     const AxisVector q = poseAwayFromSingularities(m, rng);
     AxisVector qStar;
@@ -152,7 +152,7 @@ TEST(PostprocSolverSingular, TipOnlyKeepsRotaryCommands) {
 
 TEST(PostprocSolverSingular, ZeroDeviationsAreTheIdentity) {
     const MachineModel& m = test::multitasking();
-    const Corrector corrector(m, DeviationSet(m));
+    Corrector corrector(m, DeviationSet(m));
     EXPECT_TRUE(corrector.identity());
     std::mt19937_64 rng(1);
     const AxisVector q = poseAwayFromSingularities(m, rng);
@@ -166,7 +166,7 @@ TEST(PostprocSplit, RotaryMovesAreSplitUntilMidpointsMeetTheTolerance) {
     const DeviationSet d = randomDeviations(m, 12);
     CorrectorOptions o;
     o.toleranceMm = 0.5e-3;
-    const Corrector corrector(m, d, o);
+    Corrector corrector(m, d, o);
     AxisVector a = AxisVector::Zero(m.axisCount()), b = a;
     a[m.requireAxis("X")] = 40, a[m.requireAxis("Z")] = 150;
     b[m.requireAxis("X")] = -40, b[m.requireAxis("Z")] = 160, b[m.requireAxis("B")] = 40 * kDeg,

@@ -204,7 +204,7 @@ TEST(PostprocTcp, ControllerModelMatchesLinuxCncTrtKinematics) {
     // Our TCP world frame and inverse against trtfuncs.c transcribed: random joints, tool offsets 0 and 35 mm.
     SimFiles st;
     const MachineModel m = readMachineXml(st.machine);
-    const Corrector corrector(m, DeviationSet(m));
+    Corrector corrector(m, DeviationSet(m));
     const int ax = m.requireAxis("X"), ay = m.requireAxis("Y"), az = m.requireAxis("Z"), aa = m.requireAxis("A"),
               ac = m.requireAxis("C");
     std::srand(5);

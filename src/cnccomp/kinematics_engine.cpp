@@ -1,10 +1,18 @@
-#include "postproc/compiled_kinematics.hpp"
+#include "cnccomp/kinematics_engine.hpp"
 
+#include <atomic>
 #include <cmath>
 
-namespace cnccomp::pp {
+#include <fmt/format.h>
+
+#include "cnccomp/error.hpp"
+
+namespace cnccomp {
 
 namespace {
+
+std::atomic<uint64_t> modelCount{0};
+uint64_t nextModelId() { return ++modelCount; }
 
 bool isIdentity(const Mat3& R, const Vec3& t) { return R == Mat3::Identity() && t == Vec3::Zero(); }
 
@@ -18,7 +26,7 @@ inline void rotateAboutUnit(Mat3& R, int k, double c, double s) {
 
 }  // namespace
 
-void CompiledKinematics::rotateBack(const Op& op, double c, double s, Vec3& v) {
+void KinematicsModel::rotateBack(const Op& op, double c, double s, Vec3& v) {
     if (op.unit >= 0) {
         // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
         const int i = op.ui, j = op.uj;
@@ -32,7 +40,7 @@ void CompiledKinematics::rotateBack(const Op& op, double c, double s, Vec3& v) {
     }
 }
 
-Pose CompiledKinematics::componentError(const Op& op, const AxisVector& q) const {
+Pose KinematicsModel::componentError(const Op& op, const AxisVector& q) const {
     Vec6 e = Vec6::Zero();
     for (int k : op.components) {
         const DeviationDef& def = machine_->deviations[k];
@@ -41,25 +49,30 @@ Pose CompiledKinematics::componentError(const Op& op, const AxisVector& q) const
     return errorTransform(e);
 }
 
-CompiledKinematics::CompiledKinematics(const MachineModel& machine, const DeviationSet* deviations)
+KinematicsModel::KinematicsModel(const MachineModel& machine, const DeviationSet* deviations)
     : machine_(&machine),
+      id_(nextModelId()),
       values_(deviations ? deviations->values : Eigen::VectorXd::Zero(machine.parameterCount())) {
-    compile(machine.workpiece, Side::Workpiece, workpiece_);
-    compile(machine.tool, Side::Tool, tool_);
+    int slots = 0;
+    compile(machine.workpiece, Side::Workpiece, workpiece_, slots);
+    compile(machine.tool, Side::Tool, tool_, slots);
 }
 
-void CompiledKinematics::Trig::at(double angle, double& c, double& s) const {
-    if (angle == asked) {  // the same angle again (a pose and its frame, a chain walked twice)
-        c = askedC, s = askedS;
+KinematicsData::KinematicsData(const KinematicsModel& model) { model.bind(*this); }
+
+void KinematicsModel::bind(KinematicsData& d) const {
+    if (d.model_ == id_) return;
+    d = KinematicsData();
+    d.model_ = id_;
+}
+
+void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
+    if (angle == t.asked) {  // the same angle again (a pose and its frame, a chain walked twice)
+        c = t.askedC, s = t.askedS;
         return;
     }
-    asked = angle;
-    compute(angle, c, s);
-    askedC = c, askedS = s;
-}
-
-void CompiledKinematics::Trig::compute(double angle, double& c, double& s) const {
-    const double d = angle - last;
+    t.asked = angle;
+    const double d = angle - t.last;
     if (std::fabs(d) <= 0.05) {
         // Near the last angle (consecutive evaluations: Newton steps, neighbouring blocks): angle addition with the
         // Taylor series of the difference, whose first omitted terms (d¹¹/11!, d¹²/12! < 1e-22) are far below a
@@ -67,16 +80,17 @@ void CompiledKinematics::Trig::compute(double angle, double& c, double& s) const
         const double d2 = d * d;
         const double sd = d * (1 + d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880)))));
         const double cd = 1 + d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720 + d2 * (1.0 / 40320 + d2 * (-1.0 / 3628800)))));
-        c = lastC * cd - lastS * sd;
-        s = lastS * cd + lastC * sd;
-        return;
+        c = t.lastC * cd - t.lastS * sd;
+        s = t.lastS * cd + t.lastC * sd;
+    } else {
+        c = std::cos(angle);
+        s = std::sin(angle);
+        t.last = angle, t.lastC = c, t.lastS = s;  // only exact evaluations become bases: no drift
     }
-    c = std::cos(angle);
-    s = std::sin(angle);
-    last = angle, lastC = c, lastS = s;  // only exact evaluations become bases: no drift
+    t.askedC = c, t.askedS = s;
 }
 
-void CompiledKinematics::compile(const Chain& chain, Side side, ChainOps& c) {
+void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& slots) {
     std::vector<Op>& ops = c.ops;
     std::vector<int>& axes = c.axes;
     ops.clear();
@@ -119,6 +133,10 @@ void CompiledKinematics::compile(const Chain& chain, Side side, ChainOps& c) {
         op.axis = l.axisIndex;
         op.dir = l.direction;
         op.modulo = l.modulo;
+        if (op.kind == OpKind::Rotary) {
+            if (slots >= kMaxAxes) throw ModelError(fmt::format("machine '{}' has more than {} rotary axes", machine_->name, kMaxAxes));
+            op.slot = slots++;
+        }
         for (int k = 0; k < 3; ++k)
             if (l.direction == Vec3::Unit(k)) op.unit = k, op.ui = (k + 1) % 3, op.uj = (k + 2) % 3;
         ops.push_back(op);
@@ -151,7 +169,7 @@ void CompiledKinematics::compile(const Chain& chain, Side side, ChainOps& c) {
     }
 }
 
-void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const {
+void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const {
     if (c.affine.ok) {
         const Affine& a = c.affine;
         f.R = a.R;
@@ -188,7 +206,7 @@ void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame&
             case OpKind::Rotary: {
                 if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
                 double c, sn;
-                op.trig.at(q[op.axis], c, sn);
+                trig(d.trig_[op.slot], q[op.axis], c, sn);
                 if (op.unit >= 0) {
                     rotateAboutUnit(f.R, op.unit, c, sn);
                 } else {
@@ -212,12 +230,12 @@ void CompiledKinematics::evaluate(const ChainOps& c, const AxisVector& q, Frame&
     }
 }
 
-const CompiledKinematics::ChainEntry& CompiledKinematics::cached(const ChainOps& c, ChainCache& cache, const AxisVector& q,
-                                                                 bool lines) const {
+const KinematicsModel::ChainEntry& KinematicsModel::cached(KinematicsData& d, const ChainOps& c, ChainCache& cache,
+                                                           const AxisVector& q, bool lines) const {
     if (c.affine.ok) {  // cheaper to evaluate than to look up
         ChainEntry& e = cache.entry[0];
         e.lines.count = 0;
-        evaluate(c, q, e.frame, lines ? &e.lines : nullptr);
+        evaluate(d, c, q, e.frame, lines ? &e.lines : nullptr);
         e.valid = false;
         return e;
     }
@@ -231,23 +249,24 @@ const CompiledKinematics::ChainEntry& CompiledKinematics::cached(const ChainOps&
     ChainEntry& e = cache.entry[cache.next];
     cache.next ^= 1;
     e.lines.count = 0;
-    evaluate(c, q, e.frame, lines ? &e.lines : nullptr);
+    evaluate(d, c, q, e.frame, lines ? &e.lines : nullptr);
     e.hasLines = lines;
     e.valid = true;
     for (size_t k = 0; k < c.axes.size(); ++k) e.key[k] = q[c.axes[k]];
     return e;
 }
 
-void CompiledKinematics::toolPose(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
-    const Frame& w = cached(workpiece_, workpieceCache_, q, false).frame;
-    const Frame& t = cached(tool_, toolCache_, q, false).frame;
+void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
+    bind(d);
+    const Frame& w = cached(d, workpiece_, d.workpiece_, q, false).frame;
+    const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     tip.noalias() = w.R.transpose() * (t.t + length * dirB - w.t);
     axis.noalias() = w.R.transpose() * dirB;
 }
 
 template <bool WithPoint>
-void CompiledKinematics::intoWorkpiece(const AxisVector& q, Vec3& point, Vec3& direction) const {
+void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const {
     // w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base): op_1⁻¹ first.
     for (const Op& op : workpiece_.ops) {
         switch (op.kind) {
@@ -263,7 +282,7 @@ void CompiledKinematics::intoWorkpiece(const AxisVector& q, Vec3& point, Vec3& d
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                op.trig.at(q[op.axis], c, sn);
+                trig(d.trig_[op.slot], q[op.axis], c, sn);
                 if constexpr (WithPoint) rotateBack(op, c, sn, point);
                 rotateBack(op, c, sn, direction);
                 break;
@@ -278,9 +297,10 @@ void CompiledKinematics::intoWorkpiece(const AxisVector& q, Vec3& point, Vec3& d
     }
 }
 
-void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
+void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
+    bind(d);
     if (workpiece_.affine.ok) {
-        toolPose(q, length, tip, axis);
+        toolPose(d, q, length, tip, axis);
         return;
     }
     if (tool_.affine.ok) {  // the tool frame directly (no cache entry written)
@@ -290,26 +310,28 @@ void CompiledKinematics::toolPoseOnce(const AxisVector& q, double length, Vec3& 
         axis = a.R * machine_->toolDirection;  // base frame
         tip += length * axis;
     } else {
-        const Frame& t = cached(tool_, toolCache_, q, false).frame;
+        const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
         axis = t.R * machine_->toolDirection;
         tip = t.t + length * axis;
     }
-    intoWorkpiece<true>(q, tip, axis);
+    intoWorkpiece<true>(d, q, tip, axis);
 }
 
-Vec3 CompiledKinematics::toolAxisOnce(const AxisVector& q) const {
+Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const {
+    bind(d);
     if (workpiece_.affine.ok) {
         Vec3 tip, axis;
-        toolPose(q, 0.0, tip, axis);
+        toolPose(d, q, 0.0, tip, axis);
         return axis;
     }
-    Vec3 axis = (tool_.affine.ok ? tool_.affine.R : cached(tool_, toolCache_, q, false).frame.R) * machine_->toolDirection;
+    Vec3 axis = (tool_.affine.ok ? tool_.affine.R : cached(d, tool_, d.tool_, q, false).frame.R) * machine_->toolDirection;
     Vec3 unused;
-    intoWorkpiece<false>(q, unused, axis);
+    intoWorkpiece<false>(d, q, unused, axis);
     return axis;
 }
 
-Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) const {
+Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const {
+    bind(d);
     if (workpiece_.affine.ok) return workpiece_.affine.R * v;
     Vec3 r = v;
     for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
@@ -322,7 +344,7 @@ Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) con
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                op.trig.at(q[op.axis], c, sn);
+                trig(d.trig_[op.slot], q[op.axis], c, sn);
                 rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }
@@ -334,15 +356,16 @@ Vec3 CompiledKinematics::workpieceToBase(const AxisVector& q, const Vec3& v) con
     return r;
 }
 
-Vec3 CompiledKinematics::toolTip(const AxisVector& q, double length) const {
+Vec3 KinematicsModel::toolTip(KinematicsData& d, const AxisVector& q, double length) const {
     Vec3 tip, axis;
-    toolPose(q, length, tip, axis);
+    toolPose(d, q, length, tip, axis);
     return tip;
 }
 
-void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const {
-    const ChainEntry& we = cached(workpiece_, workpieceCache_, q, true);
-    const ChainEntry& te = cached(tool_, toolCache_, q, true);
+void KinematicsModel::jacobian(KinematicsData& d, const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const {
+    bind(d);
+    const ChainEntry& we = cached(d, workpiece_, d.workpiece_, q, true);
+    const ChainEntry& te = cached(d, tool_, d.tool_, q, true);
     const Frame &w = we.frame, &t = te.frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
@@ -366,15 +389,16 @@ void CompiledKinematics::jacobian(const AxisVector& q, double length, PoseJacobi
     }
 }
 
-void CompiledKinematics::pointJacobian(const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const {
+void KinematicsModel::pointJacobian(KinematicsData& d, const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const {
+    bind(d);
     // Joint lines only of the chains that hold one of the axes.
     auto holds = [&](const ChainOps& c) {
         for (int a : c.axes)
             if (a == axes[0] || a == axes[1] || a == axes[2]) return true;
         return false;
     };
-    const ChainEntry& we = cached(workpiece_, workpieceCache_, q, holds(workpiece_));
-    const ChainEntry& te = cached(tool_, toolCache_, q, holds(tool_));
+    const ChainEntry& we = cached(d, workpiece_, d.workpiece_, q, holds(workpiece_));
+    const ChainEntry& te = cached(d, tool_, d.tool_, q, holds(tool_));
     const Frame &w = we.frame, &t = te.frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     const Vec3 tipB = t.t + length * dirB;
@@ -391,8 +415,14 @@ void CompiledKinematics::pointJacobian(const AxisVector& q, double length, const
     }
 }
 
-Frame CompiledKinematics::baseToWorkpiece(const AxisVector& q) const { return cached(workpiece_, workpieceCache_, q, false).frame; }
+Frame KinematicsModel::baseToWorkpiece(KinematicsData& d, const AxisVector& q) const {
+    bind(d);
+    return cached(d, workpiece_, d.workpiece_, q, false).frame;
+}
 
-Frame CompiledKinematics::baseToTool(const AxisVector& q) const { return cached(tool_, toolCache_, q, false).frame; }
+Frame KinematicsModel::baseToTool(KinematicsData& d, const AxisVector& q) const {
+    bind(d);
+    return cached(d, tool_, d.tool_, q, false).frame;
+}
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp

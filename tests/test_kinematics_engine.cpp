@@ -1,19 +1,21 @@
-// The post-processor's compiled forward kinematics (postproc/compiled_kinematics.hpp: folded constant transforms,
-// affine chains evaluated without walking them, rotations from the last angle by angle addition, two cached
-// evaluations per chain; toolPoseOnce with the workpiece chain inverted onto the tool point) against the foundation's
-// cnccomp::Kinematics / toolPoseJacobian, an independent
-// implementation of the same model: every sample machine (location and component errors), and an inclined rotary
-// axis (a 45° head, the general rotation path). Sequences of nearby and far poses exercise every cache path.
+// The kinematics engine (src/cnccomp/kinematics_engine.hpp: folded constant transforms, affine chains evaluated
+// without walking them, rotations from the last angle by angle addition, two cached evaluations per chain in the
+// caller's workspace; toolPoseOnce with the workpiece chain inverted onto the tool point) against the exact
+// cnccomp::Kinematics / toolPoseJacobian, an independent implementation of the same model (oracle: the same equations
+// coded twice, one link at a time there): every machine in samples/machines (location and component errors), and an
+// inclined rotary axis (a 45° head, the general rotation path), to 1e-12 mm and 1e-13 rad. Sequences of nearby and far
+// poses exercise every cache path.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <random>
 
 #include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/io/machine_xml.hpp"
-#include "postproc/compiled_kinematics.hpp"
+#include "cnccomp/kinematics_engine.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp {
 namespace {
 
 /// A head whose B axis is inclined 45° in the Y-Z plane (as on a nutating head), with location errors on it.
@@ -49,7 +51,8 @@ DeviationSet randomSet(const MachineModel& m, std::mt19937_64& rng) {
 
 void compare(const MachineModel& m, const DeviationSet& d, const std::string& name) {
     const Kinematics ref(m, d);
-    const CompiledKinematics k(m, &d);
+    const KinematicsModel k(m, &d);
+    KinematicsData data = k.createData();
     std::mt19937_64 rng(11);
     std::uniform_real_distribution<double> u(-1, 1);
     AxisVector q(m.axisCount());
@@ -64,50 +67,74 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
             const bool rotary = m.axisLink(i).kind == AxisKind::Rotary;
             const double step = kind == 0 ? (rotary ? 2.0 : 200.0) : kind < 4 ? (rotary ? 0.04 : 5.0) : (rotary ? 1e-6 : 1e-4);
             q[i] += step * u(rng);
+            if (!rotary && std::fabs(q[i]) > 500.0) q[i] = std::copysign(1000.0, q[i]) - q[i];  // reflected into ±500 mm
         }
         if (kind == 5) std::swap(q, prev);
         for (double L : {0.0, 120.0}) {
             Vec3 tip, axis;
-            k.toolPose(q, L, tip, axis);
+            k.toolPose(data, q, L, tip, axis);
             const ToolPose r = toolPose(ref, q, ref.toolPoint(L));
             worstTip = std::max(worstTip, (tip - r.tip).norm());
             worstAxis = std::max(worstAxis, (axis - r.axis).norm());
             PoseJacobian J, Jr;
             Vec3 t2, a2;
-            k.jacobian(q, L, J, t2, a2);
+            k.jacobian(data, q, L, J, t2, a2);
             toolPoseJacobian(ref, q, ref.toolPoint(L), Jr);
             worstJ = std::max(worstJ, (J - Jr).cwiseAbs().maxCoeff());
             EXPECT_LT((t2 - r.tip).norm(), 1e-9) << name;
             // The same pose with the workpiece chain inverted onto the tool point (no frame built).
             Vec3 tipOnce, axisOnce;
-            k.toolPoseOnce(q, L, tipOnce, axisOnce);
+            k.toolPoseOnce(data, q, L, tipOnce, axisOnce);
             worstTip = std::max(worstTip, (tipOnce - r.tip).norm());
             worstAxis = std::max(worstAxis, (axisOnce - r.axis).norm());
-            worstAxis = std::max(worstAxis, (k.toolAxisOnce(q) - r.axis).norm());
+            worstAxis = std::max(worstAxis, (k.toolAxisOnce(data, q) - r.axis).norm());
             // A workpiece direction into the bed: the frame's rotation, and back to the tool direction there.
             const Vec3 v(u(rng), u(rng), u(rng));
-            worstAxis = std::max(worstAxis, (k.workpieceToBase(q, v) - k.baseToWorkpiece(q).R * v).norm());
+            worstAxis = std::max(worstAxis, (k.workpieceToBase(data, q, v) - k.baseToWorkpiece(data, q).R * v).norm());
             worstAxis = std::max(worstAxis,
-                                 (k.workpieceToBase(q, r.axis) - k.baseToTool(q).R * m.toolDirection).norm());
+                                 (k.workpieceToBase(data, q, r.axis) - k.baseToTool(data, q).R * m.toolDirection).norm());
         }
     }
-    std::printf("[ compiled ] %-32s tip %.2g mm, axis %.2g, Jacobian %.2g\n", name.c_str(), worstTip, worstAxis, worstJ);
-    EXPECT_LT(worstTip, 1e-9) << name;  // mm, at positions up to ~1000 mm: round-off
+    std::printf("[ engine   ] %-40s tip %.2g mm, axis %.2g, Jacobian %.2g\n", name.c_str(), worstTip, worstAxis, worstJ);
+    EXPECT_LT(worstTip, 1e-12) << name;  // mm, at linear commands within ±500 mm: round-off
     EXPECT_LT(worstAxis, 1e-13) << name;
     EXPECT_LT(worstJ, 1e-9) << name;
 }
 
-TEST(PostprocKinematics, CompiledModelMatchesTheFoundationsKinematics) {
+TEST(KinematicsEngine, MatchesTheExactKinematicsOnEverySampleMachine) {
     std::mt19937_64 rng(5);
-    for (const char* file : {"multitasking", "tilting-head-b", "table-table-ac", "table-table-bc-offsets",
-                             "controllers-siemens-components", "controllers-heidenhain-components"}) {
-        const MachineModel m = readMachineXml(test::sourcePath(std::string("samples/machines/") + file + ".xml"));
-        compare(m, DeviationSet(m), std::string(file) + " nominal");
-        compare(m, randomSet(m, rng), std::string(file) + " with errors");
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(test::sourcePath("samples/machines")))
+        if (e.path().extension() == ".xml") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    ASSERT_GE(files.size(), 12u);
+    for (const auto& file : files) {
+        const MachineModel m = readMachineXml(file.string());
+        const std::string name = file.stem().string();
+        compare(m, DeviationSet(m), name + " nominal");
+        compare(m, randomSet(m, rng), name + " with errors");
     }
 }
 
-TEST(PostprocKinematics, InclinedRotaryAxis) {
+TEST(KinematicsEngine, AWorkspaceFollowsItsModel) {
+    // One workspace handed from one model to another (same machine, other deviations, same commands): it starts
+    // empty for the second, whose cached poses would otherwise be the first's.
+    const MachineModel m = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
+    std::mt19937_64 rng(8);
+    const DeviationSet d = randomSet(m, rng);
+    const KinematicsModel nominal(m, nullptr), actual(m, &d);
+    KinematicsData data(nominal);
+    AxisVector q(m.axisCount());
+    for (int i = 0; i < m.axisCount(); ++i) q[i] = 0.1 * (i + 1);
+    Vec3 tipN, axisN, tipA, axisA;
+    nominal.toolPose(data, q, 100.0, tipN, axisN);
+    actual.toolPose(data, q, 100.0, tipA, axisA);
+    const ToolPose ref = toolPose(Kinematics(m, d), q, Kinematics(m, d).toolPoint(100.0));
+    EXPECT_LT((tipA - ref.tip).norm(), 1e-12);
+    EXPECT_GT((tipA - tipN).norm(), 1e-6);  // the deviations show: not the nominal pose from the cache
+}
+
+TEST(KinematicsEngine, InclinedRotaryAxis) {
     test::ScratchDir dir("pp-kin");
     test::writeText(dir.file("m.xml"), kInclinedHead);
     const MachineModel m = readMachineXml(dir.file("m.xml"));
@@ -117,4 +144,4 @@ TEST(PostprocKinematics, InclinedRotaryAxis) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp

@@ -1,0 +1,162 @@
+#pragma once
+// The kinematics engine: the forward kinematics of one machine (nominal, or with a deviation set) compiled once into
+// an immutable model, evaluated with an explicit workspace that the caller owns (the split of Pinocchio's Model and
+// Data: Carpentier et al., "The Pinocchio C++ library", SII 2019, §III-A). The model is the one of cnccomp::Kinematics
+// (link i = placement · E_location · motion(q) · E_component(q), exact rotations; [MultiTasking] eq. (7), (10)), with
+// the constant transforms between two motions folded into one, rotations about a coordinate axis built from one
+// sincos, component errors whose coefficients are all zero left out, no allocation per call.
+//
+// KinematicsModel is immutable and may be shared between threads. KinematicsData holds everything an evaluation
+// reuses from the previous ones (the last two poses of each chain, the last angles' cosines and sines); give each
+// thread its own. A Data follows the model it was last used with: handed to another model it starts empty.
+// Every evaluation agrees with cnccomp::Kinematics (tests/test_kinematics_engine.cpp: every sample machine, random
+// deviations and poses, to 1e-12 mm); the last bits may differ (folded products, angle addition).
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "cnccomp/deviations.hpp"
+#include "cnccomp/inverse_kinematics.hpp"
+
+namespace cnccomp {
+
+/// A rigid transform as rotation and translation (frame b in frame a).
+struct Frame {
+    Mat3 R = Mat3::Identity();
+    Vec3 t = Vec3::Zero();
+    Vec3 operator*(const Vec3& p) const { return R * p + t; }
+};
+
+class KinematicsModel;
+
+/// The workspace of a KinematicsModel's evaluations (see the file comment). Plain data, no allocation; copyable.
+class KinematicsData {
+public:
+    KinematicsData() = default;
+    explicit KinematicsData(const KinematicsModel& model);
+
+private:
+    friend class KinematicsModel;
+    /// cos and sin of one rotary operation's angle: the last exactly computed angle (base of the angle addition) and
+    /// the last angle asked for.
+    struct Trig {
+        double last = HUGE_VAL, lastC = 1, lastS = 0;
+        double asked = HUGE_VAL, askedC = 1, askedS = 0;
+    };
+    struct JointLine {
+        int axis = -1;
+        bool rotary = false;
+        Vec3 direction, point;
+    };
+    struct Lines {
+        JointLine items[kMaxAxes];
+        int count = 0;
+    };
+    /// One evaluation of a chain, reused while the positions of its own axes are unchanged.
+    struct ChainEntry {
+        bool valid = false, hasLines = false;
+        double key[kMaxAxes] = {};
+        Frame frame;
+        Lines lines;
+    };
+    /// The last two evaluations of a chain (consecutive evaluations often share the rotary positions: the nominal
+    /// target, the TCP world point, the check).
+    struct ChainCache {
+        ChainEntry entry[2];
+        int next = 0;  ///< entry replaced next
+    };
+    uint64_t model_ = 0;  ///< id of the model the contents belong to (0: none)
+    Trig trig_[kMaxAxes];  ///< per rotary operation (KinematicsModel's Op::slot)
+    ChainCache workpiece_, tool_;
+};
+
+class KinematicsModel {
+public:
+    /// `deviations` nullptr: the nominal machine. The machine must outlive this object.
+    KinematicsModel(const MachineModel& machine, const DeviationSet* deviations);
+
+    const MachineModel& machine() const { return *machine_; }
+    /// A fresh workspace for this model (as KinematicsData(model)).
+    KinematicsData createData() const { return KinematicsData(*this); }
+
+    /// Tool point at `length` along the tool direction, and the tool axis (spindle → tip), in the workpiece frame,
+    /// at model commands q (mm, rad).
+    void toolPose(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
+    Vec3 toolTip(KinematicsData& d, const AxisVector& q, double length) const;
+    /// toolPose without the workpiece chain's cache: its operations inverted and applied to the tool point and
+    /// direction (about half the arithmetic of building its frame), for commands met once (Newton steps, checks).
+    void toolPoseOnce(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
+    /// The tool axis alone (as toolPoseOnce's, without the tool point's arithmetic).
+    Vec3 toolAxisOnce(KinematicsData& d, const AxisVector& q) const;
+    /// A direction given in the workpiece frame, in the base (bed) frame at q: baseToWorkpiece(q).R · v.
+    Vec3 workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const;
+    /// d(tip, axis)/dq (6 × n, workpiece frame, rows as cnccomp::toolPoseJacobian); also the pose at q.
+    void jacobian(KinematicsData& d, const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const;
+    /// The tool point at q and its derivatives by the three axes `axes` (linear axes: constant in them).
+    void pointJacobian(KinematicsData& d, const AxisVector& q, double length, const int axes[3], Mat3& J, Vec3& tip) const;
+    Frame baseToWorkpiece(KinematicsData& d, const AxisVector& q) const;
+    Frame baseToTool(KinematicsData& d, const AxisVector& q) const;
+
+private:
+    friend class KinematicsData;
+    using Trig = KinematicsData::Trig;
+    using Lines = KinematicsData::Lines;
+    using JointLine = KinematicsData::JointLine;
+    using ChainEntry = KinematicsData::ChainEntry;
+    using ChainCache = KinematicsData::ChainCache;
+    enum class OpKind : uint8_t { Constant, Linear, Rotary, Component };
+    struct Op {
+        OpKind kind = OpKind::Constant;
+        int axis = -1;
+        int slot = -1;  ///< Rotary op: its Trig in KinematicsData
+        int unit = -1;  ///< rotary direction is +X / +Y / +Z exactly: 0 / 1 / 2; else −1
+        int ui = 1, uj = 2;  ///< with `unit`: the plane it turns, (unit + 1) % 3 and (unit + 2) % 3
+        Mat3 R = Mat3::Identity();
+        Vec3 t = Vec3::Zero();
+        Vec3 dir = Vec3::UnitZ();
+        bool modulo = false;
+        bool identityR = false;  ///< Constant op without rotation
+        std::vector<int> components;  ///< deviation definitions of a Component op
+    };
+    /// A chain without rotary motion or component errors is affine in its axes: R constant, t = t0 + Σ colₖ qₖ
+    /// (evaluated without walking its operations).
+    struct Affine {
+        bool ok = false;
+        Mat3 R = Mat3::Identity();
+        Vec3 t0 = Vec3::Zero();
+        int count = 0;
+        int axis[kMaxAxes] = {};
+        Vec3 col[kMaxAxes];    ///< base-frame direction of each axis (also its joint line's direction)
+        Vec3 start[kMaxAxes];  ///< where each axis' joint line starts with the axes before it at 0
+    };
+    struct ChainOps {
+        std::vector<Op> ops;
+        std::vector<int> axes;
+        Affine affine;
+    };
+    void compile(const Chain& chain, Side side, ChainOps& c, int& slots);
+    /// `d` emptied when it belongs to another model.
+    void bind(KinematicsData& d) const;
+    /// cos and sin of `angle` for a rotary op: the same angle again from `asked`, an angle near the last exactly
+    /// computed one by angle addition, else exactly.
+    static void trig(Trig& t, double angle, double& c, double& s);
+    /// v ← Rot(op's direction, θ)ᵀ v, given c = cos θ and s = sin θ.
+    static void rotateBack(const Op& op, double c, double s, Vec3& v);
+    /// A base-frame point (WithPoint) and direction into the workpiece frame at q, the workpiece chain's operations
+    /// inverted one by one (no frame built).
+    template <bool WithPoint>
+    void intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const;
+    /// The error transform of a Component op at q.
+    Pose componentError(const Op& op, const AxisVector& q) const;
+    void evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const;
+    /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
+    const ChainEntry& cached(KinematicsData& d, const ChainOps& c, ChainCache& cache, const AxisVector& q,
+                             bool lines) const;
+
+    const MachineModel* machine_;
+    uint64_t id_;  ///< distinct for every constructed model (copies share it: same contents)
+    Eigen::VectorXd values_;
+    ChainOps workpiece_, tool_;
+};
+
+}  // namespace cnccomp
