@@ -209,7 +209,7 @@ TEST(VerifyCircles, LinuxcncBacklashTakesTheTruthsLostMotionOutOfTheCircles) {
                 EXPECT_GT(v.isoBefore.circularity, w.isoBefore.circularity + 1.0 * kUm) << route << " " << run.name << " " << v.label;
                 EXPECT_NEAR(v.isoAfter.circularity, w.isoAfter.circularity, 0.01 * kUm) << route << " " << run.name << " " << v.label;
             }
-            EXPECT_LT(largestG(run, true), largestG(run, false) - 2.0 * kUm) << route << " " << run.name;
+            EXPECT_LT(largestG(run, true), largestG(run, false) - 1.0 * kUm) << route << " " << run.name;
         }
         EXPECT_FALSE(r.worse.any()) << route;
         EXPECT_LT(r.residual, r.residualBefore) << route;
@@ -237,6 +237,16 @@ TEST(VerifyCircles, AReversalOfTheWrongSignMakesTheCirclesWorseAndVerifySaysSo) 
         EXPECT_TRUE(bad.worse.span) << route;
         EXPECT_NEAR(bad.residual, 2 * bad.residualBefore, 0.02 * kUm) << route;
         EXPECT_NE(worseBanner(bad).find("COMPENSATION MAKES THE MACHINE WORSE"), std::string::npos) << route;
+    }
+    // A backlash on slides without lost motion (the right set's files on the machine without it): the largest span
+    // goes down (the geometry's) while the ZX circle gets worse: verify says which run.
+    {
+        const MachineModel& mm = m;
+        const DeviationSet geometry = readDeviationCsv(src("samples/deviations/mill-3axis-truth.csv"), mm);
+        const VerifyResult r = verify(mm, plan, geometry, "geometry", linuxcncFiles(mm, withReversals(geometry), "linuxcnc"), o);
+        EXPECT_FALSE(r.worse.span);
+        ASSERT_FALSE(r.worse.runs.empty());
+        EXPECT_EQ(r.worse.runs.front().rfind("zx ", 0), 0u) << r.worse.runs.front();
     }
     // Through the executable: emit the wrong set, verify against the truth: exit 1 and the banner; the right set: exit 0.
     const test::ScratchDir dir("verify-circles-backlash");

@@ -19,7 +19,7 @@ LaserAxisCompensation laserAxisCompensation(const LaserPositioningResult& r, boo
         c.referenceUm.push_back(referenceForward ? t.meanForward : t.meanReverse);
         c.backlashLeftUm = std::max(c.backlashLeftUm, std::abs(t.reversal - r.meanReversal));
     }
-    c.backlashUm = backlashFromMeanReversalUm(r.meanReversal, referenceForward);
+    c.backlashUm = backlashFromMeanReversalUm(r.meanReversal);
     return c;
 }
 

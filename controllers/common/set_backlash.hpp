@@ -3,9 +3,9 @@
 // backlash value per axis that Fanuc (1851), Sinumerik (MD32450), HEIDENHAIN (MP710 / MP_backLash) and ISG
 // (P-AXIS-00103) hold, for `emit`, and how those controls apply it, for their apply models (`verify`).
 //
-// The value: β = −B̄ for a reference-point approach in + (laser_axis.hpp: the backlash is the extra travel the motor
-// makes when the axis moves against the reference approach; positive for the usual lost motion, the slide lagging its
-// motor). Positive for the usual case in every vendor's text: Fanuc B-64120EN p.116 (1851, "backlash compensating
+// The value: β = −B̄ (laser_axis.hpp: the backlash is the extra travel the motor makes, in its direction of motion, when
+// the axis moves against the reference approach; positive for the usual lost motion, the slide lagging its motor; the
+// same for either reference direction). Positive for the usual case in every vendor's text: Fanuc B-64120EN p.116 (1851, "backlash compensating
 // value"), SINUMERIK 808D Parameter Manual 08/2013 p.228 (MD32450 BACKLASH: "positive, if the encoder is leading the
 // machine part (normal situation)"), HEIDENHAIN TNC 426/430 Technical Manual 6.4.1 (MP710: "Positive backlash: The
 // rotary encoder reading is ahead of the table. The table traverse is too short"), Beckhoff TF5200 axis compensation
@@ -23,10 +23,11 @@
 
 namespace cnccomp::controllers {
 
-/// β (µm) from a mean reversal value B̄ (µm): −B̄ for a reference approach in +, +B̄ in −.
-inline double backlashFromMeanReversalUm(double meanReversalUm, bool referenceForward = true) {
-    return referenceForward ? -meanReversalUm : meanReversalUm;
-}
+/// β (µm) from a mean reversal value B̄ (µm): −B̄, whichever the reference approach. Approach in +: moving − the slide
+/// stays x̄↓ − x̄↑ = −B̄ above the target, so the motor goes −B̄ further in its direction of motion; approach in −: moving
+/// + it stays x̄↑ − x̄↓ = B̄ below, so the motor goes −B̄ further in its direction of motion again (Fanuc 1851: "the
+/// direction for compensating values is the direction of movement").
+inline double backlashFromMeanReversalUm(double meanReversalUm) { return -meanReversalUm; }
 
 struct AxisBacklash {
     int axis = -1;            ///< machine axis index

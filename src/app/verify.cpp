@@ -407,6 +407,9 @@ VerifyWorse compensationWorse(const VerifyResult& r) {
     VerifyWorse w;
     w.spanAllowance = allowance(r.residualBefore);
     w.span = r.residual > r.residualBefore + w.spanAllowance;
+    for (const VerifyRun& run : r.runs)
+        if (run.spanAfter() > run.spanBefore() + allowance(run.spanBefore()))
+            w.runs.push_back(fmt::format("{} {:.3f} -> {:.3f} um", run.name, run.spanBefore() / kUm, run.spanAfter() / kUm));
     if (r.volumetric.available) {
         w.volumetricAllowance = allowance(r.volumetric.maxBefore);
         w.volumetric = r.volumetric.maxAfter > r.volumetric.maxBefore + w.volumetricAllowance;
