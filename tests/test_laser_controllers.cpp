@@ -48,7 +48,9 @@ TEST(LaserControllers, OneTableControllersTakeTheReferenceDirectionAndTheMeanRev
     EXPECT_NEAR(c.backlashUm, -kMeanReversal, 1e-9);  // lost motion: positive
     const auto r = controllers::laserAxisCompensation(sample(), false);
     EXPECT_NEAR(r.referenceUm.back(), kDown500, 1e-9);
-    EXPECT_NEAR(r.backlashUm, kMeanReversal, 1e-9);
+    // Moving + after a − approach the slide lags below the target by B̄: the motor goes −B̄ further in its direction of
+    // motion, the same β (Fanuc 1851: compensation in the direction of movement).
+    EXPECT_NEAR(r.backlashUm, -kMeanReversal, 1e-9);
 }
 
 // Fanuc: data = increments of the correction −(x̄↑(P) − x̄↑(0)) in 0.0001 mm from the reference position (machine 0);

@@ -42,7 +42,8 @@ TEST(OwnMachineReadme, EveryCommandOfTheWalkThroughRuns) {
         ASSERT_EQ(r.exitCode, 0) << c << "\n" << r.out;
         last = r.out;
     }
-    EXPECT_NE(last.find("residual (largest span after compensation): 0.001 um (before: 3.157 um)"), std::string::npos) << last;
+    // Before: the identified machine with the laser's BX as lost motion (verify simulates it); after: BACKLASH takes it out.
+    EXPECT_NE(last.find("residual (largest span after compensation): 0.002 um (before: 5.320 um)"), std::string::npos) << last;
     const MachineModel m = readMachineXml(test::sourcePath("samples/machines/mill-3axis.xml"));
     const DeviationSet set = readDeviationCsv(dir.file("own/machine.csv"), m);
     EXPECT_NEAR(set.get("EC0Y") / kArcsec, 5.0, 0.5);  // the circles' squareness (0.5 µm noise)

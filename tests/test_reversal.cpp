@@ -205,5 +205,43 @@ TEST(Reversal, CircleBacklashGoesToTheReversalWithinItsInterval) {
     EXPECT_FALSE(id.deviations.reversalPresent[2]);
 }
 
+// identify --merge: a reversal value the identification determined replaces the base's, one it did not keeps the base's,
+// and the output says which (oracle: the rule, applied by hand to the values written into the base here). The plan is
+// the sample's XY circle alone: it determines BX and BY (both ends of X and Y inside its data arc), not BZ.
+TEST(Reversal, IdentifyMergeKeepsWhatTheRunDidNotDetermine) {
+    const test::ScratchDir dir("reversal-merge");
+    const std::string machine = test::sourcePath("samples/machines/mill-3axis.xml");
+    const std::string samplePlan = readText(test::sourcePath("samples/plans/mill-3axis-circles.xml"));
+    std::string plan;  // the sample plan without its YZ and ZX circles
+    std::istringstream in(samplePlan);
+    for (std::string line; std::getline(in, line);)
+        if (line.find("name=\"yz\"") == std::string::npos && line.find("name=\"zx\"") == std::string::npos) plan += line + "\n";
+    writeText(dir.file("xy.xml"), plan);
+    ASSERT_EQ(test::runCli(fmt::format("simulate --machine '{}' --plan '{}' --deviations '{}' --out '{}'", machine, dir.file("xy.xml"),
+                                       test::sourcePath("samples/deviations/mill-3axis-truth.csv"), dir.file("traces"))).exitCode, 0);
+    const MachineModel& m = test::sampleMachine("mill-3axis");
+    DeviationSet base(m);
+    base.set("EB0Z", 7.0 * kArcsec);  // not determined by an XY circle either: kept
+    base.setReversal("X", -3.0 * kUm);
+    base.setReversal("Z", -1.5 * kUm);
+    writeText(dir.file("base.csv"), formatDeviationCsv(base));
+    const test::CliResult r = test::runCli(fmt::format("identify --machine '{}' --plan '{}' --traces '{}' --merge '{}' --out '{}'", machine,
+                                                       dir.file("xy.xml"), dir.file("traces"), dir.file("base.csv"), dir.file("d.csv")));
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const DeviationSet d = readDeviationCsv(dir.file("d.csv"), m);
+    // Determined (the traces hold no lost motion: ~0), replacing the base's −3 µm; BY new; BZ kept exactly.
+    ASSERT_TRUE(d.reversalPresent[0] && d.reversalPresent[1] && d.reversalPresent[2]);
+    EXPECT_NEAR(d.reversal[0] / kUm, 0.0, 0.01);
+    EXPECT_NEAR(d.reversal[1] / kUm, 0.0, 0.01);
+    EXPECT_NEAR(d.reversal[2] / kUm, -1.5, 1e-9);
+    EXPECT_NEAR(d.get("EB0Z") / kArcsec, 7.0, 1e-9);
+    EXPECT_NEAR(d.get("EC0Y") / kArcsec, 5.0, 1e-3);
+    EXPECT_NE(r.out.find("merge: BX = "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("from this identification (replaces the base's -3.0000 um)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("from this identification (the base had none)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("merge: BZ = -1.5000 um kept from the base (this identification did not determine it)"), std::string::npos)
+        << r.out;
+}
+
 }  // namespace
 }  // namespace cnccomp

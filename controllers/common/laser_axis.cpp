@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "controllers/common/set_backlash.hpp"
+
 namespace cnccomp::controllers {
 
 LaserAxisCompensation laserAxisCompensation(const LaserPositioningResult& r, bool referenceForward) {
@@ -17,7 +19,7 @@ LaserAxisCompensation laserAxisCompensation(const LaserPositioningResult& r, boo
         c.referenceUm.push_back(referenceForward ? t.meanForward : t.meanReverse);
         c.backlashLeftUm = std::max(c.backlashLeftUm, std::abs(t.reversal - r.meanReversal));
     }
-    c.backlashUm = referenceForward ? -r.meanReversal : r.meanReversal;
+    c.backlashUm = backlashFromMeanReversalUm(r.meanReversal);
     return c;
 }
 

@@ -8,8 +8,10 @@
 // first backlash compensation is performed"; "The positive or negative direction for compensating values is the
 // direction of movement"; the others [G]). So the table is the error of the reference-approach direction (x̄↑ for an
 // approach in +, the usual) and the backlash β (µm) the extra travel the motor makes in the other direction: moving −
-// after a + approach the slide lags by x̄↓ − x̄↑ = −B_i, so β = −B̄ (+B̄ for a reference approach in −); positive for the
-// usual lost motion. One value cannot follow B_i target by target: max |B_i − B̄| is left (reported).
+// after a + approach the slide lags by x̄↓ − x̄↑ = −B_i, so β = −B̄; after a − approach, moving + it lags by x̄↑ − x̄↓ =
+// B_i below, the motor again goes −B̄ further in its direction of motion: β = −B̄ for either reference direction
+// (set_backlash.hpp; an earlier round wrote +B̄ for an approach in −, the sign of the lag rather than of the
+// correction); positive for the usual lost motion. One value cannot follow B_i target by target: max |B_i − B̄| is left (reported).
 // Servo mismatch (the ball-bar circle's "v lagging u", linear_circle_model.hpp) is not a table: it is the difference
 // of the interpolating axes' position-loop gains (lag Δt = 1/kv_v − 1/kv_u); each backend names its gain parameter.
 #include <string>
@@ -24,7 +26,7 @@ struct LaserAxisCompensation {
     std::vector<double> positions;          ///< the laser's targets, mm (machine coordinates)
     std::vector<double> forwardUm, reverseUm;  ///< x̄_i↑, x̄_i↓, µm
     std::vector<double> referenceUm;        ///< x̄_i of the reference direction, µm
-    double backlashUm = 0;                  ///< β, µm, added in the direction of motion against the reference approach
+    double backlashUm = 0;                  ///< β = −B̄, µm, added in the direction of motion against the reference approach
     double backlashLeftUm = 0;              ///< max |B_i − B̄|, µm: what one backlash value leaves
 };
 

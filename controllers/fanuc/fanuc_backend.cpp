@@ -6,13 +6,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
 #include "controllers/common/axis_table.hpp"
 #include "controllers/common/header.hpp"
+#include "controllers/common/set_backlash.hpp"
+#include "controllers/fanuc/laser_pitch.hpp"
 #include "controllers/fanuc/tcp_parameters.hpp"
 
 namespace cnccomp::controllers::fanuc {
@@ -50,6 +54,16 @@ EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
     }
     r.compensated.insert(r.compensated.end(), pitch.compensated.begin(), pitch.compensated.end());
     r.notCompensated.insert(r.notCompensated.end(), pitch.notCompensated.begin(), pitch.notCompensated.end());
+    // Reversal values → backlash 1851 / 1852 (the laser route's writer, laser_pitch.hpp; set_backlash.hpp).
+    std::map<int, long> backlashUnits;
+    for (const AxisBacklash& b : backlashOfSet(request)) {
+        const long units = backlashDetectionUnits(b.backlashUm, o.unit);
+        backlashUnits[controllerAxisNumber(m, b.axis)] = units;
+        r.compensated.push_back({"B" + b.name, fmt::format("backlash 1851/1852 A{} = {} detection units = {:.4f} mm (= -B{} = {:.3f} um; "
+                                                           "reference return in + [G])",
+                                                           controllerAxisNumber(m, b.axis), units, units * o.unit, b.name,
+                                                           b.backlashUm)});
+    }
 
     std::string axes;
     for (int a : controllerAxisOrder(m)) axes += fmt::format("{}A{} = {}", axes.empty() ? "" : ", ", controllerAxisNumber(m, a), m.axisNames[a]);
@@ -73,6 +87,7 @@ EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
     std::vector<Parameter> lines = tcpLines(m, tcp);
     const auto pl = pitchLines(m, pitch.tables);
     lines.insert(lines.end(), pl.begin(), pl.end());
+    addBacklashParameters(lines, backlashUnits);
     // Parameters by number, then the pitch error data.
     std::stable_sort(lines.begin(), lines.end(), [](const Parameter& a, const Parameter& b) {
         return std::make_pair(a.q == 0, a.number) < std::make_pair(b.q == 0, b.number);
@@ -101,6 +116,10 @@ AxisVector FanucCompensation::driveCommandsForTool(const AxisVector& programmed,
     return out;
 }
 
+AxisVector FanucCompensation::driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const {
+    return withBacklashOffsets(driveCommandsForTool(programmed, toolLength), backlash, motion);
+}
+
 std::unique_ptr<FanucCompensation> readFiles(const MachineModel& m, const std::vector<OutputFile>& files) {
     const OutputFile* prm = nullptr;
     for (const OutputFile& f : files) {
@@ -110,7 +129,7 @@ std::unique_ptr<FanucCompensation> readFiles(const MachineModel& m, const std::v
     if (!prm) throw InputError(kParameterFile, 0, "missing: the parameter file is needed");
     const ParameterFile f = parseParameterFile(prm->name, prm->content);
     for (const Parameter& p : f.parameters) {
-        const bool known = p.q == 0 || p.number == 1220 || (p.number >= 3620 && p.number <= 3625) || p.number == 19666 ||
+        const bool known = p.q == 0 || p.number == 1220 || p.number == 1851 || p.number == 1852 || (p.number >= 3620 && p.number <= 3625) || p.number == 19666 ||
                            (p.number >= 19680 && p.number <= 19714);
         if (!known) throw InputError(f.path, p.line, fmt::format("parameter {} is not one cnccomp writes or models", p.number));
     }
@@ -124,7 +143,20 @@ std::unique_ptr<FanucCompensation> readFiles(const MachineModel& m, const std::v
     } catch (const ModelError& e) {
         throw InputError(f.path, f.find(19680) ? f.find(19680)->line : 0, e.what());
     }
-    return std::make_unique<FanucCompensation>(m, std::move(model), std::move(pitch), PitchOptions{}.unit);
+    auto out = std::make_unique<FanucCompensation>(m, std::move(model), std::move(pitch), PitchOptions{}.unit);
+    // 1851 (cutting feed: the test programs' moves) per axis, detection units → mm (deg for a rotary axis).
+    if (const Parameter* b = f.find(1851)) {
+        out->backlash.assign(static_cast<size_t>(m.axisCount()), 0.0);
+        for (const auto& [number, text] : b->values) {
+            int axis = -1;
+            for (int a = 0; a < m.axisCount(); ++a)
+                if (controllerAxisNumber(m, a) == number) axis = a;
+            const auto v = parseNumber(text);
+            if (axis < 0 || !v) throw InputError(f.path, b->line, fmt::format("1851 A{}: expected an axis of the machine and a count", number));
+            out->backlash[static_cast<size_t>(axis)] = *v * PitchOptions{}.unit / positionScale(m.axisLink(axis));
+        }
+    }
+    return out;
 }
 
 namespace {

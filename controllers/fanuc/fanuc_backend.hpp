@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "controllers/backend.hpp"
+#include "controllers/common/directional.hpp"
 #include "controllers/common/controller_model.hpp"
 #include "controllers/fanuc/pitch_error.hpp"
 
@@ -13,7 +14,7 @@ inline constexpr const char* kParameterFile = "CNCCOMP.PRM";
 
 EmitResult emitFiles(const EmitRequest& request, const PitchOptions& options);
 
-class FanucCompensation final : public AppliedCompensation {
+class FanucCompensation final : public AppliedCompensation, public DirectionalCompensation {
 public:
     FanucCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> tcp, std::vector<PitchTable> pitch,
                       double unit);
@@ -21,8 +22,12 @@ public:
     AxisVector driveCommands(const AxisVector& programmed) const override;
     /// The TCP with the active tool's length, then the tables at the resulting machine positions.
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
+    /// The same plus the backlash 1851 by the direction of motion (controllers/common/set_backlash.hpp).
+    AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const override;
     const TcpTransform& tcp() const { return tcp_; }
     const std::vector<PitchTable>& pitch() const { return pitch_; }
+    /// 1851 of each axis (description order), mm; empty when the file sets none.
+    std::vector<double> backlash;
 
 private:
     const MachineModel* machine_;

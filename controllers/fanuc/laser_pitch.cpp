@@ -11,6 +11,19 @@
 
 namespace cnccomp::controllers::fanuc {
 
+long backlashDetectionUnits(double backlashUm, double unitMm) { return std::lround(backlashUm * 1e-3 / unitMm); }
+
+void addBacklashParameters(std::vector<Parameter>& lines, const std::map<int, long>& units) {
+    if (units.empty()) return;
+    for (int number : {1851, 1852}) {
+        Parameter p;
+        p.number = number;
+        p.kind = 'A';
+        for (const auto& [axis, value] : units) p.values[axis] = std::to_string(value);
+        lines.push_back(p);
+    }
+}
+
 LaserPitch fanucLaserPitch(const LaserPositioningResult& r, int axisNumber, bool referenceForward, const PitchOptions& o) {
     const LaserAxisCompensation c = laserAxisCompensation(r, referenceForward);
     const double first = c.positions.front(), last = c.positions.back();
@@ -47,7 +60,7 @@ LaserPitch fanucLaserPitch(const LaserPositioningResult& r, int axisNumber, bool
         }
         if (fits) break;
     }
-    out.backlash = std::lround(c.backlashUm * 1e-3 / o.unit);
+    out.backlash = backlashDetectionUnits(c.backlashUm, o.unit);
 
     std::vector<Parameter> lines;
     const auto axisParam = [&](int number, const std::string& value) {
@@ -57,8 +70,7 @@ LaserPitch fanucLaserPitch(const LaserPositioningResult& r, int axisNumber, bool
         p.values[axisNumber] = value;
         lines.push_back(p);
     };
-    axisParam(1851, std::to_string(out.backlash));
-    axisParam(1852, std::to_string(out.backlash));
+    addBacklashParameters(lines, {{axisNumber, out.backlash}});
     axisParam(3620, std::to_string(t.reference));
     axisParam(3621, std::to_string(t.negative));
     axisParam(3622, std::to_string(t.positive));

@@ -11,9 +11,11 @@
 //     are one feed).
 // Point numbers from 0 (3620 = the point of the reference position); an axis whose points overlap another axis'
 // must be renumbered (3620–3622 are per axis, the data shared) [G].
+#include <map>
 #include <string>
 
 #include "cnccomp/laser_positioning.hpp"
+#include "controllers/fanuc/parameter_file.hpp"
 #include "controllers/fanuc/pitch_error.hpp"
 
 namespace cnccomp::controllers::fanuc {
@@ -23,6 +25,12 @@ struct LaserPitch {
     long backlash = 0;      ///< 1851 = 1852, detection units
     std::string file;       ///< the parameter file text
 };
+
+/// β (µm, controllers/common/set_backlash.hpp) in detection units of `unitMm` (PitchOptions::unit), rounded.
+long backlashDetectionUnits(double backlashUm, double unitMm);
+/// 1851 (cutting feed) and 1852 (rapid traverse, with 1800#4 RBK) = the detection units of each axis number (A word)
+/// of `units`, one axis-type line each (B-64120EN p.116): the laser route and `emit` write backlash with this.
+void addBacklashParameters(std::vector<Parameter>& lines, const std::map<int, long>& units);
 
 /// `axisNumber`: the controller's axis number (A word). Throws ModelError when the data do not fit (PitchOptions).
 LaserPitch fanucLaserPitch(const LaserPositioningResult& r, int axisNumber, bool referenceForward = true,

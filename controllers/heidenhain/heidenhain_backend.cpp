@@ -5,24 +5,54 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
 #include "controllers/backend.hpp"
+#include "controllers/common/directional.hpp"
+#include "controllers/common/files.hpp"
+#include "controllers/common/set_backlash.hpp"
 #include "controllers/heidenhain/kinematics_table.hpp"
+#include "controllers/heidenhain/laser_com.hpp"
 
 namespace cnccomp::controllers::heidenhain {
 namespace {
 
-class HeidenhainCompensation final : public AppliedCompensation {
+class HeidenhainCompensation final : public AppliedCompensation, public DirectionalCompensation {
 public:
-    explicit HeidenhainCompensation(TcpTransform tcp) : tcp_(std::move(tcp)) {}
+    HeidenhainCompensation(TcpTransform tcp, std::vector<double> backlash) : tcp_(std::move(tcp)), backlash_(std::move(backlash)) {}
     AxisVector driveCommands(const AxisVector& programmed) const override { return tcp_.solve(programmed); }
     /// M128 / FUNCTION TCPM computes with the active tool's length from the tool table.
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override {
         return tcp_.solve(programmed, toolLength);
     }
+    /// The same plus MP710 by the direction of motion (controllers/common/set_backlash.hpp).
+    AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const override {
+        return withBacklashOffsets(driveCommandsForTool(programmed, toolLength), backlash_, motion);
+    }
 
 private:
     TcpTransform tcp_;
+    std::vector<double> backlash_;
 };
+
+/// MP710.x of CNCCOMP_BACKLASH.MP per machine axis (mm); empty without the file. InputError file:line otherwise.
+std::vector<double> readBacklash(const MachineModel& m, const std::vector<OutputFile>& files) {
+    const OutputFile* f = findFile(files, kBacklashFile);
+    if (!f) return {};
+    std::vector<double> b(static_cast<size_t>(m.axisCount()), 0.0);
+    for (const TextLine& l : splitLines(f->content)) {
+        const std::string_view t = trim(l.text);
+        if (t.empty() || t.front() == ';') continue;
+        const size_t colon = t.find(':');
+        int axis = -1;
+        if (t.starts_with("MP710.") && colon != std::string_view::npos)
+            for (int a = 0; a < m.axisCount(); ++a)
+                if (std::to_string(tncAxisIndex(m.axisNames[static_cast<size_t>(a)])) == t.substr(6, colon - 6)) axis = a;
+        const auto v = colon == std::string_view::npos ? std::nullopt : parseNumber(t.substr(colon + 1));
+        if (axis < 0 || !v) throw InputError(f->name, l.number, "expected MP710.<X 0, Y 1, Z 2 of the machine>:<mm> or a ';' comment");
+        b[static_cast<size_t>(axis)] = *v;
+    }
+    return b;
+}
 
 class HeidenhainBackend final : public Backend {
 public:
@@ -37,7 +67,9 @@ public:
                 "tool-side rows are read from the tool to MachBase with their motion inverted, and their .COM columns hold "
                 "-error (cnccomp's reading of KinematicsDesign); check one axis in KinematicsDesign before loading",
                 "the MachAxis letters are the TNC's axis names and each axis moves along +X/+Y/+Z or turns about them",
-                "100 COMPTAB entries including the MachAxis rows, 50 Trans+MachAxis rows, 256 rows per .COM table"};
+                "100 COMPTAB entries including the MachAxis rows, 50 Trans+MachAxis rows, 256 rows per .COM table",
+                "CNCCOMP_BACKLASH.MP: MP710.0/1/2 = the backlash of X/Y/Z in the TNC's axis order, in the machine-parameter "
+                "file syntax cnccomp assumes (MP710.0:+0.004000); enter the values by hand if yours differs"};
     }
     EmitResult emit(const EmitRequest& request) const override { return emitFiles(request, Options{}); }
     std::unique_ptr<AppliedCompensation> apply(const MachineModel& machine,
@@ -49,7 +81,7 @@ public:
         } catch (const ModelError& e) {
             throw InputError("<heidenhain-tnc kinematics>", 0, e.what());
         }
-        return std::make_unique<HeidenhainCompensation>(TcpTransform(machine, std::move(model)));
+        return std::make_unique<HeidenhainCompensation>(TcpTransform(machine, std::move(model)), readBacklash(machine, files));
     }
 };
 

@@ -1,5 +1,8 @@
 #include "controllers/heidenhain/kinematics_table.hpp"
 
+#include "controllers/common/set_backlash.hpp"
+#include "controllers/heidenhain/laser_com.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <map>
@@ -237,6 +240,15 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
         throw ModelError(fmt::format("heidenhain-tnc: {} COMPTAB entries and {} MachAxis rows need {} entries; the TNC takes {}",
                                      w.comptabs, w.axes, w.comptabs + w.axes, o.maxCompEntries));
 
+    // Reversal values → MP710 backlash (the laser route's line, laser_com.hpp; set_backlash.hpp).
+    std::string backlash;
+    for (const AxisBacklash& b : backlashOfSet(request)) {
+        const int index = tncAxisIndex(b.name);
+        if (index < 0) continue;  // left NOT compensated by the header (reversalsNotHeld)
+        backlash += mp710Line(index, b.backlashUm * 1e-3) + "\n";
+        r.compensated.push_back({"B" + b.name, fmt::format("{} = -B{} (backlash, mm) in {}", mp710Line(index, b.backlashUm * 1e-3),
+                                                           b.name, kBacklashFile)});
+    }
     std::vector<std::string> notes = {
         "for the iTNC 530 (HSCI technical manual 07/2013, KinematicsComp): the TNC 640 and TNC7 keep the kinematics in "
         "the machine configuration (kinematics editor), not in a .TAB description: these files do not load there",
@@ -270,6 +282,12 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
         }
         r.files.push_back({t.name, formatTncTable(t, comment)});
     }
+    if (!backlash.empty())
+        r.files.push_back({kBacklashFile, comment +
+                                              "; MP710.x backlash compensation (mm) = -B<axis>, the deviation set's reversal value: "
+                                              "positive when the encoder reading is ahead of the table (lost motion; TNC 426/430 "
+                                              "Technical Manual 6.4.1); TNC 640 / TNC7: MP_backLash of the axis [G: file syntax]\n" +
+                                              backlash});
     return r;
 }
 
@@ -303,6 +321,8 @@ ParsedKinematics parseFiles(const MachineModel& m, const std::vector<OutputFile>
             kinFile = &f;
         } else if (f.name.ends_with(".COM")) {
             comFiles[f.name] = &f;
+        } else if (f.name == kBacklashFile) {
+            continue;  // read by the backend's apply (heidenhain_backend.cpp)
         } else {
             throw InputError(f.name, 0, "not a heidenhain-tnc file (expected a .TAB kinematics description or .COM tables)");
         }

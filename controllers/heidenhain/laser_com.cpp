@@ -7,6 +7,12 @@
 
 namespace cnccomp::controllers::heidenhain {
 
+int tncAxisIndex(const std::string& axisName) {
+    return axisName == "X" ? 0 : axisName == "Y" ? 1 : axisName == "Z" ? 2 : -1;
+}
+
+std::string mp710Line(int index, double backlashMm) { return fmt::format("MP710.{}:{:+.6f}", index, backlashMm); }
+
 LaserCom heidenhainLaserCom(const LaserPositioningResult& r, int column, double sign, bool referenceForward) {
     const LaserAxisCompensation c = laserAxisCompensation(r, referenceForward);
     LaserCom out;
@@ -23,8 +29,10 @@ LaserCom heidenhainLaserCom(const LaserPositioningResult& r, int column, double 
         fmt::format("the error approached in {} (the reference-approach direction [G]) as the column of its positioning "
                     "component, with the sign cnccomp emit gives it ({:+g} x the laser's error); COMPTAB {}:{} on the "
                     "MachAxis {} row", referenceForward ? "+" : "-", sign, out.name, columnName, r.axis),
-        fmt::format("set MP710 (backlash compensation, mm) of axis {} to {:.6f} (= -mean reversal) [G]; one value leaves up "
-                    "to {:.3f} um of the reversal at single targets", r.axis, out.backlashMm, c.backlashLeftUm),
+        fmt::format("set MP710 (backlash compensation, mm) of axis {} to {:.6f} (= -mean reversal; {}); one value leaves up "
+                    "to {:.3f} um of the reversal at single targets", r.axis, out.backlashMm,
+                    tncAxisIndex(r.axis) >= 0 ? mp710Line(tncAxisIndex(r.axis), out.backlashMm) : std::string("MP710.x"),
+                    c.backlashLeftUm),
         servoMismatchNote("MP1810 kv factor [G]"),
         "measured with the axis' compensation and backlash compensation off",
     };

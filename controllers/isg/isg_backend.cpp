@@ -13,9 +13,13 @@
 #include "cnccomp/error.hpp"
 #include "controllers/common/axis_table.hpp"
 #include "controllers/common/controller_model.hpp"
+#include "controllers/common/directional.hpp"
 #include "controllers/common/files.hpp"
+#include "cnccomp/io/text_util.hpp"
 #include "controllers/common/header.hpp"
+#include "controllers/common/set_backlash.hpp"
 #include "controllers/isg/isg_files.hpp"
+#include "controllers/isg/laser_lsec.hpp"
 #include "controllers/isg/isg_model.hpp"
 
 namespace cnccomp::controllers::isg {
@@ -220,7 +224,35 @@ void addColumn(std::string& head, std::string& row, const std::string& name, dou
     row += fmt::format("{}{}", row.empty() ? "" : " ", fixed(v, decimals));
 }
 
-class IsgApplied final : public AppliedCompensation {
+std::string backlashFileName(const std::string& axis) { return "backlash_" + axis + ".lis"; }
+
+/// An axis' backlash list (isgAxisBacklash): kopf.log_achs_name, lr_param.anwahl_losekomp (0 or 1), getriebe[0].lose
+/// (0.1 um) into `beta` (mm, per machine axis). InputError file:line for anything else.
+void readBacklash(const MachineModel& m, const OutputFile& f, std::vector<double>& beta) {
+    if (beta.empty()) beta.assign(static_cast<size_t>(m.axisCount()), 0.0);
+    int axis = -1, selection = -1;
+    double lose = 0;
+    for (const TextLine& l : splitLines(f.content)) {
+        const auto tok = tokens(l.text);
+        if (tok.empty() || tok[0].front() == '#') continue;
+        if (tok.size() != 2) throw InputError(f.name, l.number, "expected '<parameter> <value>'");
+        if (tok[0] == "kopf.achs_nr") continue;
+        if (tok[0] == "kopf.log_achs_name") {
+            axis = m.axisIndex(std::string(tok[1]));
+            if (axis < 0) throw InputError(f.name, l.number, fmt::format("machine '{}' has no axis {}", m.name, tok[1]));
+            continue;
+        }
+        const auto v = parseNumber(tok[1]);
+        if (!v) throw InputError(f.name, l.number, "expected a number");
+        if (tok[0] == "lr_param.anwahl_losekomp" && (*v == 0 || *v == 1)) selection = static_cast<int>(*v);
+        else if (tok[0] == "getriebe[0].lose") lose = *v * 1e-4;  // 0.1 um → mm
+        else throw InputError(f.name, l.number, "expected kopf.*, lr_param.anwahl_losekomp 0|1 or getriebe[0].lose");
+    }
+    if (axis < 0 || selection < 0) throw InputError(f.name, 0, "needs kopf.log_achs_name and lr_param.anwahl_losekomp");
+    beta[static_cast<size_t>(axis)] = selection == 1 ? lose : 0.0;
+}
+
+class IsgApplied final : public AppliedCompensation, public DirectionalCompensation {
 public:
     IsgApplied(const MachineModel& m, IsgModel model, const IsgConfig& cfg) : machine_(&m), model_(std::move(model)) {
         for (char c : std::string("XYZ")) {
@@ -258,6 +290,12 @@ public:
         return m.fromController(p);
     }
     const IsgModel& model() const { return model_; }
+    /// The same plus each axis' backlash by the direction of motion (controllers/common/set_backlash.hpp).
+    AxisVector driveCommandsMoving(const AxisVector& q, double toolLength, const AxisVector& motion) const override {
+        return withBacklashOffsets(driveCommandsForTool(q, toolLength), backlash, motion);
+    }
+    /// getriebe[0].lose of each axis (mm; lr_param.anwahl_losekomp 1), empty without backlash files.
+    std::vector<double> backlash;
 
 private:
     const MachineModel* machine_;
@@ -375,16 +413,33 @@ public:
             "workpiece axes carry the table's own errors",
             "[G] records are interpolated linearly, end values held; a table over 0..360 deg closes on itself",
             fmt::format("[G] start-up list: vol_comp[0].max_records >= {}", records)};
-        const HeaderInfo h = makeHeaderInfo(r, "ISG / Beckhoff TwinCAT CNC TF5280 volumetric compensation (ISG_CSV)", out, notes);
         IsgConfig cfg;
         int n = 1;
         for (char c : kLetters)
             if (m.axisIndex(std::string(1, c)) >= 0) cfg.axisNumber[c] = n++;
+        // Reversal values → each axis' backlash parameters (laser_lsec.hpp's lines; set_backlash.hpp).
+        std::vector<OutputFile> backlashFiles;
+        for (const AxisBacklash& b : backlashOfSet(r)) {
+            const int number = cfg.axisNumber.at(b.name[0]);
+            backlashFiles.push_back({backlashFileName(b.name), isgAxisBacklash(number, b.name, b.backlashUm)});
+            out.compensated.push_back({"B" + b.name, fmt::format("axis {} (kopf.achs_nr {}): getriebe[0].lose = {} x 0.1 um (= -B{}), "
+                                                                 "lr_param.anwahl_losekomp = 1, in {}",
+                                                                 b.name, number, std::lround(b.backlashUm * 10), b.name,
+                                                                 backlashFileName(b.name))});
+        }
+        const HeaderInfo h = makeHeaderInfo(r, "ISG / Beckhoff TwinCAT CNC TF5280 volumetric compensation (ISG_CSV)", out, notes);
         cfg.chain = chain;
         cfg.workpieceAxes = static_cast<int>(p.workpiece.size());
         cfg.files.emplace_back(kCsv, "ISG_CSV");
         out.files.push_back({kLis, formatIsgConfig(cfg, formatHeader(h, "# "))});
         out.files.push_back({kCsv, formatHeader(h, "// ") + body});
+        for (OutputFile& f : backlashFiles) {
+            f.content = formatHeader(h, "# ") +
+                        "# backlash of this axis for its axis parameter list (TF5200 axis compensation: P-AXIS-00021 "
+                        "selection 1 = reference approach in +, P-AXIS-00103 size in 0.1 um, > 0 between drive and slide)\n" +
+                        f.content;
+            out.files.push_back(std::move(f));
+        }
         return out;
     }
 
@@ -399,7 +454,10 @@ public:
                 throw InputError(kLis, 0, fmt::format("chain {} lacks axis {} of machine '{}'", cfg.chain, a, m.name));
         std::vector<std::pair<std::string, std::vector<IsgBlock>>> blocks;
         for (const auto& [file, format] : cfg.files) blocks.emplace_back(file, parseIsgCsv(requireFile(files, file, "ISG").content, file));
-        return std::make_unique<IsgApplied>(m, IsgModel(cfg, blocks), cfg);
+        auto applied = std::make_unique<IsgApplied>(m, IsgModel(cfg, blocks), cfg);
+        for (const OutputFile& f : files)
+            if (f.name.starts_with("backlash_") && f.name.ends_with(".lis")) readBacklash(m, f, applied->backlash);
+        return applied;
     }
 };
 

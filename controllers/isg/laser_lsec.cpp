@@ -4,9 +4,22 @@
 
 #include <fmt/format.h>
 
+#include "cnccomp/error.hpp"
+
 #include "controllers/common/laser_axis.hpp"
 
 namespace cnccomp::controllers::isg {
+
+std::string isgAxisHead(int axisNumber, const std::string& axisName) {
+    return fmt::format("kopf.achs_nr                        {}\nkopf.log_achs_name                  {}\n", axisNumber, axisName);
+}
+
+std::string isgAxisBacklash(int axisNumber, const std::string& axisName, double backlashUm) {
+    const long tenth = std::lround(backlashUm * 10.0);
+    if (std::abs(tenth) > 32767)
+        throw ModelError(fmt::format("isg: backlash {:.1f} um of axis {} exceeds getriebe[0].lose (SGN16, 0.1 um)", backlashUm, axisName));
+    return isgAxisHead(axisNumber, axisName) + fmt::format("lr_param.anwahl_losekomp            1\ngetriebe[0].lose                    {}\n", tenth);
+}
 
 std::string isgLaserLsec(const LaserPositioningResult& r, int axisNumber, const std::string& axisName) {
     const LaserAxisCompensation c = laserAxisCompensation(r);
@@ -18,8 +31,7 @@ std::string isgLaserLsec(const LaserPositioningResult& r, int axisNumber, const 
     s += "# axis parameter list of this axis: lr_param.ssfk 1 (P-AXIS-00175), lr_param.anwahl_losekomp 0 (P-AXIS-00021)\n";
     s += "# " + servoMismatchNote("the axes' position controller gain (kv) in the axis parameter list [G]") + "\n";
     s += "# measured with the axis' LSEC and backlash compensation off\n";
-    s += fmt::format("kopf.achs_nr                        {}\n", axisNumber);
-    s += fmt::format("kopf.log_achs_name                  {}\n", axisName);
+    s += isgAxisHead(axisNumber, axisName);
     s += "kw.ssfk.interval                    0\n";
     s += fmt::format("kw.ssfk.kw_startpos                 {}\n", tenthUm(c.positions.front() * 1000));
     s += fmt::format("kw.ssfk.kw_nr_max                   {}\n", c.positions.size());

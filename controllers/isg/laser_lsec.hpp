@@ -16,6 +16,16 @@
 
 namespace cnccomp::controllers::isg {
 
+/// The head lines of an axis' lists: kopf.achs_nr and kopf.log_achs_name (the LSEC list's and the backlash list's).
+std::string isgAxisHead(int axisNumber, const std::string& axisName);
+
+/// The backlash of one axis as lines of its axis parameter list (Beckhoff TF5200 "Axis compensation", backlash
+/// compensation): P-AXIS-00021 lr_param.anwahl_losekomp 1 ("last axis motion occurred in pos. direction": the
+/// reference approach in +, controllers/common/set_backlash.hpp) and P-AXIS-00103 getriebe[0].lose = β in 0.1 µm
+/// (SGN16; "0 < backlash: backlash between drive and slide", the usual lost motion) [G: gear stage 0 of the axis]; with
+/// the head lines. `emit` writes it for the set's reversal values. ModelError beyond the SGN16 range.
+std::string isgAxisBacklash(int axisNumber, const std::string& axisName, double backlashUm);
+
 /// `axisNumber`: kopf.achs_nr; `axisName`: kopf.log_achs_name.
 std::string isgLaserLsec(const LaserPositioningResult& r, int axisNumber, const std::string& axisName);
 

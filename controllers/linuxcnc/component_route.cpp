@@ -106,6 +106,11 @@ KinsFiles readKinsFiles(const MachineModel& m, const std::vector<OutputFile>& fi
     if (f.coordinates != coordinatesOf(m) || f.joints != m.axisCount())
         throw InputError(kKinsIniFile, 0, fmt::format("JOINTS = {} and COORDINATES = {} do not match machine '{}' ({} joints {})",
                                                       f.joints, f.coordinates, m.name, m.axisCount(), coordinatesOf(m)));
+    f.backlash.assign(static_cast<size_t>(m.axisCount()), 0.0);
+    for (const auto& [n, b] : ini.backlash) {
+        if (n >= m.axisCount()) throw InputError(kKinsIniFile, 0, fmt::format("[JOINT_{}] BACKLASH but only {} joints", n, m.axisCount()));
+        f.backlash[static_cast<size_t>(n)] = b * (m.axisLink(n).kind == AxisKind::Rotary ? kDeg : 1.0);
+    }
     std::map<std::string, std::pair<int, bool>> pins;  // pin → flat index, set
     for (const DeviationDef& def : m.deviations)
         for (int k = 0; k < def.size(); ++k) pins[pinOf(def, k)] = {def.offset + k, false};
@@ -171,6 +176,13 @@ AxisVector KinsComponentModel::driveCommandsForTool(const AxisVector& q, double 
     // Both modes: the tool-offset pin carries the program's tool length (joint mode: `cnccomp testprog`'s G43.1 Z<L>
     // with the Z words written minus L, postproc/testprog/program_syntax.hpp).
     return joints(q, toolLength);
+}
+
+AxisVector KinsComponentModel::driveCommandsMoving(const AxisVector& q, double toolLength, const AxisVector& motion) const {
+    AxisVector j = joints(q, toolLength);
+    for (int a = 0; a < j.size() && a < motion.size(); ++a)
+        j[a] += 0.5 * files_.backlash[static_cast<size_t>(a)] * (motion[a] > 0 ? 1.0 : motion[a] < 0 ? -1.0 : 0.0);
+    return j;
 }
 
 }  // namespace cnccomp::controllers::linuxcnc

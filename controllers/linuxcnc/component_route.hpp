@@ -30,6 +30,7 @@
 
 #include "cnccomp/kinematics.hpp"
 #include "controllers/backend.hpp"
+#include "controllers/common/directional.hpp"
 #include "controllers/linuxcnc/linuxcnc_apply.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
@@ -49,13 +50,16 @@ struct KinsFiles {
     std::string coordinates;  ///< [TRAJ] COORDINATES, joint order
     int joints = 0;           ///< [KINS] JOINTS
     bool toolOffsetNet = false;  ///< motion.tooloffset.z => <module>.tool-offset
+    /// [JOINT_n] BACKLASH per joint (0 when not given; joint n = machine axis n), mm or deg: LinuxCNC adds ±BACKLASH/2
+    /// by the joint's direction of motion (control.c compute_screw_comp; this route writes no COMP_FILE).
+    std::vector<double> backlash;
 };
 
 /// Reads cnccomp-kins.ini and cnccomp-kins.hal (InputError naming file and line): the module, its joints, and the
 /// deviation values of the setp lines into `values` (every pin of the machine's deviations must be set once).
 KinsFiles readKinsFiles(const MachineModel& m, const std::vector<OutputFile>& files, DeviationSet& values);
 
-class KinsComponentModel final : public AppliedCompensation {
+class KinsComponentModel final : public AppliedCompensation, public DirectionalCompensation {
 public:
     /// The machine must outlive the model.
     KinsComponentModel(const MachineModel& m, const std::vector<OutputFile>& files, KinsMode mode = KinsMode::Joint);
@@ -74,6 +78,9 @@ public:
     /// tool length (joint mode: the test programs' G43.1 Z<L>; tool-tip mode: G43 with the tool length).
     AxisVector driveCommands(const AxisVector& programmed) const override { return driveCommandsForTool(programmed, 0.0); }
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
+    /// The same plus ±BACKLASH/2 of each joint by the direction its axis' command moves (0: nothing; the ramp of
+    /// control.c's backlash_filt is not modelled). Joint mode: a joint moves the way its axis' words do.
+    AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const override;
 
 private:
     const MachineModel* machine_;

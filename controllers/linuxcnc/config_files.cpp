@@ -1,5 +1,7 @@
 #include "controllers/linuxcnc/config_files.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
@@ -46,6 +48,10 @@ IniFragment parseIni(const std::string& text, const std::string& name) {
             } else if (key == "COMP_FILE_TYPE") {
                 if (value != "0" && value != "1") throw InputError(name, l.number, "COMP_FILE_TYPE must be 0 or 1");
                 ini.compType[static_cast<int>(*n)] = value == "1" ? 1 : 0;
+            } else if (key == "BACKLASH") {
+                const auto b = parseNumber(value);
+                if (!b || !std::isfinite(*b)) throw InputError(name, l.number, "BACKLASH must be a number (mm or deg)");
+                ini.backlash[static_cast<int>(*n)] = *b;
             }
         }
     }

@@ -18,10 +18,14 @@ struct IniFragment {
     int joints = 0;            ///< [KINS] JOINTS (0 when not given)
     std::map<int, std::string> compFile;  ///< joint number → COMP_FILE
     std::map<int, int> compType;          ///< joint number → COMP_FILE_TYPE (0 when not given, as inijoint.cc)
+    /// joint number → [JOINT_n] BACKLASH (mm or deg): LinuxCNC adds +BACKLASH/2 while the joint's command moves +,
+    /// −BACKLASH/2 while it moves −, and keeps the last while it rests, on a joint without COMP_FILE (control.c
+    /// compute_screw_comp; docs/src/config/ini-config.adoc: a COMP_FILE joint ignores BACKLASH).
+    std::map<int, double> backlash;
 };
 
 /// Parses `[SECTION]`, `KEY = value`, '#' / ';' comments. InputError(file:line) on anything else, on a
-/// COMP_FILE_TYPE other than 0 or 1, on a JOINTS that is not a count, when no KINEMATICS line is there.
+/// COMP_FILE_TYPE other than 0 or 1, on a BACKLASH that is not a number, on a JOINTS that is not a count, when no KINEMATICS line is there.
 IniFragment parseIni(const std::string& text, const std::string& name);
 
 /// The `setp <module>.<pin> <value>` lines of a HAL fragment; `net`/`loadrt`/comments ignored, anything else an error.

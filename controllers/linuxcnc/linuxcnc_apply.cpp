@@ -61,6 +61,12 @@ LinuxcncModel::LinuxcncModel(const MachineModel& m, const std::vector<OutputFile
     if (mode_ == KinsMode::ToolTip && !trt_)
         throw ModelError(fmt::format("{}: {} has no tool-tip mode (only xyzac/xyzbc-trt-kins switch to it)", kIniFile, ini.kinematics));
     tables_.resize(coordinates_.size());
+    backlash_.assign(coordinates_.size(), 0.0);
+    for (const auto& [n, b] : ini.backlash) {
+        if (n >= static_cast<int>(coordinates_.size()))
+            throw InputError(kIniFile, 0, fmt::format("[JOINT_{}] BACKLASH but only {} joints", n, coordinates_.size()));
+        backlash_[static_cast<size_t>(n)] = b;
+    }
     for (const auto& [n, file] : ini.compFile) {
         if (n >= static_cast<int>(coordinates_.size()))
             throw InputError(kIniFile, 0, fmt::format("[JOINT_{}] but only {} joints", n, coordinates_.size()));
@@ -104,14 +110,23 @@ JointValues LinuxcncModel::jointPositions(const JointValues& program, double too
 
 JointValues LinuxcncModel::motorPositions(const JointValues& joints, const JointValues& directions) const {
     JointValues m = joints;
-    for (int i = 0; i < m.size(); ++i)
-        if (tables_[i]) m[i] += tables_[i]->trim(joints[i], directions[i] > 0 ? 1 : directions[i] < 0 ? -1 : 0);
+    for (int i = 0; i < m.size(); ++i) {
+        const int d = directions[i] > 0 ? 1 : directions[i] < 0 ? -1 : 0;
+        if (tables_[i]) m[i] += tables_[i]->trim(joints[i], d);
+        else m[i] += 0.5 * backlash_[static_cast<size_t>(i)] * d;  // no COMP_FILE: ±BACKLASH/2
+    }
     return m;
 }
 
 AxisVector LinuxcncModel::driveCommandsForTool(const AxisVector& q, double toolLength) const {
+    return driveCommandsMoving(q, toolLength, AxisVector::Zero(q.size()));
+}
+
+AxisVector LinuxcncModel::driveCommandsMoving(const AxisVector& q, double toolLength, const AxisVector& motion) const {
     const int n = static_cast<int>(coordinates_.size());
-    const JointValues motor = motorPositions(jointPositions(program(q, toolLength), toolLength), JointValues::Zero(n));
+    JointValues directions(n);
+    for (int i = 0; i < n; ++i) directions[i] = motion.size() == q.size() ? motion[jointAxis_[i]] : 0.0;
+    const JointValues motor = motorPositions(jointPositions(program(q, toolLength), toolLength), directions);
     AxisVector c = machine_->toController(q);
     for (int i = 0; i < n; ++i) c[jointAxis_[i]] = motor[i] * unit_[i];
     return machine_->fromController(c);

@@ -26,6 +26,7 @@
 
 #include "cnccomp/kinematics.hpp"
 #include "controllers/backend.hpp"
+#include "controllers/common/directional.hpp"
 #include "controllers/linuxcnc/comp_table.hpp"
 #include "controllers/linuxcnc/trt_kins.hpp"
 
@@ -43,7 +44,7 @@ enum class KinsMode { Joint, ToolTip };
 /// Values per LinuxCNC joint (joint order of the INI's coordinates=), mm and deg.
 using JointValues = AxisVector;
 
-class LinuxcncModel final : public AppliedCompensation {
+class LinuxcncModel final : public AppliedCompensation, public DirectionalCompensation {
 public:
     /// Reads cnccomp.ini, the COMP_FILEs, and for a trt module cnccomp.hal and cnccomp-g54.ngc (InputError
     /// naming file and line). The machine must outlive the model. ModelError for KinsMode::ToolTip on trivkins.
@@ -57,12 +58,19 @@ public:
     /// and tool-offset = toolLength).
     JointValues jointPositions(const JointValues& program, double toolLength) const;
     /// joint.N.motor-pos-cmd: joint positions plus the table trims; directions[n] > 0 uses the forward column,
-    /// < 0 the reverse one, 0 their mean.
+    /// < 0 the reverse one, 0 their mean. A joint without a table and with [JOINT_n] BACKLASH gets +BACKLASH/2 for
+    /// directions[n] > 0, −BACKLASH/2 for < 0, nothing for 0 (control.c compute_screw_comp; the ramp of backlash_filt,
+    /// limited by the joint's velocity and acceleration, is not modelled: the value after the ramp).
     JointValues motorPositions(const JointValues& joints, const JointValues& directions) const;
+    /// [JOINT_n] BACKLASH of each joint (0 when not given), LinuxCNC units.
+    const std::vector<double>& backlash() const { return backlash_; }
 
     /// Drive commands (description frame) for a program for the nominal machine; tool length 0, mean column.
     AxisVector driveCommands(const AxisVector& programmed) const override { return driveCommandsForTool(programmed, 0.0); }
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
+    /// The same with each joint moving the way its axis' command does (motion, description order; the joints are
+    /// the axes' controller coordinates, of the same sign): the tables' forward / reverse column, BACKLASH by direction.
+    AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const override;
 
     const std::string& coordinates() const { return coordinates_; }
     const std::optional<TrtType>& trt() const { return trt_; }
@@ -83,6 +91,7 @@ private:
     std::array<double, 3> g54_{};
     int jx_ = -1, jy_ = -1, jz_ = -1, jt_ = -1, jc_ = -1;
     std::vector<std::optional<CompTable>> tables_;
+    std::vector<double> backlash_;
 };
 
 }  // namespace cnccomp::controllers::linuxcnc

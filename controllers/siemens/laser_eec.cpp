@@ -10,6 +10,10 @@
 
 namespace cnccomp::controllers::siemens {
 
+std::string backlashMachineData(const std::string& axis, double backlashMm) {
+    return fmt::format("$MA_BACKLASH[0,{}]={:.6f}\n", axis, backlashMm);
+}
+
 LaserEec siemensLaserEec(const LaserPositioningResult& r, const std::string& axis, bool referenceForward, int maxPoints) {
     const LaserAxisCompensation c = laserAxisCompensation(r, referenceForward);
     LaserEec out;
@@ -39,7 +43,7 @@ LaserEec siemensLaserEec(const LaserPositioningResult& r, const std::string& axi
                            "$AA_ENC_COMP_IS_MODULO[0,{0}]=0\nM17\n",
                            axis, out.step, out.min, out.min + out.step * (n - 1));
     out.machineData = "%_N_AX_LASER_MD_INI\n" + header +
-                      fmt::format("$MA_BACKLASH[0,{0}]={1:.6f}\n$MA_ENC_COMP_ENABLE[0,{0}]=1\nM17\n", axis, out.backlashMm);
+                      backlashMachineData(axis, out.backlashMm) + fmt::format("$MA_ENC_COMP_ENABLE[0,{}]=1\nM17\n", axis);
     return out;
 }
 

@@ -3,7 +3,12 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/io/text_util.hpp"
+#include "controllers/common/axis_table.hpp"
+#include "controllers/common/files.hpp"
 #include "controllers/common/header.hpp"
+#include "controllers/common/set_backlash.hpp"
+#include "controllers/siemens/laser_eec.hpp"
 #include "controllers/siemens/compensation_tables.hpp"
 #include "controllers/siemens/kinematic_chain.hpp"
 
@@ -15,6 +20,13 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
     EmitResult r;
     r.compensated = plan.compensated;
     r.notCompensated = plan.notCompensated;
+    // Reversal values → MD32450 $MA_BACKLASH (the laser route's line, laser_eec.hpp; set_backlash.hpp).
+    std::string backlash;
+    for (const AxisBacklash& b : backlashOfSet(request)) {
+        backlash += backlashMachineData(axisName(m, b.axis), b.backlashUm * 1e-3);
+        r.compensated.push_back({"B" + b.name, fmt::format("MD32450 $MA_BACKLASH[0,{}] = {:.6f} mm (= -B{}) in {}", axisName(m, b.axis),
+                                                           b.backlashUm * 1e-3, b.name, kBacklashFile)});
+    }
     std::string axes;
     for (int a : controllerAxisOrder(m)) axes += fmt::format("{}{} = {}", axes.empty() ? "" : ", ", axisName(m, a), m.axisNames[a]);
     std::vector<std::string> notes = {
@@ -39,6 +51,12 @@ EmitResult emitFiles(const EmitRequest& request, const Options& o) {
     r.files.push_back({kChainFile, formatKinematicChain(m, plan, o, header)});
     if (!plan.cec.empty()) r.files.push_back({kCecFile, formatCec(m, plan.cec, header)});
     if (!plan.eec.empty()) r.files.push_back({kEecFile, formatEec(m, plan.eec, header)});
+    if (!backlash.empty())
+        r.files.push_back({kBacklashFile, "%_N_CNCCOMP_BACKLASH_INI\n" + header +
+                                              "; MD32450 BACKLASH (mm, first measuring system) = -B<axis>, the deviation set's reversal "
+                                              "value: positive when the encoder leads the slide (lost motion, the normal case; "
+                                              "808D Parameter Manual p.228); active after the reference point approach; NewConfig\n" +
+                                              backlash + "M17\n"});
     return r;
 }
 
@@ -70,11 +88,14 @@ std::unique_ptr<SiemensCompensation> readFiles(const MachineModel& m, const std:
     const OutputFile* chain = nullptr;
     std::vector<CecTable> cec;
     std::vector<EecTable> eec;
+    const OutputFile* backlashFile = nullptr;
     for (const OutputFile& f : files) {
         if (f.name == kChainFile) chain = &f;
         else if (f.name == kCecFile) cec = parseCec(m, f.name, f.content);
         else if (f.name == kEecFile) eec = parseEec(m, f.name, f.content);
-        else throw InputError(f.name, 0, fmt::format("not a siemens-840d file (expected {}, {} or {})", kChainFile, kCecFile, kEecFile));
+        else if (f.name == kBacklashFile) backlashFile = &f;
+        else throw InputError(f.name, 0, fmt::format("not a siemens-840d file (expected {}, {}, {} or {})", kChainFile, kCecFile,
+                                                     kEecFile, kBacklashFile));
     }
     if (!chain) throw InputError(kChainFile, 0, "missing: the kinematic chain file is needed for TRAORI");
     const ParsedChain pc = parseKinematicChain(m, chain->name, chain->content);
@@ -84,7 +105,28 @@ std::unique_ptr<SiemensCompensation> readFiles(const MachineModel& m, const std:
     } catch (const ModelError& e) {
         throw InputError(chain->name, 0, e.what());
     }
-    return std::make_unique<SiemensCompensation>(m, std::move(model), std::move(cec), std::move(eec));
+    auto out = std::make_unique<SiemensCompensation>(m, std::move(model), std::move(cec), std::move(eec));
+    if (backlashFile) {  // "$MA_BACKLASH[0,AXk]=value" lines; ';' comments, the %_N_ line and M17
+        out->backlash.assign(static_cast<size_t>(m.axisCount()), 0.0);
+        for (const TextLine& l : splitLines(backlashFile->content)) {
+            const std::string_view t = trim(l.text);
+            if (t.empty() || t.front() == ';' || t.front() == '%' || t == "M17") continue;
+            const size_t close = t.find(']'), eq = t.find('=');
+            int axis = -1;
+            if (t.starts_with("$MA_BACKLASH[0,") && close != std::string_view::npos && eq == close + 1)
+                for (int a = 0; a < m.axisCount(); ++a)
+                    if (axisName(m, a) == t.substr(15, close - 15)) axis = a;
+            const auto v = eq == std::string_view::npos ? std::nullopt : parseNumber(t.substr(eq + 1));
+            if (axis < 0 || !v)
+                throw InputError(backlashFile->name, l.number, "expected $MA_BACKLASH[0,<axis of the machine>]=<mm>, a comment or M17");
+            out->backlash[static_cast<size_t>(axis)] = *v / positionScale(m.axisLink(axis));
+        }
+    }
+    return out;
+}
+
+AxisVector SiemensCompensation::driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const {
+    return withBacklashOffsets(driveCommandsForTool(programmed, toolLength), backlash, motion);
 }
 
 namespace {

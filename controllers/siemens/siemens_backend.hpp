@@ -7,15 +7,19 @@
 #include <vector>
 
 #include "controllers/backend.hpp"
+#include "controllers/common/directional.hpp"
 #include "controllers/common/controller_model.hpp"
 #include "controllers/siemens/siemens_plan.hpp"
 
 namespace cnccomp::controllers::siemens {
 
+/// MD32450 $MA_BACKLASH of the set's reversal values (written when the set has one; laser_eec.hpp's line).
+inline constexpr const char* kBacklashFile = "CNCCOMP_BACKLASH.INI";
+
 /// emit with explicit controller limits (the registered backend uses the defaults).
 EmitResult emitFiles(const EmitRequest& request, const Options& options);
 
-class SiemensCompensation final : public AppliedCompensation {
+class SiemensCompensation final : public AppliedCompensation, public DirectionalCompensation {
 public:
     SiemensCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> chain, std::vector<CecTable> cec,
                         std::vector<EecTable> eec);
@@ -26,6 +30,10 @@ public:
     const TcpTransform& tcp() const { return tcp_; }
     const std::vector<CecTable>& cec() const { return cec_; }
     const std::vector<EecTable>& eec() const { return eec_; }
+    /// The same plus MD32450 by the direction of motion (controllers/common/set_backlash.hpp).
+    AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const override;
+    /// MD32450 of each axis (description order), mm; empty when no file sets one.
+    std::vector<double> backlash;
 
 private:
     const MachineModel* machine_;

@@ -11,6 +11,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/rtest_run.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
+#include "cnccomp/lost_motion.hpp"
+#include "controllers/common/directional.hpp"
 #include "controllers/common/evaluate.hpp"
 #include "postproc/testprog/read_back.hpp"
 #include "postproc/testprog/test_program.hpp"
@@ -19,18 +21,25 @@ namespace cnccomp {
 
 namespace {
 
-class IdealCompensation final : public controllers::AppliedCompensation {
+class IdealCompensation final : public controllers::AppliedCompensation, public controllers::DirectionalCompensation {
 public:
-    IdealCompensation(const MachineModel& m, const DeviationSet& d) : nominal_(m), identified_(m, d) {}
+    IdealCompensation(const MachineModel& m, const DeviationSet& d) : nominal_(m), identified_(m, d), reversal_(d) {}
     AxisVector driveCommands(const AxisVector& q) const override { return driveCommandsForTool(q, 0.0); }
     AxisVector driveCommandsForTool(const AxisVector& q, double toolLength) const override {
         const Vec3 tip = nominal_.toolPoint(toolLength);
         const IkResult r = solveToolPose(identified_, toolPose(nominal_, q, tip), tip, q);
         return r.converged ? r.q : q;
     }
+    /// The reversal values of the set taken off by direction (lost_motion.hpp: the slide reaches command + (B̄/2)·s, so
+    /// the drive is sent −(B̄/2)·s further: what a controller's backlash β = −B̄ does, LinuxCNC ±BACKLASH/2).
+    AxisVector driveCommandsMoving(const AxisVector& q, double toolLength, const AxisVector& motion) const override {
+        const AxisVector drive = driveCommandsForTool(q, toolLength);
+        return drive - (withLostMotion(reversal_, drive, motion) - drive);
+    }
 
 private:
     Kinematics nominal_, identified_;
+    DeviationSet reversal_;
 };
 
 double span(const std::vector<double>& v) {
@@ -305,10 +314,19 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
             const auto& [file, text] = it->second;
             after = samplesOf(r, testprog::readTestProgram(m, r, text, comp.programDialect, file));
         } else {
+            // Each pose with the direction its axes' commands move in along the pass (lost_motion.hpp: a controller's
+            // backlash or two-column table keys on it); the setup pose as reached from either side (0: the mean).
             after = before;
-            after.setup = comp.model->driveCommandsForTool(before.setup, r.toolLength);
-            for (auto& pass : after.q)
-                for (AxisVector& q : pass) q = comp.model->driveCommandsForTool(q, r.toolLength);
+            const auto* directional = dynamic_cast<const controllers::DirectionalCompensation*>(comp.model.get());
+            const auto drive = [&](const AxisVector& q, const AxisVector& motion) {
+                return directional ? directional->driveCommandsMoving(q, r.toolLength, motion)
+                                   : comp.model->driveCommandsForTool(q, r.toolLength);
+            };
+            after.setup = drive(before.setup, AxisVector::Zero(before.setup.size()));
+            for (auto& pass : after.q) {
+                const std::vector<AxisVector> motion = motionDirections(pass);
+                for (size_t j = 0; j < pass.size(); ++j) pass[j] = drive(pass[j], motion[j]);
+            }
         }
         VerifyRun run;
         run.name = r.name;
@@ -326,10 +344,12 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
             VerifyPass v;
             v.label = before.labels[p];
             TravelCheck travelBefore, travelAfter;
-            simulatePass(k, nominal, r, before.setup, before.setup, before.t[p], before.q[p], v.before, v.displacementBefore,
-                         travelBefore);
-            simulatePass(k, nominal, r, after.setup, before.setup, after.t[pa], after.q[pa], v.after, v.displacementAfter,
-                         travelAfter);
+            // The slides reach the drive commands with the simulated machine's lost motion at their reversals
+            // (lost_motion.hpp; the setup pose at the mean of its two sides); none when the set has no reversal value.
+            simulatePass(k, nominal, r, before.setup, before.setup, before.t[p], withLostMotion(simulated, before.q[p]), v.before,
+                         v.displacementBefore, travelBefore);
+            simulatePass(k, nominal, r, after.setup, before.setup, after.t[pa], withLostMotion(simulated, after.q[pa]), v.after,
+                         v.displacementAfter, travelAfter);
             v.outsideTravel = travelAfter.describe(m);
             if (r.rtest) {
                 v.spanBefore = displacementSpan(v.displacementBefore);
@@ -387,6 +407,9 @@ VerifyWorse compensationWorse(const VerifyResult& r) {
     VerifyWorse w;
     w.spanAllowance = allowance(r.residualBefore);
     w.span = r.residual > r.residualBefore + w.spanAllowance;
+    for (const VerifyRun& run : r.runs)
+        if (run.spanAfter() > run.spanBefore() + allowance(run.spanBefore()))
+            w.runs.push_back(fmt::format("{} {:.3f} -> {:.3f} um", run.name, run.spanBefore() / kUm, run.spanAfter() / kUm));
     if (r.volumetric.available) {
         w.volumetricAllowance = allowance(r.volumetric.maxBefore);
         w.volumetric = r.volumetric.maxAfter > r.volumetric.maxBefore + w.volumetricAllowance;

@@ -125,6 +125,10 @@ struct VerifyWorse {
     bool span = false;          ///< the largest span grew beyond its allowance
     bool volumetric = false;    ///< the volumetric tool-tip error grew beyond its allowance
     double spanAllowance = 0, volumetricAllowance = 0;  ///< mm
+    /// Runs whose own largest span grew beyond the allowance of their own before, "zx 1.660 -> 3.973 um", while the
+    /// largest span over the plan did not (a compensation can help one circle and hurt another, e.g. a backlash value
+    /// on a slide without lost motion): said by verify, not gated (the gate is the largest span).
+    std::vector<std::string> runs{};
     bool any() const { return span || volumetric; }
 };
 inline constexpr double kWorseFloorMm = 1e-4;    ///< 0.1 µm

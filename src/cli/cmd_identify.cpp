@@ -118,8 +118,15 @@ void run(Options o) {
     OutputSet staged({o.machine, o.plan, o.truth, r.start, r.eccentricities, o.merge});
     // --merge: the identified deviations replace theirs in an existing set (e.g. the laser's positioning components
     // and a rotary-axis identification), the others are kept (laser_deviation.hpp, mergeDeviations).
-    staged.add(o.out, formatDeviationCsv(o.merge.empty() ? res.deviations
-                                                          : mergeDeviations(readDeviationCsv(o.merge, m), res.deviations)));
+    // A reversal value this run did not determine keeps the base's (said below, reversalMergeLines).
+    std::vector<std::string> mergeLines;
+    if (o.merge.empty()) {
+        staged.add(o.out, formatDeviationCsv(res.deviations));
+    } else {
+        const DeviationSet base = readDeviationCsv(o.merge, m);
+        mergeLines = reversalMergeLines(base, res.deviations, "this identification");
+        staged.add(o.out, formatDeviationCsv(mergeDeviations(base, res.deviations)));
+    }
     if (res.circles && html) {
         if (!o.reportControllers.empty() || !o.reportGrid.empty())
             throw ModelError("--report-controllers and --report-grid: the circles of the linear axes write no maps or "
@@ -164,6 +171,7 @@ void run(Options o) {
     if (res.report && !res.report->adequacy.fits) fmt::print("WARNING: {}\n", res.report->adequacy.message);
     fmt::print("{} -> {}{}{}\n", res.summary, o.out, o.merge.empty() ? "" : " (merged into " + o.merge + ")",
                o.report.empty() ? "" : ", report -> " + o.report);
+    for (const std::string& l : mergeLines) fmt::print("merge: {}\n", l);
     if (res.report) printReport(*res.report);
     if (res.circles) printLinearCircles(*res.circles);
     printCircularTests(runs);

@@ -55,7 +55,13 @@ void run(const Options& o) {
         const MachineModel m = readMachineXml(o.machine);
         DeviationSet laser(m);
         const LaserComponentResult c = setPositioningComponent(laser, r, o.file);
-        const DeviationSet set = o.merge.empty() ? laser : mergeDeviations(readDeviationCsv(o.merge, m), laser);
+        std::string mergeLines;
+        DeviationSet set = laser;
+        if (!o.merge.empty()) {
+            const DeviationSet base = readDeviationCsv(o.merge, m);
+            for (const std::string& l : reversalMergeLines(base, laser, "the laser")) mergeLines += "merge: " + l + "\n";
+            set = mergeDeviations(base, laser);
+        }
         out.add(o.deviationsOut, formatDeviationCsv(set));
         deviationNote = fmt::format(
             "deviation set: {} = the mean bidirectional deviation (sign from the machine's kinematics: {:+.0f}), largest "
@@ -64,6 +70,7 @@ void run(const Options& o) {
             c.component, c.sensitivity, c.largestResidualUm,
             c.nodesOutside ? fmt::format(", {} table node(s) outside the targets hold the end targets' value", c.nodesOutside) : "",
             o.merge.empty() ? "" : fmt::format(", merged into {}", o.merge), r.axis, c.meanReversalUm, c.reversalUm);
+        deviationNote += mergeLines;
     }
     std::string ini;
     if (!o.json.empty()) out.add(o.json, formatLaserJson(r, in.environmentStated, o.file));

@@ -43,6 +43,8 @@ std::string ecc(const Vec3& v) {
 void print(const VerifyResult& r) {
     // A compensation that makes the machine worse is said first, before any figure (VerifyWorse).
     if (r.worse.any()) fmt::print("{}\n", worseBanner(r));
+    if (!r.worse.span)  // a run that got worse while the largest span did not (VerifyWorse::runs)
+        for (const std::string& w : r.worse.runs) fmt::print("WARNING: worse after compensation in run {} (span)\n", w);
     fmt::print("verification on '{}': {}\ncompensation: {}\n", r.machine, r.simulated, r.compensation);
     fmt::print("{:<22} {:<16} {:<7} {:>19} {:>19} {:>19}   {:<24}  {}\n", "run", "type", "pass", "span before/after",
                "G before/after", "F max/min after", "eccentricity before (um)", "after");

@@ -158,4 +158,21 @@ DeviationSet mergeDeviations(const DeviationSet& base, const DeviationSet& updat
     return out;
 }
 
+std::vector<std::string> reversalMergeLines(const DeviationSet& base, const DeviationSet& update, const std::string& updateName) {
+    const MachineModel& m = base.machine();
+    std::vector<std::string> out;
+    for (size_t a = 0; a < base.reversalPresent.size() && a < update.reversalPresent.size(); ++a) {
+        const std::string name = "B" + m.axisNames[a];
+        if (update.reversalPresent[a])
+            out.push_back(base.reversalPresent[a]
+                              ? fmt::format("{} = {:.4f} um from {} (replaces the base's {:.4f} um)", name, update.reversal[a] / kUm,
+                                            updateName, base.reversal[a] / kUm)
+                              : fmt::format("{} = {:.4f} um from {} (the base had none)", name, update.reversal[a] / kUm, updateName));
+        else if (base.reversalPresent[a])
+            out.push_back(fmt::format("{} = {:.4f} um kept from the base ({} did not determine it)", name, base.reversal[a] / kUm,
+                                      updateName));
+    }
+    return out;
+}
+
 }  // namespace cnccomp

@@ -21,6 +21,7 @@
 // squares over the targets, with the largest residual returned. Targets are the controller's machine coordinates (the
 // laser's), converted to the description's commands with the axis' machine zero (MachineModel::fromController).
 #include <string>
+#include <vector>
 
 #include "cnccomp/deviations.hpp"
 #include "cnccomp/laser_positioning.hpp"
@@ -56,5 +57,11 @@ LaserComponentResult setPositioningComponent(DeviationSet& set, const LaserPosit
 /// `base` with every deviation present in `update` replaced by update's: location errors by their ISO value (the
 /// others keep theirs), component errors coefficient by coefficient, reversal values axis by axis. Both sets must be of the same machine object.
 DeviationSet mergeDeviations(const DeviationSet& base, const DeviationSet& update);
+
+/// What mergeDeviations does with the reversal values (rows B<axis>), one line per axis that either set holds, for
+/// the output of `--merge`: a value the update determined replaces the base's ("BX = -4.0000 um from <updateName>
+/// (replaces the base's -3.0000 um)"), one it did not determine keeps the base's ("BZ = -3.0000 um kept from the base
+/// (<updateName> did not determine it)"). Empty when neither set has a reversal value.
+std::vector<std::string> reversalMergeLines(const DeviationSet& base, const DeviationSet& update, const std::string& updateName);
 
 }  // namespace cnccomp
