@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 double niceNumber(double x) {
     if (!(x > 0) || !std::isfinite(x)) return 1.0;
@@ -26,4 +26,4 @@ std::string jsonNumber(double v) {
     return fmt::format("{:.9g}", v);
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -5,7 +5,7 @@
 
 #include "cnccomp/io/markup.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 /// The smallest of 1, 2, 2.5, 5 × 10^k that is ≥ x (x > 0; 1 otherwise).
 double niceNumber(double x);
@@ -15,4 +15,4 @@ using cnccomp::jsonString;  // io/markup.hpp
 /// JSON number with 9 significant digits, or null when not finite.
 std::string jsonNumber(double v);
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report
