@@ -204,10 +204,10 @@ IdentificationSummary headPatterns(const MethodRequest& r) {
                                   ls.engine.report.termination);
     }
     r.say("{:>8} {:>10} {:>10} {:>10} {:>12} {:>12}   (errors of {} over its angle, link values)\n", "deg",
-               "dx um", "dy um", "dz um", "ex arcsec", "ey arcsec", f.headAxis);
+          "dx um", "dy um", "dz um", "ex arcsec", "ey arcsec", f.headAxis);
     for (const TiltingHeadAngle& h : rows)
         r.say("{:8.2f} {:10.4f} {:10.4f} {:10.4f} {:12.4f} {:12.4f}\n", h.angleDeg, h.dx / kUm, h.dy / kUm,
-                   h.dz / kUm, h.ex / kArcsec, h.ey / kArcsec);
+              h.dz / kUm, h.ex / kArcsec, h.ey / kArcsec);
     const std::string head = f.headAxis;
     out.extras.push_back({"--angles-out", [rows, head](std::ostream& o) {
                               o << head << "_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec\n";
@@ -236,12 +236,12 @@ IdentificationSummary rtestLocation(const MethodRequest& r) {
         const RtestLocationResult f = rtestLocationFits(m, r.plan->rtestRuns, traces, {outer, inner, refineOr(r, 4)});
         out.deviations = f.deviations;
         r.say("fits: {} circle centre ({:.4f}, {:.4f}, {:.4f}) mm r = {:.4f} mm; {} circle centre ({:.4f}, {:.4f}, "
-                   "{:.4f}) mm r = {:.4f} mm\n",
-                   outer, f.outerCircle.center.x(), f.outerCircle.center.y(), f.outerCircle.center.z(),
-                   f.outerCircle.radius, inner, f.innerCircle.center.x(), f.innerCircle.center.y(),
-                   f.innerCircle.center.z(), f.innerCircle.radius);
+              "{:.4f}) mm r = {:.4f} mm\n",
+              outer, f.outerCircle.center.x(), f.outerCircle.center.y(), f.outerCircle.center.z(),
+              f.outerCircle.radius, inner, f.innerCircle.center.x(), f.innerCircle.center.y(),
+              f.innerCircle.center.z(), f.innerCircle.radius);
         r.say("eq. (2): C_XY = {:.3f} um/m, C_YZ = {:.3f} um/m, C_ZX = {:.3f} um/m ({} tilted ±{:g} deg)\n",
-                   f.cXY * 1e6, f.cYZ * 1e6, f.cZX * 1e6, outer, f.phiDeg);
+              f.cXY * 1e6, f.cYZ * 1e6, f.cZX * 1e6, outer, f.phiDeg);
         out.summary = fmt::format("R-test location fits (circle, line and ellipse fits, eq. (2)), {} refinement steps on "
                                   "the exact model",
                                   f.refine);
@@ -255,7 +255,7 @@ IdentificationSummary rtestLocation(const MethodRequest& r) {
         const size_t i = static_cast<size_t>(it - runs.begin());
         const VolumetricAlongRun v = volumetricErrorAlongRun(m, out.deviations, *it, traces[i]);
         r.say("volumetric error along '{}': measured RMS {:.4f} um, model RMS residual {:.4f} um, max {:.4f} um\n",
-                   r.volumetricRun, v.rmsMeasured / kUm, v.rmsResidual / kUm, v.maxResidual / kUm);
+              r.volumetricRun, v.rmsMeasured / kUm, v.rmsResidual / kUm, v.maxResidual / kUm);
         out.extras.push_back({"--volumetric-out", [v](std::ostream& o) {
                                   o << "pose,meas_dx_um,meas_dy_um,meas_dz_um,calc_dx_um,calc_dy_um,calc_dz_um,delta_um\n";
                                   for (size_t k = 0; k < v.measured.size(); ++k) {
@@ -283,7 +283,7 @@ void printTables(const MethodRequest& r, const DeviationSet& d, const std::vecto
             double vmax = 0;
             for (int k = 0; k < def.size(); ++k) vmax = std::max(vmax, std::abs(d.values[def.offset + k]) / s);
             r.say("{:<6} {:<8} {:>5} {:12.4f}  {}\n", def.name, def.alias, def.size(), vmax,
-                       def.isAngle() ? "arcsec" : "um");
+                  def.isAngle() ? "arcsec" : "um");
         }
 }
 
@@ -303,8 +303,8 @@ IdentificationSummary rtestTables(const MethodRequest& r) {
         out.deviations = cradleTablesPerAngle(m, outer, inner, r.plan->rtestRuns, traces, &per);
         for (const AxisErrors& a : per)
             r.say("eq. (1)-(7) per angle: axis {} at {} angles, worst fit residual {:.5f} um\n", a.axis,
-                       a.samples.size(),
-                       std::max_element(a.samples.begin(), a.samples.end(), [](auto& x, auto& y) { return x.rms < y.rms; })->rms / kUm);
+                  a.samples.size(),
+                  std::max_element(a.samples.begin(), a.samples.end(), [](auto& x, auto& y) { return x.rms < y.rms; })->rms / kUm);
         out.summary = fmt::format("R-test tables of {} and {}, per-angle formulas (1)-(7) ({} first)", outer, inner, outer);
     } else {
         const CradleLsq ls = cradleLeastSquares(m, outer, inner, r.plan->rtestRuns, traces);
@@ -343,12 +343,12 @@ IdentificationSummary dbb5(const MethodRequest& r) {
     const std::vector<Dbb5Run>& runs = r.plan->dbb5Runs;
     const std::vector<BallbarTrace>& traces = r.data->dbb5;
     r.say("{:<14} {:>8} {:>16} {:>18} {:>10}  (ISO 230-4)\n", "run", "samples", "circularity um",
-               "mean radial err um", "b2 um");
+          "mean radial err um", "b2 um");
     std::vector<CircularTestResult> iso;
     for (size_t i = 0; i < traces.size(); ++i) {
         iso.push_back(evaluateCircularTest(traces[i], runs[i].LB));
         r.say("{:<14} {:>8} {:16.4f} {:18.4f} {:10.4f}\n", runs[i].name, iso.back().samples,
-                   iso.back().circularity / kUm, iso.back().meanRadialError / kUm, iso.back().b2 / kUm);
+              iso.back().circularity / kUm, iso.back().meanRadialError / kUm, iso.back().b2 / kUm);
     }
     const Dbb5LocationOptions lo{r.outer, r.inner, refineOr(r, 4)};
     IdentificationSummary out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
@@ -358,7 +358,7 @@ IdentificationSummary dbb5(const MethodRequest& r) {
         r.say("plain formulas, the paper's definitions (relative to the machine axes):\n");
         for (const Dbb5FormulaValue& v : f.formulas)
             r.say("  {:<18} {:>10.4f} {:<6}  {}\n", v.name, v.value / (v.angle ? kArcsec : kUm),
-                       v.angle ? "arcsec" : "um", v.definition);
+                  v.angle ? "arcsec" : "um", v.definition);
         out.summary = fmt::format("DBB5 formulas (1)-(3), (6)-(7) and the elliptic term of the linear circles, {} "
                                   "refinement steps on the exact model{}",
                                   f.refine, f.refine > 0 ? "" : " (plain formulas converted to the model's definitions)");
@@ -372,8 +372,8 @@ IdentificationSummary dbb5(const MethodRequest& r) {
         const Dbb5ComponentProfile p = dbb5ComponentProfile(m, runs, traces, out.deviations, inner);
         out.deviations = dbb5ComponentTables(m, p, out.deviations);
         r.say("component errors of {} from {} (bed frame, relative to the average line; tilts: {}, axial: {}) "
-                   "-> the model's tables\n",
-                   inner, fmt::join(p.runs, ", "), p.tilts ? "yes" : "no", p.axial ? "yes" : "no");
+              "-> the model's tables\n",
+              inner, fmt::join(p.runs, ", "), p.tilts ? "yes" : "no", p.axial ? "yes" : "no");
         out.extras.push_back({"--profile-out", [p](std::ostream& o) {
                                   o << "angle_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec,ez_arcsec\n";
                                   for (size_t i = 0; i < p.angleDeg.size(); ++i)
@@ -388,17 +388,17 @@ IdentificationSummary dbb5(const MethodRequest& r) {
         if (isDbb5XycTest(m, run)) {
             const Dbb5XycResult x = evaluateDbb5XycTest(m, run, traces[i]);
             r.say("XYC test {}: centre offset ({:.4f}, {:.4f}) um at R = {:g} mm -> {} {:.4f} arcsec, {} {:.4f} arcsec "
-                       "(eq. (4)-(5), relative to the plane of motion)\n",
-                       run.name, x.centre[0] / kUm, x.centre[1] / kUm, x.radius,
-                       fmt::format("E{}0{}", "ABC"[x.second], run.axis), x.rotation[x.second] / kArcsec,
-                       fmt::format("E{}0{}", "ABC"[x.first], run.axis), x.rotation[x.first] / kArcsec);
+                  "(eq. (4)-(5), relative to the plane of motion)\n",
+                  run.name, x.centre[0] / kUm, x.centre[1] / kUm, x.radius,
+                  fmt::format("E{}0{}", "ABC"[x.second], run.axis), x.rotation[x.second] / kArcsec,
+                  fmt::format("E{}0{}", "ABC"[x.first], run.axis), x.rotation[x.first] / kArcsec);
         } else if (run.kind == Dbb5Run::Kind::ConeFrustum) {
             const Dbb5ConeEvaluation c = evaluateDbb5ConeRun(m, run, traces[i], &out.deviations);
             r.say("cone frustum {}: circularity {:.4f} um; measured - predicted by the identified errors: rms {:.4f} "
-                       "um, max {:.4f} um ({})\n",
-                       run.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm,
-                       r.formulas ? "not used by the formulas: an independent check"
-                                  : "a run of the fit, not an independent check");
+                  "um, max {:.4f} um ({})\n",
+                  run.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm,
+                  r.formulas ? "not used by the formulas: an independent check"
+                             : "a run of the fit, not an independent check");
         }
     }
     std::vector<std::string> names;
@@ -457,14 +457,14 @@ IdentificationSummary sphereProbe(const MethodRequest& r) {
     const ProbeLog& log = *r.data->probes;
     Observations obs = sphereObservations(m, cmds, log);
     r.say("{:<16} {:>6} {:>8} {:>22}  (sphere centres fitted with the known radius)\n", "run", "poses", "touches",
-               "worst fit rms um (pose)");
+          "worst fit rms um (pose)");
     for (size_t i = 0; i < obs.size(); ++i) {
         const auto& so = static_cast<const SphereObservation&>(*obs[i]);
         const auto& rms = so.fitRms();
         const auto w = std::max_element(rms.begin(), rms.end());
         r.say("{:<16} {:>6} {:>8} {:>16.4f} ({:>3})\n", so.runName(), rms.size(),
-                   rms.size() * static_cast<size_t>(cmds.runs[i].run.touchesPerPose()), *w / kUm,
-                   cmds.runs[i].poses[static_cast<size_t>(w - rms.begin())].planPose);
+              rms.size() * static_cast<size_t>(cmds.runs[i].run.touchesPerPose()), *w / kUm,
+              cmds.runs[i].poses[static_cast<size_t>(w - rms.begin())].planPose);
     }
     const IdentifyOptions io = engineOptions(r, sphereDefaults(m, obs));
     IdentificationResult res = cnccomp::identify(m, obs, io);

@@ -53,8 +53,8 @@ std::string solverText(const SolverChoice& solver);
 
 /// Checks every option that needs no file: the solver and its NLopt algorithm, the iteration limit, the rank
 /// tolerance, the Monte Carlo count, --refine, the bounds' syntax and, for least squares, bounds only with a bounded
-/// solver. ModelError naming the option and what it accepts. The façade calls it
-/// first; `cnccomp identify` calls it before it reads the machine.
+/// solver. ModelError naming the option and what it accepts. The façade calls it first; `cnccomp identify` calls it
+/// before it reads the machine.
 void validateOptions(const IdentificationOptions& options);
 
 /// The bounds "NAME=LOWER:UPPER, …" (µm for lengths and nuisance parameters, arcsec for angles) in internal units,
