@@ -175,7 +175,7 @@ TEST(ControllerFit, FanucOnTheQuickstartMachineLeavesClearlyLessThanNone) {
     const MachineModel& m = test::multitasking();
     const DeviationSet d = readDeviationCsv(src("samples/deviations/multitasking-truth.csv"), m);
     const MeasurementPlan plan = readPlanXml(src("samples/plans/multitasking-six-circles-recorded.xml"));
-    const PlanWorkspace p = planWorkspace(m, plan);
+    const app::PlanWorkspace p = app::planWorkspace(m, plan);
     controllers::FitWorkspace w;
     w.poses = p.poses;
     const auto travel = controllers::workspaceSamples(m, 5);

@@ -377,14 +377,14 @@ TEST(ControllerHeidenhain, ATransRowThatShiftsTheDatumIsReadAndOnlyTheVolumetric
         EXPECT_LT((bad->driveCommandsForTool(q, 100.0) - good->driveCommandsForTool(q, 100.0) - shift).norm(), 1e-7);
     }
     MeasurementPlan plan = readPlanXml(sourcePath("samples/plans/table-table-ac-rtest.xml"));
-    VerifyOptions o;
+    app::VerifyOptions o;
     o.volumetricPerAxis = 3;
-    VerifyCompensation c;
-    c.kind = VerifyCompensation::Kind::ControllerFiles;
+    app::VerifyCompensation c;
+    c.kind = app::VerifyCompensation::Kind::ControllerFiles;
     c.model = std::shared_ptr<const AppliedCompensation>(tnc().apply(m, r.files));
-    const VerifyResult vg = verify(m, plan, truth, "truth", c, o);
+    const app::VerifyResult vg = app::verify(m, plan, truth, "truth", c, o);
     c.model = std::shared_ptr<const AppliedCompensation>(tnc().apply(m, damaged));
-    const VerifyResult vb = verify(m, plan, truth, "truth", c, o);
+    const app::VerifyResult vb = app::verify(m, plan, truth, "truth", c, o);
     EXPECT_LT(vg.residual, 0.01 * kUm);
     EXPECT_LT(vb.residual, 0.01 * kUm);
     EXPECT_LT(vg.volumetric.maxAfter, 0.01 * kUm);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <random>
 
+#include "app/identify.hpp"
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_circular.hpp"
 #include "cnccomp/identification/dbb5_location_errors.hpp"
@@ -15,6 +16,7 @@
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/io/trace_csv.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
@@ -226,29 +228,27 @@ TEST(Dbb5LocationErrors, MissingRunsAndMachinesAreNamed) {
                  ModelError);
 }
 
-TEST(Dbb5LocationErrors, CommandLineOnTheBcTable) {
-    // The paths that failed on B/C before ("needs two B runs with the bar along Y"; --lsq: "no deviation named
-    // 'EY0B'"): formulas (refined) and least squares through `cnccomp identify`, read back against the truth.
-    test::ScratchDir dir("dbb5-bc-cli");
-    const std::string m = test::sourcePath("samples/machines/table-table-bc.xml");
-    const std::string p = test::sourcePath("samples/plans/dbb5-table-table-bc.xml");
-    const std::string truth = test::sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv");
-    auto r = test::runCli("simulate --machine " + m + " --plan " + p + " --deviations " + truth + " --out " +
-                          dir.file("traces"));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    for (const std::string extra : {" --method formulas", ""}) {
-        r = test::runCli("identify --machine " + m + " --plan " + p + " --traces " + dir.file("traces") + " --out " +
-                         dir.file("d.csv") + extra);
-        ASSERT_EQ(r.exitCode, 0) << r.out;
-        if (!extra.empty()) {
-            EXPECT_NE(r.out.find("relative to the machine axes (B at 0)"), std::string::npos) << r.out;
+TEST(Dbb5LocationErrors, IdentifyFacadeOnTheBcTable) {
+    // The paths that failed on B/C before ("needs two B runs with the bar along Y"; least squares: "no deviation named
+    // 'EY0B'"): formulas (refined) and least squares through the identification façade `cnccomp identify` runs
+    // (src/app/identify.hpp; it called the executable while the façade lived in the CLI), on the simulated runs
+    // written as files, against the truth.
+    test::ScratchDir dir("dbb5-bc-facade");
+    const Case& c = bcCase();
+    for (size_t i = 0; i < c.plan.dbb5Runs.size(); ++i) writeTraceCsv(dir.file(c.plan.dbb5Runs[i].name + ".csv"), c.traces[i]);
+    for (const app::Approach approach : {app::Approach::Formulas, app::Approach::LeastSquares}) {
+        app::IdentificationOptions o;
+        o.traces = dir.path.string();
+        o.approach = approach;
+        const app::IdentificationSummary s = app::identify(*c.machine, &c.plan, o);
+        EXPECT_EQ(s.method, "dbb5");
+        if (approach == app::Approach::Formulas) {
+            EXPECT_NE(s.methodTables.find("relative to the machine axes (B at 0)"), std::string::npos) << s.methodTables;
         }
-        const DeviationSet got = readDeviationCsv(dir.file("d.csv"), *bcCase().machine);
-        const auto [um, as] = worst(got, bcCase().truth, dbb5LocationErrors(*bcCase().machine, bcCase().plan.dbb5Runs,
-                                                                           bcCase().traces, {"", "", 0}).identified);
-        EXPECT_LT(um, 0.001) << extra;  // file rounding 1e-6 µm
-        EXPECT_LT(as, 0.001) << extra;
-        std::filesystem::remove(dir.file("d.csv"));
+        const auto [um, as] = worst(s.deviations, c.truth,
+                                    dbb5LocationErrors(*c.machine, c.plan.dbb5Runs, c.traces, {"", "", 0}).identified);
+        EXPECT_LT(um, 0.001) << s.briefReport();  // the trace files' rounding
+        EXPECT_LT(as, 0.001) << s.briefReport();
     }
 }
 

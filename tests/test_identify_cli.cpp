@@ -4,8 +4,6 @@
 
 #include <filesystem>
 
-#include "cnccomp/closed_form.hpp"
-#include "cnccomp/eccentricity.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
@@ -54,37 +52,8 @@ TEST(IdentifyCli, LeastSquaresIsTheDefaultAndRecoversAllThirteen) {
     EXPECT_EQ(j["singular_values"].array.size(), 13u);
 }
 
-TEST(IdentifyCli, ClosedFormStillWorksExactly) {
-    test::ScratchDir dir("id-cli-cf");
-    const std::string traces = simulateInto(dir, kPlan);
-    const auto r = test::runCli("identify --method closed-form --machine " + kMachine + " --plan " + kPlan +
-                                " --traces " + traces + " --out " + dir.file("cf.csv"));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    const MachineModel& m = test::multitasking();
-    const MeasurementPlan plan = readPlanXml(kPlan);
-    const DeviationSet lib = identifyClosedForm(m, eccentricitiesFromTraces(m, plan.runs, readRunTraces(traces, plan.runs)));
-    EXPECT_EQ(test::readText(dir.file("cf.csv")), formatDeviationCsv(lib));
-}
-
-TEST(IdentifyCli, UnidentifiableRequestIsReportedByName) {
-    test::ScratchDir dir("id-cli-unid");
-    const std::string plan = test::sourcePath("samples/plans/lsq-multitasking-b-runs.xml");
-    const std::string traces = simulateInto(dir, plan, "--noise-um 0.2 --seed 3");
-    const auto r = test::runCli("identify --machine " + kMachine + " --plan " + plan + " --traces " + traces +
-                                " --params dzBT,gXB,dxCZ,dyCZ,aCZ,bCZ --out " + dir.file("d.csv") + " --report " +
-                                dir.file("r.json"));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_NE(r.out.find("EX0C           unidentified"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("warning: 4 of 6 unknowns are not identifiable"), std::string::npos) << r.out;
-    const Json j = readJsonFile(dir.file("r.json"));
-    ASSERT_EQ(j["unidentified"].array.size(), 4u);
-    EXPECT_EQ(j["unidentified"][0].string, "EX0C");
-    EXPECT_EQ(j["unidentified"][3].string, "EB0C");
-    EXPECT_EQ(j["unobservable_directions"].array.size(), 4u);
-    const DeviationSet id = readDeviationCsv(dir.file("d.csv"), test::multitasking());
-    EXPECT_TRUE(id.present[test::multitasking().deviationIndex("gXB")]);
-    EXPECT_FALSE(id.present[test::multitasking().deviationIndex("dxCZ")]);  // no meaningless value written
-}
+// ClosedFormStillWorksExactly and UnidentifiableRequestIsReportedByName call the façade now
+// (tests/test_identify_facade.cpp).
 
 TEST(IdentifyCli, MonteCarloSolverAndStartOptions) {
     test::ScratchDir dir("id-cli-mc");
@@ -131,6 +100,10 @@ TEST(IdentifyCli, BadInputFailsCleanlyWithoutOutputFiles) {
     r = test::runCli(base + " --solver nlopt:NOT_AN_ALGORITHM" + outs);
     EXPECT_EQ(r.exitCode, 2) << r.out;
     EXPECT_NE(r.out.find("unknown NLopt algorithm 'NOT_AN_ALGORITHM'"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("C-axial.csv"), std::string::npos) << r.out;
+    r = test::runCli(base + " --solver gauss" + outs);  // an unknown solver: named with what --solver accepts
+    EXPECT_EQ(r.exitCode, 2) << r.out;
+    EXPECT_NE(r.out.find("unknown --solver 'gauss' (lm, or nlopt:<ALGORITHM>"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("C-axial.csv"), std::string::npos) << r.out;
     r = test::runCli(base + " --rank-tolerance 2" + outs);
     EXPECT_EQ(r.exitCode, 2) << r.out;

@@ -245,7 +245,7 @@ TEST(LinearCircleCli, HtmlReportHasPolarPlotsIsoTableAndRankedDiagnostics) {
     if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
     // Three plots of two passes, before and after (CW drawn wide underneath, CCW narrow on top: where they coincide, as
     // here without hysteresis, only the CW's edges show).
-    for (const char* colour : {report::kCwBefore, report::kCcwBefore, report::kCwAfter, report::kCcwAfter})
+    for (const char* colour : {app::report::kCwBefore, app::report::kCcwBefore, app::report::kCwAfter, app::report::kCcwAfter})
         EXPECT_GT(test::countColour(*pic, colour), 500) << colour;
 }
 

@@ -6,10 +6,15 @@
 
 #include <fmt/format.h>
 
+#include "app/identify.hpp"
 #include "cnccomp/identification/dbb5_location_errors.hpp"
 #include "cnccomp/identification/staged_fit.hpp"
 #include "cnccomp/io/json.hpp"
+#include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/report_json.hpp"
+#include "cnccomp/io/trace_csv.hpp"
+#include "cnccomp/kinematics.hpp"
 #include "test_dbb5_support.hpp"
 #include "test_support.hpp"
 
@@ -90,19 +95,20 @@ TEST(LsqStagedFit, RunsThatSeeNoneOfTheUnknownsLeaveThemUnidentified) {
     EXPECT_EQ(r.report.termination, "the measurements see none of the unknowns");
 }
 
-// A plan without runs of the linear axes alone (the main job's six ball-bar circles) is fitted once, as before.
+// A plan without runs of the linear axes alone (the main job's six ball-bar circles) is fitted once, as before: through
+// the identification façade `cnccomp identify` runs (src/app/identify.hpp), on the simulated runs written as files.
 TEST(LsqStagedFit, PlanWithoutLinearCirclesIsOneFit) {
     const test::ScratchDir dir("staged-one-fit");
-    const std::string m = test::sourcePath("samples/machines/multitasking.xml");
-    const std::string p = test::sourcePath("samples/plans/multitasking-six-circles.xml");
-    ASSERT_EQ(test::runCli(fmt::format("simulate --machine {} --plan {} --deviations {} --out {}", m, p,
-                                       test::sourcePath("samples/deviations/multitasking-truth.csv"), dir.file("t")))
-                  .exitCode,
-              0);
-    const auto r = test::runCli(fmt::format("identify --machine {} --plan {} --traces {} --out {}", m, p, dir.file("t"),
-                                            dir.file("d.csv")));
-    ASSERT_EQ(r.exitCode, 0) << r.out;
-    EXPECT_EQ(r.out.find("two stages"), std::string::npos) << r.out;
+    const MachineModel& m = test::multitasking();
+    const MeasurementPlan plan = readPlanXml(test::sourcePath("samples/plans/multitasking-six-circles.xml"));
+    const Kinematics k(m, readDeviationCsv(test::sourcePath("samples/deviations/multitasking-truth.csv"), m));
+    for (const BallbarRun& r : plan.runs) writeTraceCsv(dir.file(r.name + ".csv"), simulateRun(k, r), r, m.name);
+    app::IdentificationOptions o;
+    o.traces = dir.path.string();
+    const app::IdentificationSummary s = app::identify(m, &plan, o);
+    ASSERT_TRUE(s.report);
+    EXPECT_EQ(s.report->stages, "");
+    EXPECT_EQ(s.fullReport().find("two stages"), std::string::npos) << s.fullReport();
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/measured_observations.hpp"
+#include "cnccomp/io/plan_measurements_io.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/trace_csv.hpp"
@@ -425,7 +426,8 @@ TEST(MeasuredImport, MeasuredObservationsWrapRelativeRuns) {
     plan.runs[1].capture.relativeLength = true;
     for (const BallbarRun& r : plan.runs)
         writeTraceCsv(dir.file(r.name + ".csv"), simulate(r, 0, 359, 1), r, machine().name);
-    const MeasuredRuns mr = measuredObservations(machine(), plan, dir.path.string());
+    const MeasuredRuns mr = measuredObservations(
+        machine(), plan, loadPlanMeasurements(machine(), plan, dir.path.string(), MeasurementKinds::observed()));
     ASSERT_EQ(mr.observations.size(), 2u);
     ASSERT_EQ(mr.ballbar.size(), 2u);
     EXPECT_EQ(mr.observations[0]->nuisanceCount(), 0);

@@ -35,12 +35,12 @@ const std::string kTruth = test::sourcePath("samples/deviations/multitasking-tru
 
 // ---- a run built by hand, for the plot tests ---------------------------------------------------------------------
 
-report::RunSection sampleRun() {
-    report::RunSection r;
+app::report::RunSection sampleRun() {
+    app::report::RunSection r;
     r.name = "C-X";
     r.test = "C-X";
     r.LB = 100;
-    report::PolarPass ccw, cw;
+    app::report::PolarPass ccw, cw;
     ccw.direction = +1;
     cw.direction = -1;
     for (int k = 0; k < 360; ++k) {
@@ -58,37 +58,37 @@ report::RunSection sampleRun() {
 }
 
 TEST(ReportPolarPlot, TracesSitWhereTheScaleSaysInABrowserScreenshot) {
-    const report::RunSection run = sampleRun();
-    const report::PolarScale sc = report::polarScale(run);
+    const app::report::RunSection run = sampleRun();
+    const app::report::PolarScale sc = app::report::polarScale(run);
     EXPECT_EQ(sc.ringUm, 5.0);  // 11 µm full scale → 5 µm rings (3 of them)
     EXPECT_EQ(sc.rings, 3);
-    const std::string svg = report::renderPolarPlot(run, "p");
+    const std::string svg = app::report::renderPolarPlot(run, "p");
     EXPECT_EQ(svg.rfind("<svg", 0), 0u);
-    for (const char* c : {report::kCcwBefore, report::kCwBefore, report::kCcwAfter, report::kCwAfter})
+    for (const char* c : {app::report::kCcwBefore, app::report::kCwBefore, app::report::kCcwAfter, app::report::kCwAfter})
         EXPECT_NE(svg.find(c), std::string::npos) << c;
     EXPECT_NE(svg.find("5 µm per ring"), std::string::npos);
     if (!chromium()) GTEST_SKIP() << "Chromium is not installed (Debian package chromium, tools/deps.sh): the browser check is skipped";
     test::ScratchDir dir("polar-browser");
     test::writeText(dir.file("p.svg"), svg);
-    const std::string log = screenshot(dir.file("p.svg"), dir.file("p.png"), static_cast<int>(report::kPolarWidth),
-                                       static_cast<int>(report::kPolarHeight), dir);
+    const std::string log = screenshot(dir.file("p.svg"), dir.file("p.png"), static_cast<int>(app::report::kPolarWidth),
+                                       static_cast<int>(app::report::kPolarHeight), dir);
     EXPECT_EQ(log.find("CONSOLE"), std::string::npos) << log;
     std::string why;
     const auto pic = readPng(dir.file("p.png"), why);
     if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
     // At 0°: CCW before at +8 µm, CW before at +11 µm, both outside the nominal circle on the right; at 90° the CCW
     // trace is 8 µm inside. The after traces stay within 1.5 µm of the nominal circle.
-    const auto at = [&](double deg, double dl) { return report::polarPixel(sc, deg, dl); };
+    const auto at = [&](double deg, double dl) { return app::report::polarPixel(sc, deg, dl); };
     for (const auto& [deg, dl, colour] : std::vector<std::tuple<double, double, const char*>>{
-             {0, 8 * kUm, report::kCcwBefore}, {90, -8 * kUm, report::kCcwBefore}, {45, 0, report::kCcwBefore},
-             {0, 11 * kUm, report::kCwBefore}, {90, -5 * kUm, report::kCwBefore}, {180, 11 * kUm, report::kCwBefore},
-             {30, 0.5 * kUm, report::kCcwAfter}, {210, -0.5 * kUm + 1.0 * kUm, report::kCwAfter}}) {
-        const report::PolarPixel p = at(deg, dl);
+             {0, 8 * kUm, app::report::kCcwBefore}, {90, -8 * kUm, app::report::kCcwBefore}, {45, 0, app::report::kCcwBefore},
+             {0, 11 * kUm, app::report::kCwBefore}, {90, -5 * kUm, app::report::kCwBefore}, {180, 11 * kUm, app::report::kCwBefore},
+             {30, 0.5 * kUm, app::report::kCcwAfter}, {210, -0.5 * kUm + 1.0 * kUm, app::report::kCwAfter}}) {
+        const app::report::PolarPixel p = at(deg, dl);
         EXPECT_TRUE(colourNear(*pic, p.x, p.y, colour)) << colour << " expected near " << deg << " deg, " << dl / kUm << " um";
     }
     // And not where nothing was drawn: the CCW trace is not on the nominal circle at 0°.
-    const report::PolarPixel off = at(0, -8 * kUm);
-    EXPECT_FALSE(colourNear(*pic, off.x, off.y, report::kCcwBefore, 2));
+    const app::report::PolarPixel off = at(0, -8 * kUm);
+    EXPECT_FALSE(colourNear(*pic, off.x, off.y, app::report::kCcwBefore, 2));
 }
 
 TEST(ReportMapSvg, ScaleFromZeroSharedClippedArrowsMicrometresAndZeroMessage) {
@@ -112,7 +112,7 @@ TEST(ReportMapSvg, ScaleFromZeroSharedClippedArrowsMicrometresAndZeroMessage) {
     EXPECT_NE(svg.find("marker-end=\"url(#m1-head)\""), std::string::npos);
     // The colour bar starts at 0 and reaches the shared maximum.
     EXPECT_NE(svg.find(">0</text>"), std::string::npos);
-    const double top = report::niceNumber(3 * own / 5) * std::ceil(3 * own / report::niceNumber(3 * own / 5) - 1e-9);
+    const double top = app::report::niceNumber(3 * own / 5) * std::ceil(3 * own / app::report::niceNumber(3 * own / 5) - 1e-9);
     EXPECT_NE(svg.find(fmt::format(">{:g}</text>", top)), std::string::npos) << top;
     // The cells use only the lower part of the scale: no yellow (the top colour) in any cell.
     EXPECT_NE(svg.find("#fde725"), std::string::npos);  // in the colour bar
@@ -189,15 +189,15 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
     if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
     // The polar plots are on the page: the before traces (blue) in quantity, and each plot's blue pixels form a ring
     // (the bounding box of the first plot's trace is about as wide as it is high, with no blue at its centre).
-    EXPECT_GT(countColour(*pic, report::kCcwBefore), 3000);
-    EXPECT_GT(countColour(*pic, report::kCcwAfter), 3000);
+    EXPECT_GT(countColour(*pic, app::report::kCcwBefore), 3000);
+    EXPECT_GT(countColour(*pic, app::report::kCcwAfter), 3000);
     // The first plot's CCW trace: the connected set of its pixels (3 px neighbourhood: the after trace is drawn over
     // it where they cross) from the topmost one in the first column of plots.
-    const int column = static_cast<int>(report::kPolarWidth) + 40;
+    const int column = static_cast<int>(app::report::kPolarWidth) + 40;
     int sx = -1, sy = -1;
     for (int y = 0; y < pic->h && sy < 0; ++y)
         for (int x = 0; x < column; ++x)
-            if (near(pic->at(x, y), rgb(report::kCcwBefore), 24)) {
+            if (near(pic->at(x, y), rgb(app::report::kCcwBefore), 24)) {
                 sx = x, sy = y;
                 break;
             }
@@ -215,7 +215,7 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
                 const int xx = x + dx, yy = y + dy;
                 if (xx < 0 || yy < 0 || xx >= pic->w || yy >= pic->h) continue;
                 char& v = seen[static_cast<size_t>(yy) * pic->w + xx];
-                if (v || !near(pic->at(xx, yy), rgb(report::kCcwBefore), 60)) continue;
+                if (v || !near(pic->at(xx, yy), rgb(app::report::kCcwBefore), 60)) continue;
                 v = 1;
                 todo.emplace_back(xx, yy);
             }
@@ -223,20 +223,20 @@ TEST(ReportHtml, IdentifyWritesASelfContainedPageThatChromiumShows) {
     ASSERT_GT(x1, x0);
     const double wBox = x1 - x0, hBox = y1 - y0;
     EXPECT_NEAR(wBox / hBox, 1.0, 0.15) << x0 << " " << x1 << " " << y0 << " " << y1;
-    EXPECT_GT(wBox, 2 * (report::kPolarNominalPx - report::kPolarBandPx));  // within the scale rings
-    EXPECT_LT(wBox, 2 * (report::kPolarNominalPx + report::kPolarBandPx));
-    EXPECT_FALSE(colourNear(*pic, (x0 + x1) / 2.0, (y0 + y1) / 2.0, report::kCcwBefore, 20));
+    EXPECT_GT(wBox, 2 * (app::report::kPolarNominalPx - app::report::kPolarBandPx));  // within the scale rings
+    EXPECT_LT(wBox, 2 * (app::report::kPolarNominalPx + app::report::kPolarBandPx));
+    EXPECT_FALSE(colourNear(*pic, (x0 + x1) / 2.0, (y0 + y1) / 2.0, app::report::kCcwBefore, 20));
 }
 
 TEST(ReportHtml, NamesAreEscapedAndRunNamesMustBeFileNames) {
-    report::ReportData d;
+    app::report::ReportData d;
     d.title = "Machine <A&B> \"test\"";
     d.machine = "A&B";
     d.deviations.push_back({"EB0B", "bXB", "arcsec", true, 1, 0, 2});
     d.deviations.push_back({"EC0Y", "gXY", "arcsec", false});
     d.warnings.push_back("x < y & z");
-    const report::ReportFiles f = report::reportFiles("o/r.html", d);
-    const std::string html = report::formatHtmlReport(d, f, {});
+    const app::report::ReportFiles f = app::report::reportFiles("o/r.html", d);
+    const std::string html = app::report::formatHtmlReport(d, f, {});
     EXPECT_NE(html.find("<title>Machine &lt;A&amp;B&gt; &quot;test&quot;</title>"), std::string::npos);
     EXPECT_NE(html.find("x &lt; y &amp; z"), std::string::npos);
     EXPECT_EQ(html.substr(0, html.find("<script")).find("<A&B>"), std::string::npos);
@@ -244,13 +244,13 @@ TEST(ReportHtml, NamesAreEscapedAndRunNamesMustBeFileNames) {
               std::string::npos);
     // The JSON summary inside the page cannot end the script element early.
     d.title = "</script><b>";
-    const std::string json = report::formatReportSummaryJson(d, f);
+    const std::string json = app::report::formatReportSummaryJson(d, f);
     EXPECT_EQ(json.find("</script>"), std::string::npos);
     EXPECT_EQ(parseJson(json)["title"].string, "</script><b>");
-    report::RunSection bad;
+    app::report::RunSection bad;
     bad.name = "../x";
     d.runs.push_back(bad);
-    EXPECT_THROW(report::reportFiles("o/r.html", d), InputError);
+    EXPECT_THROW(app::report::reportFiles("o/r.html", d), InputError);
 }
 
 }  // namespace

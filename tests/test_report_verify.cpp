@@ -153,12 +153,12 @@ TEST(VerifyReport, NumbersOfThePageAreThoseOfTheSamplesAndTheFiles) {
 }
 
 /// A polar plot's run rebuilt from the raw samples of verify.json, for its scale.
-report::RunSection runFromJson(const Json& raw) {
-    report::RunSection r;
+app::report::RunSection runFromJson(const Json& raw) {
+    app::report::RunSection r;
     r.name = raw["name"].string;
     r.LB = raw["LB_mm"].num();
     for (const Json& p : raw["passes"].array) {
-        report::PolarPass pp;
+        app::report::PolarPass pp;
         pp.direction = p["direction"].string == "CCW" ? +1 : -1;
         for (const Json& a : p["angle_deg"].array) pp.angleDeg.push_back(a.num());
         for (const Json& x : p["dL_before_um"].array) pp.before.push_back(x.num() * kUm);
@@ -181,35 +181,35 @@ TEST(VerifyReport, ChromiumShowsThePageAndTheTracesBeforeAndAfterWhereTheScalePu
     std::string why;
     const auto page = test::readPng(dir.file("page.png"), why);
     if (!page) GTEST_SKIP() << "cannot read the screenshot: " << why;
-    EXPECT_GT(test::countColour(*page, report::kCcwBefore), 2000);
-    EXPECT_GT(test::countColour(*page, report::kCcwAfter), 2000);
+    EXPECT_GT(test::countColour(*page, app::report::kCcwBefore), 2000);
+    EXPECT_GT(test::countColour(*page, app::report::kCcwAfter), 2000);
     // The C-radial plot on its own: before (CW wide underneath, CCW on top) and after at the pixels the scale gives
     // for the samples' ΔL, every 30°.
     const Json* raw = nullptr;
     for (const Json& run : v["runs"].array)
         if (run["name"].string == "C-radial") raw = &run;
     ASSERT_NE(raw, nullptr);
-    const report::RunSection run = runFromJson(*raw);
-    const report::PolarScale sc = report::polarScale(run);
-    test::screenshot(base + "report-polar-C-radial.svg", dir.file("polar.png"), static_cast<int>(report::kPolarWidth),
-                     static_cast<int>(report::kPolarHeight), dir);
+    const app::report::RunSection run = runFromJson(*raw);
+    const app::report::PolarScale sc = app::report::polarScale(run);
+    test::screenshot(base + "report-polar-C-radial.svg", dir.file("polar.png"), static_cast<int>(app::report::kPolarWidth),
+                     static_cast<int>(app::report::kPolarHeight), dir);
     const auto pic = test::readPng(dir.file("polar.png"), why);
     if (!pic) GTEST_SKIP() << "cannot read the screenshot: " << why;
     int checked = 0;
-    for (const report::PolarPass& p : run.passes) {
+    for (const app::report::PolarPass& p : run.passes) {
         if (p.direction < 0) continue;  // the CCW pass is on top; the CW pass is the same here (checked above: H = 0)
         for (size_t i = 0; i < p.angleDeg.size(); i += 30) {
-            const report::PolarPixel b = report::polarPixel(sc, p.angleDeg[i], p.before[i]);
-            const report::PolarPixel a = report::polarPixel(sc, p.angleDeg[i], p.after[i]);
+            const app::report::PolarPixel b = app::report::polarPixel(sc, p.angleDeg[i], p.before[i]);
+            const app::report::PolarPixel a = app::report::polarPixel(sc, p.angleDeg[i], p.after[i]);
             // CCW after is drawn last, on top of everything.
-            EXPECT_TRUE(test::colourNear(*pic, a.x, a.y, report::kCcwAfter, 2)) << "CCW after at " << p.angleDeg[i] << " deg";
+            EXPECT_TRUE(test::colourNear(*pic, a.x, a.y, app::report::kCcwAfter, 2)) << "CCW after at " << p.angleDeg[i] << " deg";
             if (std::hypot(a.x - b.x, a.y - b.y) < 15) continue;  // where they meet, after covers before
-            EXPECT_TRUE(test::colourNear(*pic, b.x, b.y, report::kCcwBefore, 2)) << "CCW before at " << p.angleDeg[i] << " deg";
-            EXPECT_TRUE(test::colourNear(*pic, b.x, b.y, report::kCwBefore, 4)) << "CW before at " << p.angleDeg[i] << " deg";
-            EXPECT_TRUE(test::colourNear(*pic, a.x, a.y, report::kCwAfter, 4)) << "CW after at " << p.angleDeg[i] << " deg";
+            EXPECT_TRUE(test::colourNear(*pic, b.x, b.y, app::report::kCcwBefore, 2)) << "CCW before at " << p.angleDeg[i] << " deg";
+            EXPECT_TRUE(test::colourNear(*pic, b.x, b.y, app::report::kCwBefore, 4)) << "CW before at " << p.angleDeg[i] << " deg";
+            EXPECT_TRUE(test::colourNear(*pic, a.x, a.y, app::report::kCwAfter, 4)) << "CW after at " << p.angleDeg[i] << " deg";
             // Where before and after are far apart, neither colour sits at the other's place.
-            EXPECT_FALSE(test::colourNear(*pic, b.x, b.y, report::kCcwAfter, 2)) << p.angleDeg[i];
-            EXPECT_FALSE(test::colourNear(*pic, a.x, a.y, report::kCcwBefore, 2)) << p.angleDeg[i];
+            EXPECT_FALSE(test::colourNear(*pic, b.x, b.y, app::report::kCcwAfter, 2)) << p.angleDeg[i];
+            EXPECT_FALSE(test::colourNear(*pic, a.x, a.y, app::report::kCcwBefore, 2)) << p.angleDeg[i];
             ++checked;
         }
     }

@@ -47,18 +47,18 @@ TEST(Verify, ReadingsBeforeCompensationAreTheSimulationsForEveryPlanKind) {
         const MachineModel m = readMachineXml(src(std::string("samples/machines/") + s.machine + ".xml"));
         const MeasurementPlan plan = readPlanXml(src(std::string("samples/plans/") + s.plan));
         const DeviationSet truth = readDeviationCsv(src(std::string("samples/deviations/") + s.truth), m);
-        VerifyCompensation comp;
-        comp.kind = VerifyCompensation::Kind::Deviations;
-        comp.model = idealCompensation(m, truth);
-        VerifyOptions o;
+        app::VerifyCompensation comp;
+        comp.kind = app::VerifyCompensation::Kind::Deviations;
+        comp.model = app::idealCompensation(m, truth);
+        app::VerifyOptions o;
         o.volumetricPerAxis = 2;
-        const VerifyResult r = verify(m, plan, truth, "truth", comp, o);
+        const app::VerifyResult r = app::verify(m, plan, truth, "truth", comp, o);
         ASSERT_EQ(r.runs.size(), plan.runCount()) << s.plan;
         const Kinematics k(m, truth);
         size_t i = 0;
         const auto compare = [&](const BallbarTrace& want) {
-            const VerifyRun& run = r.runs[i++];
-            for (const VerifyPass& p : run.passes) {
+            const app::VerifyRun& run = r.runs[i++];
+            for (const app::VerifyPass& p : run.passes) {
                 ASSERT_EQ(p.before.dL.size(), want.dL.size()) << s.plan << " " << run.name;
                 for (size_t j = 0; j < want.dL.size(); ++j) {
                     // The pass may run backwards: find the sample by its angle.
@@ -76,8 +76,8 @@ TEST(Verify, ReadingsBeforeCompensationAreTheSimulationsForEveryPlanKind) {
         for (const Dbb5Run& d : plan.dbb5Runs) compare(simulateDbb5(k, d));
         for (const RtestRun& t : plan.rtestRuns) {
             const RtestTrace want = simulateRtest(k, t);
-            const VerifyRun& run = r.runs[i++];
-            for (const VerifyPass& p : run.passes)
+            const app::VerifyRun& run = r.runs[i++];
+            for (const app::VerifyPass& p : run.passes)
                 for (size_t j = 0; j < p.displacementBefore.size(); ++j)
                     EXPECT_LT((p.displacementBefore[j] - want.d[static_cast<size_t>(p.before.angleDeg[j])]).norm(), 2e-6)
                         << s.plan << " " << run.name;
@@ -328,12 +328,12 @@ TEST(Verify, NotCompensatedListReadFromAnyCommentSyntax) {
         {"a.txt", "nothing here\n"},
         {"b.PRM", "%\n(NOT compensated:)\n(  EA0B   tilt [no parameter])\n(  EBB [constant part]  at the reference)\n(units)\n%\n"},
     };
-    const auto list = readNotCompensated(files);
+    const auto list = app::readNotCompensated(files);
     ASSERT_EQ(list.size(), 2u);
     EXPECT_EQ(list[0].deviation, "EA0B");
     EXPECT_EQ(list[0].note, "tilt [no parameter]");
     EXPECT_EQ(list[1].deviation, "EBB [constant part]");
-    EXPECT_TRUE(readNotCompensated({{"c.ini", "# NOT compensated:\n#   (none)\n"}}).empty());
+    EXPECT_TRUE(app::readNotCompensated({{"c.ini", "# NOT compensated:\n#   (none)\n"}}).empty());
 }
 
 TEST(Verify, EmitWarnsWhenItsFilesLeaveMoreThanNoCompensation) {
@@ -396,10 +396,10 @@ TEST(Verify, TheDeviationsLeftCarryTheirIsoValueAndAliasValueAsTheDeviationFileW
 
 TEST(Verify, TheWorseGateAllowsATenthOfAMicronOrOnePercent) {
     // The allowance on its own (verify.hpp VerifyWorse): max(0.1 µm, 1 % of before), on the span and the tool-tip error.
-    VerifyResult r;
+    app::VerifyResult r;
     const auto worse = [&](double beforeUm, double afterUm) {
         r.residualBefore = beforeUm * kUm, r.residual = afterUm * kUm;
-        return compensationWorse(r).span;
+        return app::compensationWorse(r).span;
     };
     EXPECT_FALSE(worse(0.001, 0.001));  // noise level: equal
     EXPECT_FALSE(worse(0.001, 0.1));    // within the 0.1 µm floor
@@ -410,11 +410,11 @@ TEST(Verify, TheWorseGateAllowsATenthOfAMicronOrOnePercent) {
     r.residualBefore = r.residual = 0;
     r.volumetric.available = true;
     r.volumetric.maxBefore = 50 * kUm, r.volumetric.maxAfter = 50.4 * kUm;
-    EXPECT_FALSE(compensationWorse(r).any());
+    EXPECT_FALSE(app::compensationWorse(r).any());
     r.volumetric.maxAfter = 51 * kUm;
-    EXPECT_TRUE(compensationWorse(r).volumetric);
+    EXPECT_TRUE(app::compensationWorse(r).volumetric);
     r.volumetric.available = false;  // corrected programs: no volumetric figure, no volumetric verdict
-    EXPECT_FALSE(compensationWorse(r).any());
+    EXPECT_FALSE(app::compensationWorse(r).any());
 }
 
 TEST(Verify, ACompensationThatMakesTheMachineWorseFailsWhateverTheGate) {
@@ -435,7 +435,7 @@ TEST(Verify, ACompensationThatMakesTheMachineWorseFailsWhateverTheGate) {
     ASSERT_EQ(r.exitCode, 0) << r.out;
     std::string copied = "# cnccomp-deviations/2: location errors under ISO 230-1 names are ISO values (iso_names.hpp)\nname,alias,value,unit\n", flipped = "# cnccomp-deviations/2: location errors under ISO 230-1 names are ISO values (iso_names.hpp)\nname,alias,value,unit\n";
     std::vector<std::string> held;
-    for (const controllers::Coverage& c : readCompensated(readFolder(dir.file("l")))) held.push_back(c.deviation);
+    for (const controllers::Coverage& c : app::readCompensated(app::readFolder(dir.file("l")))) held.push_back(c.deviation);
     ASSERT_FALSE(held.empty());
     for (const auto& [name, row] : rows) {
         if (std::find(held.begin(), held.end(), name) != held.end()) copied += fmt::format("{},,{},{}\n", name, row.value, row.unit);

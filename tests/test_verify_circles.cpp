@@ -22,6 +22,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace app;  // verification (src/app)
 namespace {
 
 std::string src(const std::string& rel) { return test::sourcePath(rel); }
@@ -50,17 +51,17 @@ TEST(VerifyCircles, TheIdealCompensationOfTheSquarenessLeavesTheCirclesOfTheMach
         squareness.set(n, truth.get(n));
         rest.set(n, 0.0);
     }
-    VerifyCompensation comp;
-    comp.kind = VerifyCompensation::Kind::Deviations;
-    comp.model = idealCompensation(m, squareness);
+    app::VerifyCompensation comp;
+    comp.kind = app::VerifyCompensation::Kind::Deviations;
+    comp.model = app::idealCompensation(m, squareness);
     comp.description = "squareness";
-    VerifyOptions o;
+    app::VerifyOptions o;
     o.volumetricPerAxis = 2;
-    const VerifyResult r = verify(m, plan, truth, "truth", comp, o);
+    const app::VerifyResult r = app::verify(m, plan, truth, "truth", comp, o);
     ASSERT_EQ(r.runs.size(), plan.circleRuns.size());
     const Kinematics kTruth(m, truth), kRest(m, rest);
     for (size_t i = 0; i < r.runs.size(); ++i) {
-        const VerifyRun& run = r.runs[i];
+        const app::VerifyRun& run = r.runs[i];
         const LinearCircleRun& c = plan.circleRuns[i];
         EXPECT_EQ(run.type, fmt::format("{} circle (ISO 230-4)", linearPlaneName(c.plane)));
         EXPECT_EQ(run.LB, c.radius);
@@ -69,7 +70,7 @@ TEST(VerifyCircles, TheIdealCompensationOfTheSquarenessLeavesTheCirclesOfTheMach
         const double wantBefore = *std::max_element(gBefore.begin(), gBefore.end());
         const double wantAfter = *std::max_element(gAfter.begin(), gAfter.end());
         double before = 0, after = 0;
-        for (const VerifyPass& p : run.passes) {
+        for (const app::VerifyPass& p : run.passes) {
             ASSERT_TRUE(p.circular) << run.name;
             before = std::max(before, p.isoBefore.circularity);
             after = std::max(after, p.isoAfter.circularity);
@@ -82,9 +83,9 @@ TEST(VerifyCircles, TheIdealCompensationOfTheSquarenessLeavesTheCirclesOfTheMach
     EXPECT_LT(r.volumetric.maxAfter, r.volumetric.maxBefore);
     // The programs of the other dialects (G2/G3 of Fanuc and Sinumerik, Klartext CC / C) read back to the same circles.
     for (const auto d : {testprog::ProgramDialect::Fanuc, testprog::ProgramDialect::Sinumerik, testprog::ProgramDialect::Heidenhain}) {
-        VerifyOptions od = o;
+        app::VerifyOptions od = o;
         od.dialect = d;
-        const VerifyResult rd = verify(m, plan, truth, "truth", comp, od);
+        const app::VerifyResult rd = app::verify(m, plan, truth, "truth", comp, od);
         EXPECT_NEAR(rd.residualBefore, r.residualBefore, 1e-6) << static_cast<int>(d);
         EXPECT_NEAR(rd.residual, r.residual, 1e-6) << static_cast<int>(d);
     }
@@ -121,17 +122,17 @@ TEST(VerifyCircles, TheKneeMillsCirclesCloseWithItsIdentifiedSquareness) {
     const MachineModel m = readMachineXml(src("samples/machines/mill-3axis-table-xy.xml"));
     const MeasurementPlan plan = readPlanXml(src("samples/plans/mill-3axis-table-xy-circles.xml"));
     const DeviationSet truth = readDeviationCsv(src("samples/deviations/mill-3axis-table-xy-truth.csv"), m);
-    VerifyCompensation comp;
-    comp.kind = VerifyCompensation::Kind::Deviations;
-    comp.model = idealCompensation(m, truth);
+    app::VerifyCompensation comp;
+    comp.kind = app::VerifyCompensation::Kind::Deviations;
+    comp.model = app::idealCompensation(m, truth);
     comp.description = "truth";
-    VerifyOptions o;
+    app::VerifyOptions o;
     o.volumetricPerAxis = 2;
-    const VerifyResult r = verify(m, plan, truth, "truth", comp, o);
+    const app::VerifyResult r = app::verify(m, plan, truth, "truth", comp, o);
     EXPECT_GT(r.residualBefore, 1.0 * kUm);
     EXPECT_LT(r.residual, 0.01 * kUm);
-    for (const VerifyRun& run : r.runs)
-        for (const VerifyPass& p : run.passes) EXPECT_LT(p.isoAfter.circularity, 0.01 * kUm) << run.name << " " << p.label;
+    for (const app::VerifyRun& run : r.runs)
+        for (const app::VerifyPass& p : run.passes) EXPECT_LT(p.isoAfter.circularity, 0.01 * kUm) << run.name << " " << p.label;
 }
 
 // Lost motion (the truth's reversal values B<axis>) and LinuxCNC's backlash compensation. Oracle for "before": the

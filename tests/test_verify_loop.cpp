@@ -218,8 +218,8 @@ double roundingAllowance(const Loop& l, const controllers::EmitResult& r) {
     return out;
 }
 
-VerifyOptions fastOptions() {
-    VerifyOptions o;
+app::VerifyOptions fastOptions() {
+    app::VerifyOptions o;
     o.volumetricPerAxis = 3;
     return o;
 }
@@ -244,11 +244,11 @@ TEST(VerifyLoop, EmittedFilesLeaveLessThanATenthOfAMicrometreOfWhatEachBackendCl
             // The loop restricted to what the backend claims: truth and identification without the others.
             const DeviationSet truthClaimed = claimed(*l.truth, full), idClaimed = claimed(identified, full);
             const controllers::EmitResult files = b->emit({l.machine, idClaimed, "identified.csv", "2024-01-01"});
-            VerifyCompensation comp;
-            comp.kind = VerifyCompensation::Kind::ControllerFiles;
+            app::VerifyCompensation comp;
+            comp.kind = app::VerifyCompensation::Kind::ControllerFiles;
             comp.description = where;
             comp.model = std::shared_ptr<const controllers::AppliedCompensation>(b->apply(l.machine, files.files));
-            const VerifyResult r = verify(l.machine, l.plan, truthClaimed, "truth", comp, fastOptions());
+            const app::VerifyResult r = app::verify(l.machine, l.plan, truthClaimed, "truth", comp, fastOptions());
             if (full.compensated.empty()) continue;
             const double rounding = roundingAllowance(l, full);
             std::cout << "[ residual ] " << where << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm
@@ -273,13 +273,13 @@ TEST(VerifyLoop, WhatABackendLeavesIsNamedWithItsReason) {
             } catch (const ModelError&) {
                 continue;  // refused: see the loop above
             }
-            VerifyCompensation comp;
-            comp.kind = VerifyCompensation::Kind::ControllerFiles;
+            app::VerifyCompensation comp;
+            comp.kind = app::VerifyCompensation::Kind::ControllerFiles;
             comp.model = std::shared_ptr<const controllers::AppliedCompensation>(b->apply(l.machine, files.files));
             // Read from the files' own headers, as `cnccomp verify` does with a folder.
-            comp.notCompensated = readNotCompensated(files.files);
+            comp.notCompensated = app::readNotCompensated(files.files);
             ASSERT_EQ(comp.notCompensated.size(), files.notCompensated.size()) << where;
-            const VerifyResult r = verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
+            const app::VerifyResult r = app::verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
             ASSERT_EQ(r.remaining.size(), files.notCompensated.size()) << where;
             for (size_t i = 0; i < r.remaining.size(); ++i) {
                 // The header's comment syntax may turn parentheses into brackets (Fanuc).
@@ -316,8 +316,8 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
             testprog::TestProgramOptions to;
             to.dialect = dialect;
             const auto set = testprog::makeTestPrograms(l.machine, l.plan, to);
-            VerifyCompensation comp;
-            comp.kind = VerifyCompensation::Kind::CorrectedPrograms;
+            app::VerifyCompensation comp;
+            comp.kind = app::VerifyCompensation::Kind::CorrectedPrograms;
             comp.description = "corrected programs";
             comp.programDialect = reader;
             uint64_t split = 0;
@@ -333,7 +333,7 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
                 split += s.split;
                 comp.programs.push_back({motions[i].name, {set.programs[i].file, out.str()}});
             }
-            const VerifyResult r = verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
+            const app::VerifyResult r = app::verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
             std::cout << "[ corrected ] " << c.machine << " " << pp::dialectName(reader)
                       << (c.machineZero.empty() ? "" : " (machine-zero)") << (c.correctWithTruth ? " (truth set)" : "")
                       << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm << " um), " << split
@@ -355,10 +355,10 @@ TEST(VerifyLoop, WithHalfAMicrometreOfNoiseTheResidualStaysBelowThreeSigma) {
         // (the instrument samples continuously); at the plan's 15° the 102 samples leave 1.8 µm.
         for (BallbarRun& r : l.plan.absoluteRuns) r.stepDeg = 1;
         const DeviationSet identified = simulateAndIdentify(l, sigma, 11);
-        VerifyCompensation comp;
-        comp.kind = VerifyCompensation::Kind::Deviations;
-        comp.model = idealCompensation(l.machine, identified);
-        const VerifyResult r = verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
+        app::VerifyCompensation comp;
+        comp.kind = app::VerifyCompensation::Kind::Deviations;
+        comp.model = app::idealCompensation(l.machine, identified);
+        const app::VerifyResult r = app::verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
         EXPECT_LT(r.residual, 3 * sigma * kUm) << c.machine << ": before " << r.residualBefore / kUm << " um";
         std::cout << "[ noise 0.5 um ] " << c.machine << ": residual " << r.residual / kUm << " um (before "
                   << r.residualBefore / kUm << " um)\n";

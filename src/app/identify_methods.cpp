@@ -1,7 +1,7 @@
-#include "app/identify_methods.hpp"
-
-#include "app/identify_circle.hpp"
-
+// The rotary-axis and ball-bar identification methods of the registry (identify_registry.hpp), one per kind of plan
+// (identification/plan_method.hpp): each runs either the least-squares solution on the exact model or the paper's
+// formulas on the plan's captures read once, writes its tables into the summary and returns the deviation set (and
+// the report of a least-squares solution). Nothing is printed or written here.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -22,7 +22,6 @@
 #include "cnccomp/identification/rtest_axis_tables.hpp"
 #include "cnccomp/identification/rtest_location_fits.hpp"
 #include "cnccomp/identification/sphere_probe.hpp"
-#include "cnccomp/io/probe_log.hpp"
 #include "cnccomp/identification/dbb5_component_errors.hpp"
 #include "cnccomp/identification/dbb5_cone_frustum.hpp"
 #include "cnccomp/identification/dbb5_location_errors.hpp"
@@ -30,52 +29,25 @@
 #include "cnccomp/identification/tilting_head_errors.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/eccentricity_csv.hpp"
-#include "cnccomp/io/rtest_csv.hpp"
 #include "cnccomp/io/text_util.hpp"
-#include "cnccomp/io/trace_csv.hpp"
+#include "app/identify_registry.hpp"
 
-namespace cnccomp::cli {
+namespace cnccomp::app {
 namespace {
 
-std::string cell(double v, double scale, int width = 10, int prec = 4) {
-    return std::isfinite(v) ? fmt::format("{:{}.{}f}", v / scale, width, prec) : fmt::format("{:>{}}", "-", width);
-}
-
-/// "dxBT=-20:10, EB0B=-5:5" (µm for lengths, arcsec for angles) → bounds in internal units.
-std::vector<ParameterBound> parseBounds(const MachineModel& m, const std::string& text) {
-    std::vector<ParameterBound> out;
-    size_t pos = 0;
-    while (pos < text.size()) {
-        size_t end = text.find(',', pos);
-        if (end == std::string::npos) end = text.size();
-        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
-        pos = end + 1;
-        if (item.empty()) continue;
-        const size_t eq = item.find('='), colon = item.find(':', eq == std::string::npos ? 0 : eq);
-        if (eq == std::string::npos || colon == std::string::npos)
-            throw ModelError(fmt::format("--bounds item '{}': expected NAME=LOWER:UPPER (um or arcsec)", item));
-        const std::string name(trim(std::string_view(item).substr(0, eq)));
-        const auto lo = parseNumber(trim(std::string_view(item).substr(eq + 1, colon - eq - 1)));
-        const auto hi = parseNumber(trim(std::string_view(item).substr(colon + 1)));
-        if (!lo || !hi) throw ModelError(fmt::format("--bounds item '{}': bounds must be numbers", item));
-        std::string base = name.substr(0, name.find('['));
-        const int di = m.deviationIndex(base);
-        // Nuisance names ("run.xT") are lengths; deviations take their own unit.
-        const double unit = di >= 0 && m.deviations[di].isAngle() ? kArcsec : kUm;
-        if (di < 0 && name.find('.') == std::string::npos)
-            throw ModelError(fmt::format("--bounds: unknown deviation '{}' for machine '{}'", name, m.name));
-        out.push_back({name, *lo * unit, *hi * unit});
-    }
+/// The ball-bar traces of the plan's <run> elements, as read once.
+std::vector<BallbarTrace> ballbarTraces(const MethodRequest& r) {
+    std::vector<BallbarTrace> out;
+    for (const MeasuredTrace& t : r.data->ballbar) out.push_back(t.trace);
     return out;
 }
 
-std::vector<BallbarTrace> readTraces(const std::string& dir, const std::vector<Dbb5Run>& runs) {
-    std::vector<BallbarTrace> traces;
-    for (const Dbb5Run& r : runs) traces.push_back(readTraceCsv((std::filesystem::path(dir) / (r.name + ".csv")).string()));
-    return traces;
+/// --params names deviations of the machine (checked before any file is read; engineOptions parses them again).
+void checkParams(const MethodRequest& r) {
+    if (!r.params.empty()) parseDeviationList(*r.machine, r.params);
 }
 
-void requireTraces(const IdentifyRequest& r) {
+void requireTraces(const MethodRequest& r) {
     if (r.traces.empty()) throw ModelError("give the measured runs with --traces DIR (one <run>.csv per run of the plan)");
     if (!r.eccentricities.empty())
         throw ModelError(fmt::format("--eccentricities is for the ball-bar formulas only; this plan is '{}'",
@@ -83,7 +55,7 @@ void requireTraces(const IdentifyRequest& r) {
 }
 
 /// The outer (tilting) and inner (table) rotary axes of a cradle method.
-std::pair<std::string, std::string> cradleAxes(const IdentifyRequest& r) {
+std::pair<std::string, std::string> cradleAxes(const MethodRequest& r) {
     auto axes = tableRotaryAxes(*r.machine);
     if (!r.outer.empty()) axes.first = r.outer;
     if (!r.inner.empty()) axes.second = r.inner;
@@ -105,8 +77,8 @@ std::vector<int> elevenErrors(const MachineModel& m, const std::string& outer, c
     return out;
 }
 
-/// The solver's settings of a request (no file read): what validateIdentifyOptions checks before any work.
-IdentifyOptions solverOptions(const IdentifyRequest& r) {
+/// The solver's settings of a request (no file read).
+IdentifyOptions solverOptions(const MethodRequest& r) {
     IdentifyOptions io;
     io.solver = r.solver;
     io.maxIterations = r.maxIterations;
@@ -114,11 +86,11 @@ IdentifyOptions solverOptions(const IdentifyRequest& r) {
     io.monteCarlo = r.monteCarlo;
     io.seed = r.seed;
     io.staged = !r.oneStage;
-    io.bounds = parseBounds(*r.machine, r.bounds);
+    io.bounds = r.parsedBounds;
     return io;
 }
 
-IdentifyOptions engineOptions(const IdentifyRequest& r, std::vector<int> defaults) {
+IdentifyOptions engineOptions(const MethodRequest& r, std::vector<int> defaults) {
     const MachineModel& m = *r.machine;
     IdentifyOptions io = solverOptions(r);
     io.deviations = r.params.empty() ? std::move(defaults) : parseDeviationList(m, r.params);
@@ -129,12 +101,12 @@ IdentifyOptions engineOptions(const IdentifyRequest& r, std::vector<int> default
     return io;
 }
 
-void noEngineOptions(const IdentifyRequest& r, const char* why) {
-    if (!r.params.empty() || !r.bounds.empty() || !r.start.empty() || r.monteCarlo > 0 || r.solver != "lm")
+void noEngineOptions(const MethodRequest& r, const char* why) {
+    if (!r.params.empty() || !r.bounds.empty() || !r.start.empty() || r.monteCarlo > 0 || r.solver != SolverChoice{})
         throw ModelError(fmt::format("--params, --bounds, --start, --monte-carlo and --solver do not apply: {}", why));
 }
 
-int refineOr(const IdentifyRequest& r, int fallback) {
+int refineOr(const MethodRequest& r, int fallback) {
     const int n = r.refine < 0 ? fallback : r.refine;
     if (n > 20) throw ModelError("--refine takes 0..20 passes");
     return n;
@@ -142,27 +114,22 @@ int refineOr(const IdentifyRequest& r, int fallback) {
 
 // ---- least squares on every sample of every run (ball-bar, mixed, R-test location, DBB5 plans)
 
-IdentifyOutcome generalLeastSquares(const IdentifyRequest& r, std::vector<int> defaults, const std::string& what) {
-    requireTraces(r);
+IdentificationSummary generalLeastSquares(const MethodRequest& r, std::vector<int> defaults, const std::string& what) {
     const MachineModel& m = *r.machine;
     const MeasurementPlan& plan = *r.plan;
     std::optional<MeasuredRuns> measured;
     Observations obs;
-    if (r.observe == "eccentricity") {
-        if (r.kind != PlanMethod::Ballbar)
-            throw ModelError("--observe eccentricity works on ball-bar <run> elements only");
-        obs = eccentricityObservations(m, plan.runs, readRunTraces(r.traces, plan.runs));
-    } else if (r.observe == "traces") {
-        measured = measuredObservations(m, plan, r.traces);  // ball-bar files imported and checked against their runs
-        obs = std::move(measured->observations);
+    if (r.observe == Observe::Eccentricity) {
+        obs = eccentricityObservations(m, plan.runs, ballbarTraces(r));
     } else {
-        throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", r.observe));
+        measured = measuredObservations(m, plan, *r.data);  // ball-bar files imported and checked against their runs
+        obs = std::move(measured->observations);
     }
     const IdentifyOptions io = engineOptions(r, std::move(defaults));
     IdentificationResult res = identifyStaged(m, obs, io);
     const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
                                           [&](int i) { return res.deviations.present[static_cast<size_t>(i)] != 0; });
-    IdentifyOutcome out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};
+    IdentificationSummary out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};
     if (measured) {
         measured->observations = std::move(obs);
         out.measured = std::move(measured);
@@ -176,20 +143,22 @@ IdentifyOutcome generalLeastSquares(const IdentifyRequest& r, std::vector<int> d
 
 // ---- ball-bar formulas (eccentricities)
 
-IdentifyOutcome ballbarFormulas(const IdentifyRequest& r) {
-    const MachineModel& m = *r.machine;
+void checkBallbarFormulas(const MethodRequest& r) {
     noEngineOptions(r, "the eccentricity formulas have no free unknowns");
-    std::vector<EccentricityRow> rows;
     if (!r.eccentricities.empty()) {
         if (!r.traces.empty()) throw ModelError("give either --eccentricities or --traces with --plan, not both");
-        rows = readEccentricityCsv(r.eccentricities);
-    } else {
-        if (r.traces.empty() || !r.plan)
-            throw ModelError("the ball-bar formulas need --eccentricities E.csv, or --traces DIR with --plan P.xml");
-        rows = eccentricitiesFromTraces(m, r.plan->runs, readRunTraces(r.traces, r.plan->runs));
+    } else if (r.traces.empty() || !r.plan) {
+        throw ModelError("the ball-bar formulas need --eccentricities E.csv, or --traces DIR with --plan P.xml");
     }
+}
+
+IdentificationSummary ballbarFormulas(const MethodRequest& r) {
+    const MachineModel& m = *r.machine;
+    const std::vector<EccentricityRow> rows = !r.eccentricities.empty()
+                                                  ? readEccentricityCsv(r.eccentricities)
+                                                  : eccentricitiesFromTraces(m, r.plan->runs, ballbarTraces(r));
     const int refine = refineOr(r, 3);
-    IdentifyOutcome out{identifyClosedForm(m, rows, {refine, 1.0}), std::nullopt, {}, "", std::nullopt, std::nullopt};
+    IdentificationSummary out{identifyClosedForm(m, rows, {refine, 1.0}), std::nullopt, {}, "", std::nullopt, std::nullopt};
     out.summary = fmt::format("identified {} deviations of '{}' (ball-bar eccentricity formulas (17)-(28), {} refinement "
                               "passes on the exact model)",
                               std::count(out.deviations.present.begin(), out.deviations.present.end(), 1), m.name, refine);
@@ -198,13 +167,16 @@ IdentifyOutcome ballbarFormulas(const IdentifyRequest& r) {
 
 // ---- tilting head from absolute ball-bar patterns
 
-IdentifyOutcome headPatterns(const IdentifyRequest& r) {
+void checkHeadPatterns(const MethodRequest& r) {
     requireTraces(r);
     noEngineOptions(r, "the head-pattern method identifies the head axis' error tables and its orientation");
+}
+
+IdentificationSummary headPatterns(const MethodRequest& r) {
     const MachineModel& m = *r.machine;
-    const std::vector<BallbarTrace> traces = readRunTraces(r.traces, r.plan->absoluteRuns);
+    const std::vector<BallbarTrace>& traces = r.data->absolute;
     const TiltingHeadResult f = tiltingHeadFormulas(r.plan->absoluteRuns, traces);
-    IdentifyOutcome out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
+    IdentificationSummary out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
     std::vector<TiltingHeadAngle> rows;
     if (r.formulas) {
         out.deviations = tiltingHeadDeviations(m, f);
@@ -214,7 +186,7 @@ IdentifyOutcome headPatterns(const IdentifyRequest& r) {
     } else {
         const TiltingHeadLsq ls = tiltingHeadLeastSquares(m, r.plan->absoluteRuns, traces);
         out.deviations = ls.deviations;
-        for (const std::string& w : ls.engine.report.warnings) fmt::print("warning: {}\n", w);
+        for (const std::string& w : ls.engine.report.warnings) r.say("warning: {}\n", w);
         for (const TiltingHeadAngle& a : f.angles) {
             TiltingHeadAngle h;
             h.angleDeg = a.angleDeg;
@@ -231,11 +203,11 @@ IdentifyOutcome headPatterns(const IdentifyRequest& r) {
                                   ls.engine.report.observations, ls.engine.report.rank, ls.engine.report.unknowns,
                                   ls.engine.report.termination);
     }
-    fmt::print("{:>8} {:>10} {:>10} {:>10} {:>12} {:>12}   (errors of {} over its angle, link values)\n", "deg",
-               "dx um", "dy um", "dz um", "ex arcsec", "ey arcsec", f.headAxis);
+    r.say("{:>8} {:>10} {:>10} {:>10} {:>12} {:>12}   (errors of {} over its angle, link values)\n", "deg",
+          "dx um", "dy um", "dz um", "ex arcsec", "ey arcsec", f.headAxis);
     for (const TiltingHeadAngle& h : rows)
-        fmt::print("{:8.2f} {:10.4f} {:10.4f} {:10.4f} {:12.4f} {:12.4f}\n", h.angleDeg, h.dx / kUm, h.dy / kUm,
-                   h.dz / kUm, h.ex / kArcsec, h.ey / kArcsec);
+        r.say("{:8.2f} {:10.4f} {:10.4f} {:10.4f} {:12.4f} {:12.4f}\n", h.angleDeg, h.dx / kUm, h.dy / kUm,
+              h.dz / kUm, h.ex / kArcsec, h.ey / kArcsec);
     const std::string head = f.headAxis;
     out.extras.push_back({"--angles-out", [rows, head](std::ostream& o) {
                               o << head << "_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec\n";
@@ -248,23 +220,28 @@ IdentifyOutcome headPatterns(const IdentifyRequest& r) {
 
 // ---- R-test: location errors and squareness
 
-IdentifyOutcome rtestLocation(const IdentifyRequest& r) {
+void checkRtestLocation(const MethodRequest& r) {
     requireTraces(r);
+    cradleAxes(r);
+    if (r.formulas) noEngineOptions(r, "the R-test fits identify the eleven location and squareness errors");
+    else checkParams(r);
+}
+
+IdentificationSummary rtestLocation(const MethodRequest& r) {
     const MachineModel& m = *r.machine;
     const auto [outer, inner] = cradleAxes(r);
-    const std::vector<RtestTrace> traces = readRtestTraces(r.traces, m, r.plan->rtestRuns);
-    IdentifyOutcome out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
+    const std::vector<RtestTrace>& traces = r.data->rtest;
+    IdentificationSummary out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
     if (r.formulas) {
-        noEngineOptions(r, "the R-test fits identify the eleven location and squareness errors");
         const RtestLocationResult f = rtestLocationFits(m, r.plan->rtestRuns, traces, {outer, inner, refineOr(r, 4)});
         out.deviations = f.deviations;
-        fmt::print("fits: {} circle centre ({:.4f}, {:.4f}, {:.4f}) mm r = {:.4f} mm; {} circle centre ({:.4f}, {:.4f}, "
-                   "{:.4f}) mm r = {:.4f} mm\n",
-                   outer, f.outerCircle.center.x(), f.outerCircle.center.y(), f.outerCircle.center.z(),
-                   f.outerCircle.radius, inner, f.innerCircle.center.x(), f.innerCircle.center.y(),
-                   f.innerCircle.center.z(), f.innerCircle.radius);
-        fmt::print("eq. (2): C_XY = {:.3f} um/m, C_YZ = {:.3f} um/m, C_ZX = {:.3f} um/m ({} tilted ±{:g} deg)\n",
-                   f.cXY * 1e6, f.cYZ * 1e6, f.cZX * 1e6, outer, f.phiDeg);
+        r.say("fits: {} circle centre ({:.4f}, {:.4f}, {:.4f}) mm r = {:.4f} mm; {} circle centre ({:.4f}, {:.4f}, "
+              "{:.4f}) mm r = {:.4f} mm\n",
+              outer, f.outerCircle.center.x(), f.outerCircle.center.y(), f.outerCircle.center.z(),
+              f.outerCircle.radius, inner, f.innerCircle.center.x(), f.innerCircle.center.y(),
+              f.innerCircle.center.z(), f.innerCircle.radius);
+        r.say("eq. (2): C_XY = {:.3f} um/m, C_YZ = {:.3f} um/m, C_ZX = {:.3f} um/m ({} tilted ±{:g} deg)\n",
+              f.cXY * 1e6, f.cYZ * 1e6, f.cZX * 1e6, outer, f.phiDeg);
         out.summary = fmt::format("R-test location fits (circle, line and ellipse fits, eq. (2)), {} refinement steps on "
                                   "the exact model",
                                   f.refine);
@@ -277,8 +254,8 @@ IdentifyOutcome rtestLocation(const IdentifyRequest& r) {
         if (it == runs.end()) throw ModelError(fmt::format("the plan has no R-test run '{}'", r.volumetricRun));
         const size_t i = static_cast<size_t>(it - runs.begin());
         const VolumetricAlongRun v = volumetricErrorAlongRun(m, out.deviations, *it, traces[i]);
-        fmt::print("volumetric error along '{}': measured RMS {:.4f} um, model RMS residual {:.4f} um, max {:.4f} um\n",
-                   r.volumetricRun, v.rmsMeasured / kUm, v.rmsResidual / kUm, v.maxResidual / kUm);
+        r.say("volumetric error along '{}': measured RMS {:.4f} um, model RMS residual {:.4f} um, max {:.4f} um\n",
+              r.volumetricRun, v.rmsMeasured / kUm, v.rmsResidual / kUm, v.maxResidual / kUm);
         out.extras.push_back({"--volumetric-out", [v](std::ostream& o) {
                                   o << "pose,meas_dx_um,meas_dy_um,meas_dz_um,calc_dx_um,calc_dy_um,calc_dz_um,delta_um\n";
                                   for (size_t k = 0; k < v.measured.size(); ++k) {
@@ -294,9 +271,9 @@ IdentifyOutcome rtestLocation(const IdentifyRequest& r) {
 // ---- R-test: six errors of each rotary axis over angle
 
 /// Largest |value| (and |value − truth|) of every component table of the two axes.
-void printTables(const DeviationSet& d, const std::vector<std::string>& axes) {
+void printTables(const MethodRequest& r, const DeviationSet& d, const std::vector<std::string>& axes) {
     const MachineModel& m = d.machine();
-    fmt::print("{:<6} {:<8} {:>5} {:>12}  {}\n", "table", "alias", "nodes", "max |value|", "unit");
+    r.say("{:<6} {:<8} {:>5} {:>12}  {}\n", "table", "alias", "nodes", "max |value|", "unit");
     for (const std::string& ax : axes)
         for (const char* c : {"EX", "EY", "EZ", "EA", "EB", "EC"}) {
             const int i = m.deviationIndex(c + ax);
@@ -305,43 +282,47 @@ void printTables(const DeviationSet& d, const std::vector<std::string>& axes) {
             const double s = def.isAngle() ? kArcsec : kUm;
             double vmax = 0;
             for (int k = 0; k < def.size(); ++k) vmax = std::max(vmax, std::abs(d.values[def.offset + k]) / s);
-            fmt::print("{:<6} {:<8} {:>5} {:12.4f}  {}\n", def.name, def.alias, def.size(), vmax,
-                       def.isAngle() ? "arcsec" : "um");
+            r.say("{:<6} {:<8} {:>5} {:12.4f}  {}\n", def.name, def.alias, def.size(), vmax,
+                  def.isAngle() ? "arcsec" : "um");
         }
 }
 
-IdentifyOutcome rtestTables(const IdentifyRequest& r) {
+void checkRtestTables(const MethodRequest& r) {
     requireTraces(r);
     noEngineOptions(r, "the R-test tables method identifies the six error tables of both rotary axes");
+    cradleAxes(r);
+}
+
+IdentificationSummary rtestTables(const MethodRequest& r) {
     const MachineModel& m = *r.machine;
     const auto [outer, inner] = cradleAxes(r);
-    const std::vector<RtestTrace> traces = readRtestTraces(r.traces, m, r.plan->rtestRuns);
-    IdentifyOutcome out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
+    const std::vector<RtestTrace>& traces = r.data->rtest;
+    IdentificationSummary out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
     if (r.formulas) {
         std::vector<AxisErrors> per;
         out.deviations = cradleTablesPerAngle(m, outer, inner, r.plan->rtestRuns, traces, &per);
         for (const AxisErrors& a : per)
-            fmt::print("eq. (1)-(7) per angle: axis {} at {} angles, worst fit residual {:.5f} um\n", a.axis,
-                       a.samples.size(),
-                       std::max_element(a.samples.begin(), a.samples.end(), [](auto& x, auto& y) { return x.rms < y.rms; })->rms / kUm);
+            r.say("eq. (1)-(7) per angle: axis {} at {} angles, worst fit residual {:.5f} um\n", a.axis,
+                  a.samples.size(),
+                  std::max_element(a.samples.begin(), a.samples.end(), [](auto& x, auto& y) { return x.rms < y.rms; })->rms / kUm);
         out.summary = fmt::format("R-test tables of {} and {}, per-angle formulas (1)-(7) ({} first)", outer, inner, outer);
     } else {
         const CradleLsq ls = cradleLeastSquares(m, outer, inner, r.plan->rtestRuns, traces);
         out.deviations = ls.deviations;
-        for (const std::string& w : ls.report.warnings) fmt::print("warning: {}\n", w);
+        for (const std::string& w : ls.report.warnings) r.say("warning: {}\n", w);
         out.summary = fmt::format("R-test tables of {} and {}, least squares: rank {} of {} ({} unobservable directions, the "
                                   "constant transform between the {} and {} frames, fixed by '{} errors = 0 at {} = 0'), {}",
                                   outer, inner, ls.report.rank, ls.report.unknowns, ls.report.unobservable.size(), outer,
                                   inner, inner, inner, ls.report.termination);
     }
-    printTables(out.deviations, {outer, inner});
+    printTables(r, out.deviations, {outer, inner});
     return out;
 }
 
 // ---- DBB5 (Ibaraki et al., "Identification of motion error sources on five-axis machine tools by ball-bar
 //      measurements (1st report)")
 
-IdentifyOutcome dbb5(const IdentifyRequest& r) {
+void checkDbb5(const MethodRequest& r) {
     requireTraces(r);
     const MachineModel& m = *r.machine;
     const std::vector<Dbb5Run>& runs = r.plan->dbb5Runs;
@@ -353,25 +334,31 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
                                      "arc; README \"Linear-axis circles (ISO 230-4)\"), whose identification needs no rotary "
                                      "axis and estimates the bar's centring offset",
                                      m.name));
-    const std::vector<BallbarTrace> traces = readTraces(r.traces, runs);
-    fmt::print("{:<14} {:>8} {:>16} {:>18} {:>10}  (ISO 230-4)\n", "run", "samples", "circularity um",
-               "mean radial err um", "b2 um");
+    if (r.formulas) noEngineOptions(r, "the DBB5 formulas identify the eleven location and squareness errors");
+    else checkParams(r);
+}
+
+IdentificationSummary dbb5(const MethodRequest& r) {
+    const MachineModel& m = *r.machine;
+    const std::vector<Dbb5Run>& runs = r.plan->dbb5Runs;
+    const std::vector<BallbarTrace>& traces = r.data->dbb5;
+    r.say("{:<14} {:>8} {:>16} {:>18} {:>10}  (ISO 230-4)\n", "run", "samples", "circularity um",
+          "mean radial err um", "b2 um");
     std::vector<CircularTestResult> iso;
     for (size_t i = 0; i < traces.size(); ++i) {
         iso.push_back(evaluateCircularTest(traces[i], runs[i].LB));
-        fmt::print("{:<14} {:>8} {:16.4f} {:18.4f} {:10.4f}\n", runs[i].name, iso.back().samples,
-                   iso.back().circularity / kUm, iso.back().meanRadialError / kUm, iso.back().b2 / kUm);
+        r.say("{:<14} {:>8} {:16.4f} {:18.4f} {:10.4f}\n", runs[i].name, iso.back().samples,
+              iso.back().circularity / kUm, iso.back().meanRadialError / kUm, iso.back().b2 / kUm);
     }
     const Dbb5LocationOptions lo{r.outer, r.inner, refineOr(r, 4)};
-    IdentifyOutcome out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
+    IdentificationSummary out{DeviationSet(m), std::nullopt, {}, "", std::nullopt, std::nullopt};
     if (r.formulas) {
-        noEngineOptions(r, "the DBB5 formulas identify the eleven location and squareness errors");
         const Dbb5LocationResult f = dbb5LocationErrors(m, runs, traces, lo);
         out.deviations = f.deviations;
-        fmt::print("plain formulas, the paper's definitions (relative to the machine axes):\n");
+        r.say("plain formulas, the paper's definitions (relative to the machine axes):\n");
         for (const Dbb5FormulaValue& v : f.formulas)
-            fmt::print("  {:<18} {:>10.4f} {:<6}  {}\n", v.name, v.value / (v.angle ? kArcsec : kUm),
-                       v.angle ? "arcsec" : "um", v.definition);
+            r.say("  {:<18} {:>10.4f} {:<6}  {}\n", v.name, v.value / (v.angle ? kArcsec : kUm),
+                  v.angle ? "arcsec" : "um", v.definition);
         out.summary = fmt::format("DBB5 formulas (1)-(3), (6)-(7) and the elliptic term of the linear circles, {} "
                                   "refinement steps on the exact model{}",
                                   f.refine, f.refine > 0 ? "" : " (plain formulas converted to the model's definitions)");
@@ -384,9 +371,9 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
         const std::string inner = dbb5TableAxes(m, lo).second;
         const Dbb5ComponentProfile p = dbb5ComponentProfile(m, runs, traces, out.deviations, inner);
         out.deviations = dbb5ComponentTables(m, p, out.deviations);
-        fmt::print("component errors of {} from {} (bed frame, relative to the average line; tilts: {}, axial: {}) "
-                   "-> the model's tables\n",
-                   inner, fmt::join(p.runs, ", "), p.tilts ? "yes" : "no", p.axial ? "yes" : "no");
+        r.say("component errors of {} from {} (bed frame, relative to the average line; tilts: {}, axial: {}) "
+              "-> the model's tables\n",
+              inner, fmt::join(p.runs, ", "), p.tilts ? "yes" : "no", p.axial ? "yes" : "no");
         out.extras.push_back({"--profile-out", [p](std::ostream& o) {
                                   o << "angle_deg,dx_um,dy_um,dz_um,ex_arcsec,ey_arcsec,ez_arcsec\n";
                                   for (size_t i = 0; i < p.angleDeg.size(); ++i)
@@ -400,18 +387,18 @@ IdentifyOutcome dbb5(const IdentifyRequest& r) {
         const Dbb5Run& run = runs[i];
         if (isDbb5XycTest(m, run)) {
             const Dbb5XycResult x = evaluateDbb5XycTest(m, run, traces[i]);
-            fmt::print("XYC test {}: centre offset ({:.4f}, {:.4f}) um at R = {:g} mm -> {} {:.4f} arcsec, {} {:.4f} arcsec "
-                       "(eq. (4)-(5), relative to the plane of motion)\n",
-                       run.name, x.centre[0] / kUm, x.centre[1] / kUm, x.radius,
-                       fmt::format("E{}0{}", "ABC"[x.second], run.axis), x.rotation[x.second] / kArcsec,
-                       fmt::format("E{}0{}", "ABC"[x.first], run.axis), x.rotation[x.first] / kArcsec);
+            r.say("XYC test {}: centre offset ({:.4f}, {:.4f}) um at R = {:g} mm -> {} {:.4f} arcsec, {} {:.4f} arcsec "
+                  "(eq. (4)-(5), relative to the plane of motion)\n",
+                  run.name, x.centre[0] / kUm, x.centre[1] / kUm, x.radius,
+                  fmt::format("E{}0{}", "ABC"[x.second], run.axis), x.rotation[x.second] / kArcsec,
+                  fmt::format("E{}0{}", "ABC"[x.first], run.axis), x.rotation[x.first] / kArcsec);
         } else if (run.kind == Dbb5Run::Kind::ConeFrustum) {
             const Dbb5ConeEvaluation c = evaluateDbb5ConeRun(m, run, traces[i], &out.deviations);
-            fmt::print("cone frustum {}: circularity {:.4f} um; measured - predicted by the identified errors: rms {:.4f} "
-                       "um, max {:.4f} um ({})\n",
-                       run.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm,
-                       r.formulas ? "not used by the formulas: an independent check"
-                                  : "a run of the fit, not an independent check");
+            r.say("cone frustum {}: circularity {:.4f} um; measured - predicted by the identified errors: rms {:.4f} "
+                  "um, max {:.4f} um ({})\n",
+                  run.name, c.iso.circularity / kUm, c.rmsDifference / kUm, c.maxDifference / kUm,
+                  r.formulas ? "not used by the formulas: an independent check"
+                             : "a run of the fit, not an independent check");
         }
     }
     std::vector<std::string> names;
@@ -456,29 +443,34 @@ std::vector<int> sphereDefaults(const MachineModel& m, const Observations& obs) 
     return out;
 }
 
-IdentifyOutcome sphereProbe(const IdentifyRequest& r) {
+void checkSphere(const MethodRequest& r) {
     if (r.traces.empty())
         throw ModelError(fmt::format("give the folder of the probe result file with --traces DIR (DIR/{})", r.probeLog));
     if (r.formulas) throw ModelError("the sphere method has no paper's formulas: use --method least-squares");
+    sphereCommands(*r.machine, r.plan->sphereRuns);  // the machine makes every pose
+    checkParams(r);
+}
+
+IdentificationSummary sphereProbe(const MethodRequest& r) {
     const MachineModel& m = *r.machine;
     const SpherePlanCommands cmds = sphereCommands(m, r.plan->sphereRuns);
-    const ProbeLog log = readProbeLog((std::filesystem::path(r.traces) / r.probeLog).string(), m);
+    const ProbeLog& log = *r.data->probes;
     Observations obs = sphereObservations(m, cmds, log);
-    fmt::print("{:<16} {:>6} {:>8} {:>22}  (sphere centres fitted with the known radius)\n", "run", "poses", "touches",
-               "worst fit rms um (pose)");
+    r.say("{:<16} {:>6} {:>8} {:>22}  (sphere centres fitted with the known radius)\n", "run", "poses", "touches",
+          "worst fit rms um (pose)");
     for (size_t i = 0; i < obs.size(); ++i) {
         const auto& so = static_cast<const SphereObservation&>(*obs[i]);
         const auto& rms = so.fitRms();
         const auto w = std::max_element(rms.begin(), rms.end());
-        fmt::print("{:<16} {:>6} {:>8} {:>16.4f} ({:>3})\n", so.runName(), rms.size(),
-                   rms.size() * static_cast<size_t>(cmds.runs[i].run.touchesPerPose()), *w / kUm,
-                   cmds.runs[i].poses[static_cast<size_t>(w - rms.begin())].planPose);
+        r.say("{:<16} {:>6} {:>8} {:>16.4f} ({:>3})\n", so.runName(), rms.size(),
+              rms.size() * static_cast<size_t>(cmds.runs[i].run.touchesPerPose()), *w / kUm,
+              cmds.runs[i].poses[static_cast<size_t>(w - rms.begin())].planPose);
     }
     const IdentifyOptions io = engineOptions(r, sphereDefaults(m, obs));
-    IdentificationResult res = identify(m, obs, io);
+    IdentificationResult res = cnccomp::identify(m, obs, io);
     const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
                                           [&](int i) { return res.deviations.present[static_cast<size_t>(i)] != 0; });
-    IdentifyOutcome out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};
+    IdentificationSummary out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};
     out.result = std::move(res);
     out.summary = fmt::format("identified {} of {} requested deviations of '{}' (sphere probing, least squares on the "
                               "centres of {} poses, {} touches)",
@@ -486,99 +478,68 @@ IdentifyOutcome sphereProbe(const IdentifyRequest& r) {
     return out;
 }
 
+// ---- what each method reads, and the registry's entries
+
+MeasurementKinds only(bool MeasurementKinds::*kind) {
+    MeasurementKinds k;
+    k.*kind = true;
+    return k;
+}
+
+void checkBallbar(const MethodRequest& r) {
+    if (r.formulas) return checkBallbarFormulas(r);
+    if (!r.eccentricities.empty())
+        throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (an "
+                         "eccentricity table is for --method formulas)");
+    requireTraces(r);
+    checkParams(r);
+}
+
+MeasurementKinds ballbarReads(const MethodRequest& r) {
+    if (r.formulas) return r.eccentricities.empty() ? only(&MeasurementKinds::ballbar) : MeasurementKinds{};
+    return r.observe == Observe::Eccentricity ? only(&MeasurementKinds::ballbar) : MeasurementKinds::observed();
+}
+
+IdentificationSummary ballbar(const MethodRequest& r) {
+    return r.formulas ? ballbarFormulas(r) : generalLeastSquares(r, {}, "ball-bar runs");
+}
+
+void checkMixed(const MethodRequest& r) {
+    if (r.formulas)
+        throw ModelError("the plan has runs of several kinds: no paper's formulas take them together; it fits "
+                         "--method least-squares");
+    requireTraces(r);
+    checkParams(r);
+}
+
+MeasurementKinds observed(const MethodRequest&) { return MeasurementKinds::observed(); }
+
+IdentificationSummary mixed(const MethodRequest& r) { return generalLeastSquares(r, {}, "runs of several kinds"); }
+
+MeasurementKinds headReads(const MethodRequest&) { return only(&MeasurementKinds::absolute); }
+MeasurementKinds rtestReads(const MethodRequest&) { return only(&MeasurementKinds::rtest); }
+MeasurementKinds sphereReads(const MethodRequest&) { return only(&MeasurementKinds::probes); }
+/// The formulas read their own runs; least squares every run of the plan.
+MeasurementKinds rtestLocationReads(const MethodRequest& r) {
+    return r.formulas ? only(&MeasurementKinds::rtest) : MeasurementKinds::observed();
+}
+MeasurementKinds dbb5Reads(const MethodRequest& r) {
+    return r.formulas ? only(&MeasurementKinds::dbb5) : MeasurementKinds::observed();
+}
+
 }  // namespace
 
-IdentifyOutcome runIdentification(const IdentifyRequest& r) {
-    // The engine's options are checked before any measurement is read: a misspelt solver fails at once, not after
-    // every trace of the plan was imported.
-    if (r.observe != "traces" && r.observe != "eccentricity")
-        throw ModelError(fmt::format("unknown --observe '{}' (traces, eccentricity)", r.observe));
-    if (!r.formulas && r.machine) validateIdentifyOptions(solverOptions(r));
-    if (!r.plan) {
-        if (r.formulas) return ballbarFormulas(r);
-        throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (an eccentricity "
-                         "table is for --method formulas)");
-    }
-    if (r.observe != "traces" && r.kind != PlanMethod::Ballbar)
-        throw ModelError("--observe eccentricity works on ball-bar <run> elements only");
-    switch (r.kind) {
-        case PlanMethod::Ballbar:
-            if (r.formulas) return ballbarFormulas(r);
-            if (!r.eccentricities.empty())
-                throw ModelError("least squares works on the raw traces: give --traces DIR and --plan P.xml (an "
-                                 "eccentricity table is for --method formulas)");
-            return generalLeastSquares(r, {}, "ball-bar runs");
-        case PlanMethod::Mixed:
-            if (r.formulas)
-                throw ModelError("the plan has runs of several kinds: no paper's formulas take them together; it fits "
-                                 "--method least-squares");
-            return generalLeastSquares(r, {}, "runs of several kinds");
-        case PlanMethod::HeadPatterns: return headPatterns(r);
-        case PlanMethod::RtestLocation: return rtestLocation(r);
-        case PlanMethod::RtestTables: return rtestTables(r);
-        case PlanMethod::Dbb5: return dbb5(r);
-        case PlanMethod::LinearCircle: return identifyLinearCircles(r);
-        case PlanMethod::Sphere: return sphereProbe(r);
-    }
-    throw ModelError("unknown plan method");
+std::vector<IdentificationMethod> rotaryAxisMethods() {
+    const auto entry = [](PlanMethod kind, auto reads, auto check, auto run) {
+        return IdentificationMethod{planMethodName(kind), {kind}, planMethodMeasures(kind), reads, check, run};
+    };
+    return {entry(PlanMethod::Ballbar, ballbarReads, checkBallbar, ballbar),
+            entry(PlanMethod::Mixed, observed, checkMixed, mixed),
+            entry(PlanMethod::HeadPatterns, headReads, checkHeadPatterns, headPatterns),
+            entry(PlanMethod::RtestLocation, rtestLocationReads, checkRtestLocation, rtestLocation),
+            entry(PlanMethod::RtestTables, rtestReads, checkRtestTables, rtestTables),
+            entry(PlanMethod::Dbb5, dbb5Reads, checkDbb5, dbb5),
+            entry(PlanMethod::Sphere, sphereReads, checkSphere, sphereProbe)};
 }
 
-void printAdequacy(const Adequacy& a) {
-    if (!a.tested) {
-        fmt::print("model adequacy: not tested (no run has a sweep, repeated passes or a stated noise)\n");
-        return;
-    }
-    fmt::print("model adequacy ({:.1f} %): F = {:.3g}, allowed {:.3g} -> {}\n", 100 * a.confidence, a.statistic, a.threshold,
-               a.fits ? "the model fits the data" : "THE MODEL DOES NOT FIT THE DATA");
-    fmt::print("{:<18} {:>10} {:>10} {:>10}  {:<24} {:>9}  {}\n", "run", "noise um", "F", "allowed", "noise from",
-               "h1-6 %", "verdict");
-    for (const RunAdequacy& ra : a.runs)
-        fmt::print("{:<18} {:>10.4f} {:>10.3g} {:>10.3g}  {:<24} {:>9}  {}\n", ra.run, ra.noise / kUm, ra.statistic,
-                   ra.threshold, ra.noiseSource,
-                   std::isfinite(ra.harmonicShare) ? fmt::format("{:.0f}", 100 * ra.harmonicShare) : "-",
-                   ra.fits ? "fits" : "DOES NOT FIT");
-    if (!a.fits) fmt::print("intervals: {}\n", a.inflationRule);
-}
-
-void printReport(const IdentificationReport& r) {
-    fmt::print("{}: {} after {} iteration(s); cost {:.6g} -> {:.6g} um^2; rank {}/{}, condition number {:.4g}, "
-               "sigma {} um\n",
-               r.solver, r.termination, r.iterations, r.costBefore, r.costAfter, r.rank, r.unknowns,
-               r.conditionNumber, std::isfinite(r.sigma) ? fmt::format("{:.4f}", r.sigma / kUm) : "-");
-    const bool mc = r.monteCarloSamples > 0;
-    fmt::print("{:<14} {:>12} {:>10} {:>10} {:>10}{}  {:<6}  {}\n", "ISO name", "value", "std", "low95", "high95",
-               mc ? fmt::format(" {:>10} {:>10} {:>10}", "mc std", "mc low95", "mc high95") : "", "unit", "paper alias");
-    for (const ParameterEstimate& p : r.parameters) {
-        const double s = p.displayScale();
-        const std::string alias =
-            p.alias.empty() ? "" : std::isfinite(p.aliasValue) ? fmt::format("{} = {:.4f}", p.alias, p.aliasValue / s) : p.alias;
-        if (!p.identified) {
-            fmt::print("{:<14} {:>12} {:>10} {:>10} {:>10}  {:<6}  {}\n", p.name, "unidentified", "-", "-", "-", p.unit(),
-                       p.alias);
-            continue;
-        }
-        fmt::print("{:<14} {} {} {} {}{}  {:<6}  {}\n", p.name, cell(p.value, s, 12), cell(p.stddev, s), cell(p.lower95, s),
-                   cell(p.upper95, s),
-                   mc ? fmt::format(" {} {} {}", cell(p.mcStddev, s), cell(p.mcLower95, s), cell(p.mcUpper95, s)) : "",
-                   p.unit(), alias);
-    }
-    if (!r.identifiable.empty()) {
-        fmt::print("identifiable combinations of the unidentified parameters (ISO values; coefficients in mm, rad):\n");
-        for (const Combination& c : r.identifiable)
-            fmt::print("  {} = {} ± {} {}  (identifiable, not each term)\n", c.text,
-                       cell(c.value, c.angle ? kArcsec : kUm, 0), cell(c.stddev, c.angle ? kArcsec : kUm, 0),
-                       c.angle ? "arcsec" : "um");
-    }
-    if (!r.unobservable.empty()) {
-        fmt::print("directions these measurements cannot see:\n");
-        for (const Combination& c : r.unobservable) fmt::print("  {}\n", c.text);
-    }
-    fmt::print("{:<18} {:>8} {:>14} {:>14}\n", "run", "samples", "rms before um", "rms after um");
-    for (const RunResidual& rr : r.runs)
-        fmt::print("{:<18} {:>8} {:>14.4f} {:>14.4f}\n", rr.run, rr.samples, rr.rmsBefore / kUm, rr.rmsAfter / kUm);
-    printAdequacy(r.adequacy);
-    if (!r.stages.empty()) fmt::print("fitted in two stages: {}\n", r.stages);
-    for (const std::string& w : r.warnings) fmt::print("warning: {}\n", w);
-}
-
-}  // namespace cnccomp::cli
+}  // namespace cnccomp::app

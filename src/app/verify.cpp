@@ -17,7 +17,7 @@
 #include "postproc/testprog/read_back.hpp"
 #include "postproc/testprog/test_program.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 
 namespace {
 
@@ -430,4 +430,4 @@ std::string worseBanner(const VerifyResult& r) {
     return s + "; do not load it";
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

@@ -24,7 +24,7 @@
 #include "postproc/testprog/program_syntax.hpp"
 #include "postproc/testprog/run_motion.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 
 /// What the test programs' commands go through before they reach the drives.
 struct VerifyCompensation {
@@ -157,4 +157,4 @@ std::string worseBanner(const VerifyResult& result);
 VerifyResult verify(const MachineModel& machine, const MeasurementPlan& plan, const DeviationSet& simulated,
                     const std::string& simulatedName, const VerifyCompensation& compensation, const VerifyOptions& options = {});
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

@@ -7,7 +7,7 @@
 #include "cnccomp/io/markup.hpp"
 
 
-namespace cnccomp {
+namespace cnccomp::app {
 namespace {
 
 std::string str(std::string_view s) { return jsonString(s); }
@@ -101,4 +101,4 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
     return o;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

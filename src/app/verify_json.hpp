@@ -8,7 +8,7 @@
 
 #include "app/verify.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 
 /// The gates of `cnccomp verify`: the residual (largest ΔL span after) at most `gateUm`, and the volumetric tool-tip
 /// error after at most `volumetricGateUm` (failed when there is no volumetric figure). Unset gates pass.
@@ -20,4 +20,4 @@ bool verifyGatePassed(const VerifyResult& result, std::optional<double> gateUm, 
 std::string formatVerifyJson(const VerifyResult& result, std::optional<double> gateUm = std::nullopt,
                              std::optional<double> volumetricGateUm = std::nullopt);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

@@ -12,7 +12,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "postproc/testprog/test_program.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 
 std::vector<controllers::OutputFile> readFolder(const std::string& dir) {
     namespace fs = std::filesystem;
@@ -156,4 +156,4 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

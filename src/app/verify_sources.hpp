@@ -11,7 +11,7 @@
 
 #include "app/verify.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 
 struct LoadedCompensation {
     VerifyCompensation compensation;
@@ -32,4 +32,4 @@ std::vector<controllers::Coverage> readCompensated(const std::vector<controllers
 /// The files of a folder (regular files, not recursive), sorted by name.
 std::vector<controllers::OutputFile> readFolder(const std::string& dir);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

@@ -10,7 +10,7 @@
 #include "postproc/testprog/probe_program.hpp"
 #include "postproc/testprog/read_back.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 namespace {
 
 /// Parameter t in [0, 1] where the stylus, driven to drive(t), is `radius` from `sphere`.
@@ -97,4 +97,4 @@ std::vector<VerifyRun> verifySphereRuns(const MachineModel& m, const Measurement
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

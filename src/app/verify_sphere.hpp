@@ -5,7 +5,7 @@
 // over the poses before and after. A perfect compensation puts every centre on the sphere's true position.
 #include "app/verify.hpp"
 
-namespace cnccomp {
+namespace cnccomp::app {
 
 /// One VerifyRun per sphere run: one pass "poses", displacement = each pose's centre minus the mean centre (table
 /// frame), span = largest span of a component (as the R-test's displacements). `model` null = no compensation after.
@@ -13,4 +13,4 @@ namespace cnccomp {
 std::vector<VerifyRun> verifySphereRuns(const MachineModel& machine, const MeasurementPlan& plan, const Kinematics& simulated,
                                         const controllers::AppliedCompensation& model, testprog::ProgramDialect dialect);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::app

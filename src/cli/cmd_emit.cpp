@@ -44,9 +44,9 @@ controllers::FitWorkspace fitWorkspace(const MachineModel& m, const MeasurementP
     std::vector<double> lengths = o.fitToolLengths.empty() ? std::vector<double>{0.0, 100.0} : o.fitToolLengths;
     std::string what;
     if (plan) {
-        VerifyOptions vo;
+        app::VerifyOptions vo;
         vo.volumetricPerAxis = o.fitGrid;
-        const PlanWorkspace p = planWorkspace(m, *plan, vo);
+        const app::PlanWorkspace p = app::planWorkspace(m, *plan, vo);
         w.poses = p.poses;
         if (o.fitToolLengths.empty())
             for (double L : p.toolLengths)
@@ -65,17 +65,17 @@ controllers::FitWorkspace fitWorkspace(const MachineModel& m, const MeasurementP
 }
 
 /// What one candidate's files leave on the identified machine through the plan's test programs (cnccomp verify).
-VerifyResult verifyFiles(const controllers::Backend& b, const MachineModel& m, const MeasurementPlan& plan, const DeviationSet& identified,
+app::VerifyResult verifyFiles(const controllers::Backend& b, const MachineModel& m, const MeasurementPlan& plan, const DeviationSet& identified,
                          const controllers::EmitResult& r, const std::string& what, int volumetricPerAxis = 5) {
-    VerifyCompensation c;
-    c.kind = VerifyCompensation::Kind::ControllerFiles;
+    app::VerifyCompensation c;
+    c.kind = app::VerifyCompensation::Kind::ControllerFiles;
     c.backend = std::string(b.name());
     c.description = what;
     c.model = std::shared_ptr<const controllers::AppliedCompensation>(b.apply(m, r.files));
     c.notCompensated = r.notCompensated;
-    VerifyOptions vo;
+    app::VerifyOptions vo;
     vo.volumetricPerAxis = volumetricPerAxis;
-    return verify(m, plan, identified, "identified machine", c, vo);
+    return app::verify(m, plan, identified, "identified machine", c, vo);
 }
 
 /// The files correct some deviations and leave others; where those partly cancelled, correcting only some makes the
@@ -117,9 +117,9 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                 if (i == 2 && (!fitted || sampled)) continue;
                 const controllers::EmitRequest req{m, *rows[i].values, "prediction", "2000-01-01"};
                 // The candidates' spans only (their volumetric figure is the fit's own, above): one volumetric point.
-                const VerifyResult v = verifyFiles(b, m, *plan, d, b.emit(req), rows[i].name, 1);
+                const app::VerifyResult v = verifyFiles(b, m, *plan, d, b.emit(req), rows[i].name, 1);
                 spans[static_cast<size_t>(i)] = v.residual;
-                for (const VerifyRun& run : v.runs) rtest = rtest || run.kind == testprog::RunKind::Rtest;
+                for (const app::VerifyRun& run : v.runs) rtest = rtest || run.kind == testprog::RunKind::Rtest;
             }
         }
         const std::string spanName = rtest ? "largest R-test displacement (um)" : "largest span (um)";
@@ -145,7 +145,7 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                                                                     : sampled ? "zero values (the copy left more than none)"
                                                                               : "zero values (every other candidate left more than none)");
         if (plan) {
-            VerifyResult v = verifyFiles(b, m, *plan, d, written, fmt::format("{} files just written", b.name()));
+            app::VerifyResult v = verifyFiles(b, m, *plan, d, written, fmt::format("{} files just written", b.name()));
             fmt::print("predicted residual on the identified machine (cnccomp verify, {}): largest span {:.3f} um (before {:.3f} um); "
                        "volumetric max {:.3f} -> {:.3f} um\n",
                        std::filesystem::path(o.plan).filename().string(), v.residual / kUm, v.residualBefore / kUm,

@@ -8,8 +8,7 @@
 #include <fmt/format.h>
 
 #include "cli/command.hpp"
-#include "app/identify_circle.hpp"
-#include "app/identify_methods.hpp"
+#include "app/identify.hpp"
 #include "cli/print.hpp"
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
@@ -28,8 +27,9 @@ namespace cnccomp::cli {
 namespace {
 
 struct Options {
-    IdentifyRequest request;
-    std::string method = "least-squares", measure, machine, plan, out, report, truth, merge;
+    app::IdentificationOptions request;
+    std::string method = "least-squares", observe = "traces", solver = "lm";  ///< as typed; parsed into `request`
+    std::string machine, plan, out, report, truth, merge;
     std::string anglesOut, volumetricOut, isoOut, profileOut;
     std::string reportControllers, reportGrid, reportPlane = "XY";
 };
@@ -47,15 +47,15 @@ std::vector<std::string> splitList(const std::string& text) {
 }
 
 /// ISO 230-4 figures of every ball-bar run, as measured and with the identified deviations compensated.
-void printCircularTests(const std::vector<report::RunSection>& runs) {
+void printCircularTests(const std::vector<app::report::RunSection>& runs) {
     if (runs.empty()) return;
     fmt::print("ISO 230-4 circular test figures (um; after = identified deviations compensated):\n");
     fmt::print("{:<18} {:<7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9}\n", "run", "passes", "G before",
                "G after", "Fmax bef", "Fmin bef", "Fmax aft", "Fmin aft", "mean R mm", "H before", "H after");
     const auto um = [](double v) { return std::isfinite(v) ? fmt::format("{:9.3f}", v / kUm) : fmt::format("{:>9}", "-"); };
-    for (const report::RunSection& r : runs) {
+    for (const app::report::RunSection& r : runs) {
         std::string passes;
-        for (const report::PolarPass& p : r.passes) passes += p.direction > 0 ? "+" : "-";
+        for (const app::report::PolarPass& p : r.passes) passes += p.direction > 0 ? "+" : "-";
         fmt::print("{:<18} {:<7} {} {} {} {} {} {} {:12.5f} {} {}\n", r.name, passes, um(r.before.G), um(r.after.G),
                    um(r.before.Fmax), um(r.before.Fmin), um(r.after.Fmax), um(r.after.Fmin), r.before.meanRadius,
                    um(r.before.H), um(r.after.H));
@@ -63,22 +63,22 @@ void printCircularTests(const std::vector<report::RunSection>& runs) {
 }
 
 void run(Options o) {
+    // The options as typed, parsed and checked before any file is read (the façade checks them again).
+    app::IdentificationOptions& r = o.request;
+    r.approach = app::parseApproach(o.method);
+    r.observe = app::parseObserve(o.observe);
+    r.solver = app::parseSolver(o.solver);
+    app::validateOptions(r);
     const MachineModel m = readMachineXml(o.machine);
-    IdentifyRequest& r = o.request;
-    r.machine = &m;
-    if (o.method == "formulas" || o.method == "closed-form") r.formulas = true;
-    else if (o.method != "least-squares" && o.method != "lsq")
-        throw ModelError(fmt::format("unknown --method '{}' (least-squares, formulas)", o.method));
     std::optional<MeasurementPlan> plan;
     if (!o.plan.empty()) {
         plan = readPlanXml(o.plan);
         checkPlanMachine(*plan, o.plan, m.name);
-        r.plan = &*plan;
-        r.kind = choosePlanMethod(*plan, o.measure);
-    } else if (!o.measure.empty() && o.measure != "ball-bar") {
+        choosePlanMethod(*plan, r.measure);
+    } else if (!r.measure.empty() && r.measure != "ball-bar") {
         throw ModelError("--measure needs the plan (--plan P.xml)");
     }
-    const bool html = !o.report.empty() && report::isHtmlPath(o.report);
+    const bool html = !o.report.empty() && app::report::isHtmlPath(o.report);
     if ((!o.reportControllers.empty() || !o.reportGrid.empty()) && !html)
         throw ModelError("--report-controllers and --report-grid belong to an HTML report: give --report R.html");
     if (!o.profileOut.empty() && !r.components) throw ModelError("--profile-out needs --components");
@@ -98,21 +98,23 @@ void run(Options o) {
     const std::optional<DeviationSet> truth =
         o.truth.empty() ? std::nullopt : std::optional<DeviationSet>(readDeviationCsv(o.truth, m));
 
-    IdentifyOutcome res = runIdentification(r);
+    const app::IdentificationSummary res = app::identify(m, plan ? &*plan : nullptr, r);
+    // What the method found as it worked, as before any file is written.
+    fmt::print("{}", res.methodTables);
     if (!o.report.empty() && !res.report && !res.circles)
         throw ModelError(fmt::format("--report: the {} of '{}' writes no least-squares report",
-                                     r.formulas ? "formulas" : "method", planMethodName(r.kind)));
-    std::vector<std::pair<std::string, const ExtraOutput*>> extras;
+                                     res.formulas ? "formulas" : "method", planMethodName(res.kind)));
+    std::vector<std::pair<std::string, const app::ExtraOutput*>> extras;
     for (const auto& [option, path] : outputs) {
         if (path.empty() || option == "--out" || option == "--report") continue;
-        const auto it = std::find_if(res.extras.begin(), res.extras.end(), [&](const ExtraOutput& e) { return e.option == option; });
+        const auto it = std::find_if(res.extras.begin(), res.extras.end(), [&](const app::ExtraOutput& e) { return e.option == option; });
         if (it == res.extras.end())
-            throw ModelError(fmt::format("{} does not apply to the {} method", option, planMethodName(r.kind)));
+            throw ModelError(fmt::format("{} does not apply to the {} method", option, planMethodName(res.kind)));
         extras.emplace_back(path, &*it);
     }
     // Ball-bar runs of a least-squares solution on measured traces: ISO 230-4 figures before / after.
-    std::vector<report::RunSection> runs;
-    if (res.measured && res.result && plan) runs = report::measuredRunSections(m, *plan, *res.measured, *res.result);
+    std::vector<app::report::RunSection> runs;
+    if (res.measured && res.result && plan) runs = app::report::measuredRunSections(m, *plan, *res.measured, *res.result);
 
     // Everything is computed: stage every output, then commit them together (all or nothing).
     OutputSet staged({o.machine, o.plan, o.truth, r.start, r.eccentricities, o.merge});
@@ -131,8 +133,8 @@ void run(Options o) {
         if (!o.reportControllers.empty() || !o.reportGrid.empty())
             throw ModelError("--report-controllers and --report-grid: the circles of the linear axes write no maps or "
                              "controller sections yet");
-        report::stageHtmlReport(staged, o.report,
-                                report::linearCircleReportData(m.name, *res.circles,
+        app::report::stageHtmlReport(staged, o.report,
+                                app::report::linearCircleReportData(m.name, *res.circles,
                                                                {{"machine file", o.machine}, {"plan", o.plan},
                                                                 {"traces", r.traces}, {"deviations written", o.out},
                                                                 {"identification", res.summary}}));
@@ -140,7 +142,7 @@ void run(Options o) {
         staged.add(o.report, formatLinearCircleJson(m.name, *res.circles));
     } else if (html) {
         const IdentificationReport& rep = *res.report;
-        report::ReportData d;
+        app::report::ReportData d;
         d.title = fmt::format("Identification of {}", m.name);
         d.machine = m.name;
         d.facts = {{"machine file", o.machine}, {"plan", o.plan}, {"traces", r.traces}, {"deviations written", o.out},
@@ -153,14 +155,14 @@ void run(Options o) {
             if (rep.adequacy.fits || w != rep.adequacy.message) d.warnings.push_back(w);
         d.afterNote = "the run with the identified deviations compensated";
         d.runs = runs;
-        d.deviations = report::deviationRows(rep);
+        d.deviations = app::report::deviationRows(rep);
         for (const Combination& c : rep.identifiable) d.combinations.push_back(c.text);
-        report::MapOptions mo;
+        app::report::MapOptions mo;
         mo.grid = o.reportGrid;
         mo.plane = o.reportPlane;
         mo.toolLength = plan && !plan->runs.empty() ? plan->runs.front().RB : 0.0;
-        report::addCompensationSections(d, m, res.deviations, splitList(o.reportControllers), mo);
-        report::stageHtmlReport(staged, o.report, d);
+        app::report::addCompensationSections(d, m, res.deviations, splitList(o.reportControllers), mo);
+        app::report::stageHtmlReport(staged, o.report, d);
     } else if (!o.report.empty()) {
         staged.add(o.report, formatReportJson(*res.report));
     }
@@ -169,11 +171,10 @@ void run(Options o) {
 
     // A model that does not fit says so before anything else of the result.
     if (res.report && !res.report->adequacy.fits) fmt::print("WARNING: {}\n", res.report->adequacy.message);
-    fmt::print("{} -> {}{}{}\n", res.summary, o.out, o.merge.empty() ? "" : " (merged into " + o.merge + ")",
+    fmt::print("{} -> {}{}{}\n", res.briefReport(), o.out, o.merge.empty() ? "" : " (merged into " + o.merge + ")",
                o.report.empty() ? "" : ", report -> " + o.report);
     for (const std::string& l : mergeLines) fmt::print("merge: {}\n", l);
-    if (res.report) printReport(*res.report);
-    if (res.circles) printLinearCircles(*res.circles);
+    fmt::print("{}", res.resultReport());
     printCircularTests(runs);
     if (res.measured)
         for (size_t i = 0; i < res.measured->ballbar.size() && plan; ++i) {
@@ -191,7 +192,7 @@ void run(Options o) {
 
 const RegisterCommand reg([](CLI::App& app) {
     auto o = std::make_shared<Options>();
-    IdentifyRequest& r = o->request;
+    app::IdentificationOptions& r = o->request;
     auto* c = app.add_subcommand(
         "identify",
         "Identify the machine's deviations from the runs of a plan. The plan's runs choose what is measured: ball-bar "
@@ -207,7 +208,7 @@ const RegisterCommand reg([](CLI::App& app) {
                   "least-squares (exact model, every sample; the most accurate) or formulas (the paper's formulas of the "
                   "measurement, e.g. the ball-bar eccentricity formulas; closed-form is the same)")
         ->capture_default_str();
-    c->add_option("--measure", o->measure,
+    c->add_option("--measure", r.measure,
                   "override what the plan measures: ball-bar, head-patterns, rtest-location, rtest-tables, dbb5, mixed, circle");
     c->add_option("--eccentricities", r.eccentricities, "ball-bar formulas: eccentricity CSV instead of --traces/--plan")
         ->check(CLI::ExistingFile);
@@ -220,7 +221,7 @@ const RegisterCommand reg([](CLI::App& app) {
     c->add_flag("--one-stage", r.oneStage,
                 "least squares: fit every run at once (default: what the runs moving only linear axes determine, e.g. "
                 "the squareness from the DBB5 XY/YZ/ZX circles, is fitted from them first, then held)");
-    c->add_option("--observe", r.observe,
+    c->add_option("--observe", o->observe,
                   "least squares on ball-bar runs: traces (every raw sample) or eccentricity (fitted circle centres)")
         ->capture_default_str();
     c->add_option("--report", o->report,
@@ -230,7 +231,7 @@ const RegisterCommand reg([](CLI::App& app) {
                   "HTML report: controllers (comma list) whose coverage and predicted residual to show");
     c->add_option("--report-grid", o->reportGrid, "HTML report: map grid as for cnccomp map (default: X, Y over the travel)");
     c->add_option("--report-plane", o->reportPlane, "HTML report: map plane as for cnccomp map --plane")->capture_default_str();
-    c->add_option("--solver", r.solver, "least squares: lm (Levenberg-Marquardt) or nlopt:<ALGORITHM>, e.g. nlopt:LD_SLSQP")
+    c->add_option("--solver", o->solver, "least squares: lm (Levenberg-Marquardt) or nlopt:<ALGORITHM>, e.g. nlopt:LD_SLSQP")
         ->capture_default_str();
     c->add_option("--bounds", r.bounds, "NLopt: ISO-NAME=LOWER:UPPER,... in um / arcsec (default +-1000)");
     c->add_option("--start", r.start, "least squares: deviation CSV with starting values; deviations not estimated keep them")

@@ -40,16 +40,16 @@ std::string ecc(const Vec3& v) {
     return s;
 }
 
-void print(const VerifyResult& r) {
+void print(const app::VerifyResult& r) {
     // A compensation that makes the machine worse is said first, before any figure (VerifyWorse).
-    if (r.worse.any()) fmt::print("{}\n", worseBanner(r));
+    if (r.worse.any()) fmt::print("{}\n", app::worseBanner(r));
     if (!r.worse.span)  // a run that got worse while the largest span did not (VerifyWorse::runs)
         for (const std::string& w : r.worse.runs) fmt::print("WARNING: worse after compensation in run {} (span)\n", w);
     fmt::print("verification on '{}': {}\ncompensation: {}\n", r.machine, r.simulated, r.compensation);
     fmt::print("{:<22} {:<16} {:<7} {:>19} {:>19} {:>19}   {:<24}  {}\n", "run", "type", "pass", "span before/after",
                "G before/after", "F max/min after", "eccentricity before (um)", "after");
-    for (const VerifyRun& run : r.runs)
-        for (const VerifyPass& p : run.passes) {
+    for (const app::VerifyRun& run : r.runs)
+        for (const app::VerifyPass& p : run.passes) {
             const std::string g = p.circular ? fmt::format("{:9.3f} {:9.3f}", p.isoBefore.circularity / kUm, p.isoAfter.circularity / kUm)
                                              : fmt::format("{:>19}", "-");
             const std::string f = p.circular ? fmt::format("{:9.3f} {:9.3f}", p.isoAfter.radialMax / kUm, p.isoAfter.radialMin / kUm)
@@ -59,11 +59,11 @@ void print(const VerifyResult& r) {
         }
     fmt::print("(um; span = max - min of dL, R-test: of a displacement component; G = ISO 230-4 circular deviation; "
                "F = radial deviation)\n");
-    for (const VerifyRun& run : r.runs)
-        for (const VerifyPass& p : run.passes)
+    for (const app::VerifyRun& run : r.runs)
+        for (const app::VerifyPass& p : run.passes)
             if (!p.outsideTravel.empty())
                 fmt::print("warning: run '{}' {}: the compensated commands leave the travel: {}\n", run.name, p.label, p.outsideTravel);
-    const VerifyVolumetric& v = r.volumetric;
+    const app::VerifyVolumetric& v = r.volumetric;
     if (v.available)
         fmt::print("volumetric tool-tip error over the plan's workspace ({} points: {}):\n  max {:.3f} -> {:.3f} um, RMS {:.3f} -> "
                    "{:.3f} um, tool-axis tilt {:.2f} -> {:.2f} arcsec\n",
@@ -76,7 +76,7 @@ void print(const VerifyResult& r) {
     } else {
         // Under its ISO name the ISO value, under the paper alias the alias' value: the numbers an engineer adjusts.
         fmt::print("deviations left by the compensation (ISO 230-1 value in the simulated machine, paper alias, reason):\n");
-        for (const VerifyRemaining& x : r.remaining) {
+        for (const app::VerifyRemaining& x : r.remaining) {
             const std::string alias = x.alias.empty() ? "" : fmt::format("{} {:+.3f} {}", x.alias, x.aliasValue, x.unit);
             fmt::print("  {:<10} {:>16}  {:<20}  {}\n", x.deviation, x.valueKnown ? fmt::format("{:+.3f} {}", x.value, x.unit) : "-",
                        alias, x.reason);
@@ -97,13 +97,13 @@ void run(const Options& o) {
     if (o.maxVolumetricUm && !(*o.maxVolumetricUm >= 0)) throw InputError("--max-volumetric-um", 0, "expected a number >= 0");
     namespace fs = std::filesystem;
     if (!o.report.empty()) {
-        if (!report::isHtmlPath(o.report)) throw InputError(o.report, 0, "--report writes an HTML page: give R.html");
+        if (!app::report::isHtmlPath(o.report)) throw InputError(o.report, 0, "--report writes an HTML page: give R.html");
         if (!o.json.empty() && fs::path(o.json).lexically_normal() == fs::path(o.report).lexically_normal())
             throw InputError(o.report, 0, "--json and --report name the same file");
     } else if (!o.reportGrid.empty()) {
         throw InputError("--report-grid", 0, "belongs to an HTML report: give --report R.html");
     }
-    LoadedCompensation c = loadCompensation(m, plan, source, o.controller);
+    app::LoadedCompensation c = app::loadCompensation(m, plan, source, o.controller);
     std::optional<DeviationSet> simulated;
     std::string simulatedName;
     if (!o.truth.empty()) {
@@ -120,19 +120,19 @@ void run(const Options& o) {
                          "the machine to simulate is missing: --truth T.csv (simulation) or --identified D.csv (the set the "
                          "compensation was made from)");
     }
-    VerifyOptions vo;
+    app::VerifyOptions vo;
     vo.dialect = *dialect;
     vo.volumetricPerAxis = o.grid;
-    const VerifyResult r = verify(m, plan, *simulated, simulatedName, c.compensation, vo);
+    const app::VerifyResult r = app::verify(m, plan, *simulated, simulatedName, c.compensation, vo);
     // Every output is computed before any is written; a compensation folder's files are inputs too.
     std::vector<std::string> inputs{o.machine, o.plan, o.truth, o.identified, o.compensation};
     inputs.insert(inputs.end(), c.compensation.files.begin(), c.compensation.files.end());
     OutputSet staged(inputs);
     for (const std::string& out : {o.json, o.report})  // missing folders are created (and removed again on failure)
         if (!out.empty() && !fs::path(out).parent_path().empty()) staged.makeFolder(fs::path(out).parent_path().string());
-    if (!o.json.empty()) staged.add(o.json, formatVerifyJson(r, o.maxResidualUm, o.maxVolumetricUm));
+    if (!o.json.empty()) staged.add(o.json, app::formatVerifyJson(r, o.maxResidualUm, o.maxVolumetricUm));
     if (!o.report.empty()) {
-        report::VerificationReportInputs in;
+        app::report::VerificationReportInputs in;
         in.machineFile = o.machine;
         in.planFile = o.plan;
         in.compensationPath = source;
@@ -142,15 +142,15 @@ void run(const Options& o) {
         in.compensationSet = c.identified ? &*c.identified : nullptr;
         in.map.grid = o.reportGrid;
         in.map.plane = o.reportPlane;
-        const report::ReportData d = report::verificationReport(m, *simulated, c.compensation, r, in);
-        report::stageHtmlReport(staged, o.report, d);
+        const app::report::ReportData d = app::report::verificationReport(m, *simulated, c.compensation, r, in);
+        app::report::stageHtmlReport(staged, o.report, d);
     }
     staged.commit();
     print(r);
     if (!o.report.empty()) fmt::print("report -> {}\n", o.report);
     // Every gate is decided and said; any failure is exit status 1. The worse gate holds whatever the options say.
     std::vector<std::string> failed;
-    if (r.worse.any()) failed.push_back("verification failed: " + worseBanner(r));
+    if (r.worse.any()) failed.push_back("verification failed: " + app::worseBanner(r));
     if (o.maxResidualUm) {
         if (r.residual / kUm > *o.maxResidualUm)
             failed.push_back(fmt::format("verification failed: residual {:.3f} um is above --max-residual-um {:g}", r.residual / kUm,

@@ -10,7 +10,7 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/linear_circle_trace.hpp"
-#include "cnccomp/io/output_set.hpp"
+#include "cnccomp/io/plan_measurements_io.hpp"
 #include "cnccomp/kinematics.hpp"
 
 namespace cnccomp {
@@ -56,14 +56,25 @@ const LinearCircleParameter* lcParameter(const LinearCircleFit& fit, const std::
 
 LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const std::vector<LinearCircleRun>& runs,
                                                     const std::string& dir, const LinearCircleSettings& base) {
+    if (runs.empty()) throw ModelError("the plan has no circle runs (<circle>)");
+    MeasurementPlan plan;
+    plan.circleRuns = runs;
+    MeasurementKinds kinds;
+    kinds.circles = true;
+    return identifyLinearCircleRuns(m, runs, loadPlanMeasurements(m, plan, dir, kinds).circles, base);
+}
+
+LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& m, const std::vector<LinearCircleRun>& runs,
+                                                    const std::vector<LinearCircleTrace>& files,
+                                                    const LinearCircleSettings& base) {
     using namespace linear_circle_identify_detail;
     if (runs.empty()) throw ModelError("the plan has no circle runs (<circle>)");
+    if (files.size() != runs.size()) throw ModelError("the measurements of the plan's circle runs were not read");
     LinearCircleIdentification out{{}, DeviationSet(m), {}, {}, {}};
-    for (const LinearCircleRun& run : runs) {
-        run.validate();
-        linearCircleCentreCommands(m, run);  // the machine has the axes
-        const std::string path = OutputSet::fileIn(dir, run.name + ".csv");
-        const LinearCircleTrace file = importLinearCircleTrace(path, run, m.name);
+    for (size_t k = 0; k < runs.size(); ++k) {
+        const LinearCircleRun& run = runs[k];
+        const LinearCircleTrace& file = files[k];
+        const std::string& path = file.measured.path;
         LinearCircleRunResult r;
         r.run = run.name;
         r.summary = file.measured.summary;

@@ -16,6 +16,7 @@
 
 #include "cnccomp/circular_test.hpp"
 #include "cnccomp/deviations.hpp"
+#include "cnccomp/io/linear_circle_trace.hpp"
 #include "cnccomp/io/trace_import.hpp"
 #include "cnccomp/linear_circle_model.hpp"
 #include "cnccomp/linear_circle_run.hpp"
@@ -85,5 +86,10 @@ struct LinearCircleIdentification {
 /// run; ModelError for a machine that cannot make a run.
 LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& machine, const std::vector<LinearCircleRun>& runs,
                                                     const std::string& tracesDir, const LinearCircleSettings& settings = {});
+/// The same on the runs' files already read (PlanMeasurements::circles, io/plan_measurements_io.hpp: each run validated
+/// and its commands checked against the machine before its file was read), one per run in order.
+LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& machine, const std::vector<LinearCircleRun>& runs,
+                                                    const std::vector<LinearCircleTrace>& files,
+                                                    const LinearCircleSettings& settings = {});
 
 }  // namespace cnccomp

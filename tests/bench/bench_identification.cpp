@@ -2,6 +2,11 @@
 // model: each run a 360-sample trace (1° steps, the main job's; argument 360) or a 3600-sample one (0.1°). CPU time.
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
+
+#include "app/identify.hpp"
+#include "cnccomp/io/trace_csv.hpp"
+
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/parameters.hpp"
 #include "cnccomp/identification/problem.hpp"
@@ -75,6 +80,34 @@ void BM_ResidualsSixTraces(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_ResidualsSixTraces)->Unit(benchmark::kMillisecond);
+
+
+// The same main job through the identification façade (src/app/identify.hpp), as `cnccomp identify` runs it: the
+// options checked, the method looked up, the six instrument files read once (360 samples each), least squares, the
+// summary. CPU time; the files are written once to a temporary folder.
+void BM_FacadeIdentifyMainJob(benchmark::State& state) {
+    Fixture& f = fixture(360);
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "cnccomp-bench-facade";
+    std::filesystem::create_directories(dir);
+    MeasurementPlan plan;
+    plan.runs = f.runs;
+    for (size_t i = 0; i < f.runs.size(); ++i)
+        writeTraceCsv((dir / (f.runs[i].name + ".csv")).string(), f.traces[i], f.runs[i], f.machine.name);
+    writeDeviationCsv((dir / "start.csv").string(), *f.options.start, true);
+    app::IdentificationOptions o;
+    o.traces = dir.string();
+    o.params = "dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ";
+    o.start = (dir / "start.csv").string();
+    int iterations = 0;
+    for (auto _ : state) {
+        const app::IdentificationSummary s = app::identify(f.machine, &plan, o);
+        iterations = s.report->iterations;
+        benchmark::DoNotOptimize(s.deviations.values.data());
+    }
+    state.counters["lm_iterations"] = iterations;
+    std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_FacadeIdentifyMainJob)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace cnccomp

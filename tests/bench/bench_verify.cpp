@@ -19,21 +19,21 @@ void BM_VerifySixRunPlan(benchmark::State& state, const std::string& backendName
     const MachineModel m = readMachineXml(dir + "/samples/machines/multitasking.xml");
     const MeasurementPlan plan = readPlanXml(dir + "/samples/plans/multitasking-six-circles.xml");
     const DeviationSet truth = readDeviationCsv(dir + "/samples/deviations/multitasking-truth.csv", m);
-    VerifyCompensation comp;
+    app::VerifyCompensation comp;
     if (backendName == "ideal") {
-        comp.kind = VerifyCompensation::Kind::Deviations;
-        comp.model = idealCompensation(m, truth);
+        comp.kind = app::VerifyCompensation::Kind::Deviations;
+        comp.model = app::idealCompensation(m, truth);
     } else {
         const controllers::Backend& b = controllers::backend(backendName);
         const controllers::EmitResult files = b.emit({m, truth, "truth.csv", "2024-01-01"});
-        comp.kind = VerifyCompensation::Kind::ControllerFiles;
+        comp.kind = app::VerifyCompensation::Kind::ControllerFiles;
         comp.model = std::shared_ptr<const controllers::AppliedCompensation>(b.apply(m, files.files));
         comp.notCompensated = files.notCompensated;
     }
-    const VerifyResult once = verify(m, plan, truth, "truth", comp);
+    const app::VerifyResult once = app::verify(m, plan, truth, "truth", comp);
     state.SetLabel(fmt::format("residual {:.3f} um (before {:.3f})", once.residual / kUm, once.residualBefore / kUm));
     for (auto _ : state) {
-        const VerifyResult r = verify(m, plan, truth, "truth", comp);
+        const app::VerifyResult r = app::verify(m, plan, truth, "truth", comp);
         benchmark::DoNotOptimize(r.residual);
     }
 }

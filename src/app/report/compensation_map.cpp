@@ -8,7 +8,7 @@
 #include "cnccomp/map_grid.hpp"
 #include "controllers/common/evaluate.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 bool singularPose(const Kinematics& k, const AxisVector& q) {
     const Vec3 axis = k.baseToTool(q).linear() * k.machine().toolDirection;
@@ -85,4 +85,4 @@ VolumetricMap compensatedMap(const VolumetricMap& before, const MachineModel& m,
     return map;
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

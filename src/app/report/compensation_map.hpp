@@ -9,7 +9,7 @@
 #include "cnccomp/volumetric_map.hpp"
 #include "controllers/backend.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 /// True where the tool axis is (nearly) parallel to a rotary axis: there a TCP controller has no unique answer (any
 /// angle of that axis gives the same tool axis) and its model is not a prediction of the machine.
@@ -39,4 +39,4 @@ std::vector<AxisVector> regularWorkspaceSamples(const MachineModel& machine, int
 VolumetricMap compensatedMap(const VolumetricMap& before, const MachineModel& machine, const DeviationSet& deviations,
                              const controllers::AppliedCompensation& compensation, double toolLength);
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

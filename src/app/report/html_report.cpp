@@ -12,7 +12,7 @@
 #include "app/report/polar_plot.hpp"
 #include "app/report/report_format.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 namespace fs = std::filesystem;
 
 namespace {
@@ -348,4 +348,4 @@ ReportFiles stageHtmlReport(OutputSet& out, const std::string& htmlPath, const R
     return files;
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

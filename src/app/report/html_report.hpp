@@ -10,7 +10,7 @@
 #include "cnccomp/io/output_set.hpp"
 #include "app/report/report_data.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 /// The files of one report.
 struct ReportFiles {
@@ -36,4 +36,4 @@ std::string formatReportSummaryJson(const ReportData& data, const ReportFiles& f
 std::vector<std::string> renderReportPlots(const ReportData& data);
 std::string formatHtmlReport(const ReportData& data, const ReportFiles& files, const std::vector<std::string>& plots);
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

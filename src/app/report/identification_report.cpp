@@ -12,7 +12,7 @@
 #include "controllers/backend.hpp"
 #include "controllers/common/evaluate.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 namespace {
 
@@ -141,4 +141,4 @@ void addCompensationSections(ReportData& data, const MachineModel& m, const Devi
     }
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -16,7 +16,7 @@
 #include "app/report/compensation_map.hpp"
 #include "app/report/report_data.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 /// Ball-bar runs of a measured plan: before / after traces per pass, ISO 230-4 figures, fit RMS.
 /// `measured.observations` must be those the identification used (plan.runs first).
@@ -32,4 +32,4 @@ std::vector<DeviationRow> deviationRows(const IdentificationReport& report);
 void addCompensationSections(ReportData& data, const MachineModel& machine, const DeviationSet& identified,
                              const std::vector<std::string>& controllers, const MapOptions& options);
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -6,7 +6,7 @@
 
 #include "app/report/report_format.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_report_detail {
@@ -122,4 +122,4 @@ ReportData linearCircleReportData(const std::string& machine, const LinearCircle
     return d;
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -11,9 +11,9 @@
 #include "cnccomp/linear_circle_identify.hpp"
 #include "app/report/report_data.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 ReportData linearCircleReportData(const std::string& machine, const LinearCircleIdentification& id,
                                   std::vector<std::pair<std::string, std::string>> facts);
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

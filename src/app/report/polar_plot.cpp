@@ -9,7 +9,7 @@
 #include "cnccomp/io/markup.hpp"
 #include "app/report/report_format.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 PolarScale polarScale(const RunSection& run) {
     double m = 0;
@@ -125,4 +125,4 @@ std::string renderPolarPlot(const RunSection& run, const std::string& idPrefix) 
     return s;
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

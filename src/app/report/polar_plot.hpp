@@ -7,7 +7,7 @@
 
 #include "app/report/report_data.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 /// Trace colours (also what the browser test looks for in a screenshot).
 inline constexpr const char* kCcwBefore = "#1f4fd8";
@@ -40,4 +40,4 @@ PolarPixel polarPixel(const PolarScale& s, double angleDeg, double dL);
 /// The SVG (no XML prolog, so that it can also be put inline in HTML); ids start with `idPrefix`.
 std::string renderPolarPlot(const RunSection& run, const std::string& idPrefix = "polar");
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -1,6 +1,6 @@
 #include "app/report/report_data.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 IsoFigures isoFigures(const CircularRunResult& r) {
     IsoFigures f;
@@ -12,4 +12,4 @@ IsoFigures isoFigures(const CircularRunResult& r) {
     return f;
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -28,7 +28,7 @@
 #include "cnccomp/io/svg_map.hpp"
 #include "cnccomp/volumetric_map.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 inline constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
 
@@ -133,4 +133,4 @@ struct ReportData {
     std::vector<ControllerSection> controllers;
 };
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 double niceNumber(double x) {
     if (!(x > 0) || !std::isfinite(x)) return 1.0;
@@ -20,4 +20,4 @@ std::string fixed(double v, int decimals) {
     return fmt::format("{:.{}f}", v, decimals);
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -5,7 +5,7 @@
 
 #include "cnccomp/io/markup.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 /// The smallest of 1, 2, 2.5, 5 × 10^k that is ≥ x (x > 0; 1 otherwise).
 double niceNumber(double x);
@@ -13,4 +13,4 @@ double niceNumber(double x);
 std::string fixed(double v, int decimals);
 using cnccomp::jsonString;  // io/markup.hpp
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

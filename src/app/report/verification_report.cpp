@@ -9,7 +9,7 @@
 #include "cnccomp/circular_test.hpp"
 #include "cnccomp/map_grid.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 namespace {
 
@@ -138,4 +138,4 @@ ReportData verificationReport(const MachineModel& m, const DeviationSet& simulat
     return d;
 }
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

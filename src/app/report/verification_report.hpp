@@ -19,7 +19,7 @@
 #include "app/report/report_data.hpp"
 #include "app/verify.hpp"
 
-namespace cnccomp::report {
+namespace cnccomp::app::report {
 
 struct VerificationReportInputs {
     std::string machineFile, planFile, compensationPath;  ///< as given on the command line (shown in the page)
@@ -36,4 +36,4 @@ struct VerificationReportInputs {
 ReportData verificationReport(const MachineModel& machine, const DeviationSet& simulated, const VerifyCompensation& compensation,
                               const VerifyResult& result, const VerificationReportInputs& inputs);
 
-}  // namespace cnccomp::report
+}  // namespace cnccomp::app::report

@@ -19,17 +19,6 @@ namespace cnccomp {
 
 namespace {
 
-struct Solver {
-    bool nlopt = false;
-    std::string algorithm;
-};
-
-Solver parseSolver(const std::string& s) {
-    if (s == "lm" || s == "levenberg-marquardt") return {};
-    if (s.rfind("nlopt:", 0) == 0 && s.size() > 6) return {true, s.substr(6)};
-    throw ModelError(fmt::format("unknown solver '{}' (lm, or nlopt:<ALGORITHM> such as nlopt:LD_LBFGS)", s));
-}
-
 void boxBounds(const UnknownLayout& L, const IdentifyOptions& o, Eigen::VectorXd& lo, Eigen::VectorXd& hi) {
     lo.resize(L.size());
     hi.resize(L.size());
@@ -101,14 +90,18 @@ void monteCarlo(LsqProblem& p, const ObservableSubspace& sub, const Eigen::Vecto
 }  // namespace
 
 void validateIdentifyOptions(const IdentifyOptions& options) {
-    const Solver solver = parseSolver(options.solver);
-    if (solver.nlopt && !nloptAlgorithmKnown(solver.algorithm))
+    const SolverChoice& solver = options.solver;
+    const bool nlopt = solver.kind == SolverKind::Nlopt;
+    if (!nlopt && !solver.algorithm.empty())
+        throw ModelError(fmt::format("solver: the algorithm '{}' belongs to NLopt, not to Levenberg-Marquardt",
+                                     solver.algorithm));
+    if (nlopt && !nloptAlgorithmKnown(solver.algorithm))
         throw ModelError(fmt::format("unknown NLopt algorithm '{}' (e.g. LD_LBFGS, LD_SLSQP, LN_BOBYQA, LN_SBPLX)",
                                      solver.algorithm));
     if (options.maxIterations <= 0) throw ModelError("the iteration limit must be positive");
     if (!(options.rankTolerance > 0 && options.rankTolerance < 1)) throw ModelError("rank tolerance must be in (0, 1)");
     if (options.monteCarlo < 0) throw ModelError("Monte Carlo sample count must not be negative");
-    if (!solver.nlopt && !options.bounds.empty()) throw ModelError("bounds need a bounded solver: --solver nlopt:<ALGORITHM>");
+    if (!nlopt && !options.bounds.empty()) throw ModelError("bounds need a bounded solver: --solver nlopt:<ALGORITHM>");
     for (const ParameterBound& b : options.bounds)
         if (!(b.lower <= b.upper)) throw ModelError(fmt::format("bound for '{}': lower exceeds upper", b.name));
 }
@@ -116,7 +109,8 @@ void validateIdentifyOptions(const IdentifyOptions& options) {
 IdentificationResult identify(const MachineModel& machine, const Observations& observations,
                               const IdentifyOptions& options) {
     validateIdentifyOptions(options);
-    const Solver solver = parseSolver(options.solver);
+    const SolverChoice& solver = options.solver;
+    const bool nlopt = solver.kind == SolverKind::Nlopt;
     std::vector<int> devs = options.deviations;
     if (devs.empty())
         for (int i = 0; i < static_cast<int>(machine.deviations.size()); ++i) devs.push_back(i);
@@ -129,7 +123,7 @@ IdentificationResult identify(const MachineModel& machine, const Observations& o
     const ObservableSubspace sub = observableSubspace(problem, options.rankTolerance);
 
     SolverOutcome so;
-    if (solver.nlopt) {
+    if (nlopt) {
         Eigen::VectorXd lo, hi;
         boxBounds(layout, options, lo, hi);
         so = solveNlopt(problem, x0, solver.algorithm, lo, hi, 200 * options.maxIterations);
@@ -143,7 +137,7 @@ IdentificationResult identify(const MachineModel& machine, const Observations& o
     IdentificationResult res{problem.deviations(so.x), problem.nuisance(so.x), {}};
     IdentificationReport& rep = res.report;
     rep.machine = machine.name;
-    rep.solver = solver.nlopt ? "nlopt:" + solver.algorithm : "levenberg-marquardt";
+    rep.solver = nlopt ? "nlopt:" + solver.algorithm : "levenberg-marquardt";
     rep.termination = so.termination;
     rep.converged = so.converged;
     rep.iterations = so.iterations;

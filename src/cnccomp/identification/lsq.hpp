@@ -21,9 +21,22 @@ struct ParameterBound {
     double lower = -std::numeric_limits<double>::infinity(), upper = std::numeric_limits<double>::infinity();
 };
 
+/// The solver that minimises the cost. Typed: text such as "nlopt:LD_SLSQP" is parsed where the user gives it (the
+/// application layer's identification options, src/app/identify_options.hpp), never here.
+enum class SolverKind {
+    LevenbergMarquardt,  ///< levenberg_marquardt.hpp (the default)
+    Nlopt,               ///< nlopt_solver.hpp, bounded; `algorithm` names the NLopt algorithm
+};
+
+struct SolverChoice {
+    SolverKind kind = SolverKind::LevenbergMarquardt;
+    std::string algorithm;  ///< NLopt: the algorithm's name without the NLOPT_ prefix, e.g. LD_SLSQP; else empty
+    bool operator==(const SolverChoice&) const = default;
+};
+
 struct IdentifyOptions {
     std::vector<int> deviations;        ///< indices into machine.deviations; empty = every deviation
-    std::string solver = "lm";          ///< "lm" (Levenberg–Marquardt) or "nlopt:<ALGORITHM>" (e.g. nlopt:LD_LBFGS)
+    SolverChoice solver;                ///< Levenberg–Marquardt, or NLopt with an algorithm (e.g. LD_LBFGS)
     int maxIterations = 50;             ///< LM iterations (NLopt: ×200 evaluations)
     double rankTolerance = 1e-7;        ///< relative singular value below which a direction is unobservable
     std::vector<ParameterBound> bounds; ///< NLopt only

@@ -1,5 +1,6 @@
 #include "cnccomp/identification/measured_observations.hpp"
 
+#include "cnccomp/error.hpp"
 #include "cnccomp/identification/plan_observations.hpp"
 
 namespace cnccomp {
@@ -35,9 +36,11 @@ bool LengthOffsetObservation::jacobian(const DifferentiableMachine& m, const dou
     return true;
 }
 
-MeasuredRuns measuredObservations(const MachineModel& machine, const MeasurementPlan& plan, const std::string& dir) {
+MeasuredRuns measuredObservations(const MachineModel& machine, const MeasurementPlan& plan, const PlanMeasurements& data) {
     MeasuredRuns out;
-    out.ballbar = importRunTraces(dir, plan.runs, machine.name);
+    if (!plan.runs.empty() && (!data.loaded.ballbar || data.ballbar.size() != plan.runs.size()))
+        throw ModelError("the measurements of the plan's ball-bar runs were not read");
+    out.ballbar = data.ballbar;
     for (size_t i = 0; i < plan.runs.size(); ++i) {
         std::unique_ptr<ObservationModel> o =
             std::make_unique<BallbarObservation>(machine, plan.runs[i], out.ballbar[i].trace);
@@ -47,7 +50,7 @@ MeasuredRuns measuredObservations(const MachineModel& machine, const Measurement
     MeasurementPlan rest = plan;
     rest.runs.clear();
     if (rest.runCount() > 0)
-        for (auto& o : planObservations(machine, rest, dir)) out.observations.push_back(std::move(o));
+        for (auto& o : planObservations(machine, rest, data)) out.observations.push_back(std::move(o));
     return out;
 }
 

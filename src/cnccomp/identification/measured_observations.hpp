@@ -8,6 +8,7 @@
 
 #include "cnccomp/identification/observation.hpp"
 #include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/measurement/plan_measurements.hpp"
 #include "cnccomp/io/trace_import.hpp"
 
 namespace cnccomp {
@@ -44,9 +45,9 @@ struct MeasuredRuns {
     Observations observations;           ///< plan.runs first (same order), then the other kinds as planObservations
 };
 
-/// Imports DIR/<run>.csv for every <run> with its capture settings (checking `# machine:` lines against machine.name),
-/// wraps the runs whose instrument is relative, and adds the plan's other runs (planObservations). InputError naming
-/// the file and line for a file that does not fit its run.
-MeasuredRuns measuredObservations(const MachineModel& machine, const MeasurementPlan& plan, const std::string& dir);
+/// The observations of the plan's captures read once (io/plan_measurements_io.hpp, MeasurementKinds::observed(): the
+/// ball-bar files imported with their capture settings, `# machine:` lines checked against machine.name): wraps the
+/// runs whose instrument is relative, and adds the plan's other runs (planObservations).
+MeasuredRuns measuredObservations(const MachineModel& machine, const MeasurementPlan& plan, const PlanMeasurements& data);
 
 }  // namespace cnccomp

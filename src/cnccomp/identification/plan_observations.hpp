@@ -1,15 +1,18 @@
 #pragma once
-// Every run of a measurement plan as observations for the least-squares engine, reading DIR/<run>.csv for each:
+// Every run of a measurement plan as observations for the least-squares engine, from its captures read once
+// (measurement/plan_measurements.hpp, io/plan_measurements_io.hpp):
 // ball-bar runs (BallbarObservation), absolute ball-bar runs ([FanWuLi]), R-test runs ([Moravek2019] / [RotaryTableModel]) and DBB5
 // runs ([IbarakiDBB5]).
 #include <string>
 
 #include "cnccomp/identification/observation.hpp"
-#include "cnccomp/io/plan_xml.hpp"
+#include "cnccomp/measurement/plan.hpp"
+#include "cnccomp/measurement/plan_measurements.hpp"
 
 namespace cnccomp {
 
-/// Throws InputError naming a missing or malformed trace file, ModelError for an empty plan.
-Observations planObservations(const MachineModel& machine, const MeasurementPlan& plan, const std::string& traceDir);
+/// `data` holds the captures of every kind of run the plan has (MeasurementKinds::observed()). ModelError for an empty
+/// plan.
+Observations planObservations(const MachineModel& machine, const MeasurementPlan& plan, const PlanMeasurements& data);
 
 }  // namespace cnccomp
