@@ -20,7 +20,7 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "app/verify.hpp"
 #include "app/verify_sources.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 #include "postproc/testprog/test_program.hpp"
 #include "test_support.hpp"
 

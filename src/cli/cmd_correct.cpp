@@ -15,7 +15,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 
 namespace cnccomp::cli {
 namespace {
