@@ -6,25 +6,60 @@
 
 namespace cnccomp::pp {
 
-std::optional<Dialect> parseDialect(std::string_view name) {
+namespace {
+
+/// The one name table. `uses`: where the name is accepted; `listed`: where it is the dialect's own name (messages,
+/// summaries). Test programs name RS274NGC after LinuxCNC, for which they are written.
+struct DialectNameRow {
+    std::string_view name;
+    Dialect dialect;
+    unsigned uses, listed;
+};
+constexpr unsigned kRead = 1, kCorrect = 2, kWrite = 4, kAll = kRead | kCorrect | kWrite;
+constexpr DialectNameRow kDialectNames[] = {
+    {"rs274ngc", Dialect::Rs274ngc, kAll, kRead | kCorrect},
+    {"linuxcnc", Dialect::Rs274ngc, kAll, kWrite},
+    {"rs274", Dialect::Rs274ngc, kRead | kCorrect, 0},
+    {"ngc", Dialect::Rs274ngc, kAll, 0},
+    {"fanuc", Dialect::Fanuc, kAll, kAll},
+    {"haas", Dialect::Fanuc, kRead | kCorrect, 0},
+    {"sinumerik", Dialect::Sinumerik, kAll, kAll},
+    {"siemens", Dialect::Sinumerik, kAll, 0},
+    {"printer", Dialect::Printer, kRead | kCorrect, kRead | kCorrect},
+    {"marlin", Dialect::Printer, kRead | kCorrect, 0},
+    {"reprap", Dialect::Printer, kRead | kCorrect, 0},
+    {"3d-printer", Dialect::Printer, kRead | kCorrect, 0},
+    {"heidenhain", Dialect::Heidenhain, kCorrect | kWrite, kAll},
+    {"klartext", Dialect::Heidenhain, kCorrect | kWrite, 0},
+    {"tnc", Dialect::Heidenhain, kWrite, 0},
+};
+
+}  // namespace
+
+std::optional<Dialect> parseDialect(std::string_view name, DialectUse use) {
     std::string n;
     for (char c : name) n.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
-    if (n == "rs274ngc" || n == "linuxcnc" || n == "rs274" || n == "ngc") return Dialect::Rs274ngc;
-    if (n == "fanuc" || n == "haas") return Dialect::Fanuc;
-    if (n == "sinumerik" || n == "siemens") return Dialect::Sinumerik;
-    if (n == "printer" || n == "marlin" || n == "reprap" || n == "3d-printer") return Dialect::Printer;
+    for (const DialectNameRow& row : kDialectNames)
+        if ((row.uses & static_cast<unsigned>(use)) && row.name == n) return row.dialect;
     return std::nullopt;
 }
 
-const char* dialectName(Dialect d) {
-    switch (d) {
-        case Dialect::Rs274ngc: return "rs274ngc";
-        case Dialect::Fanuc: return "fanuc";
-        case Dialect::Sinumerik: return "sinumerik";
-        case Dialect::Printer: return "printer";
-        case Dialect::Heidenhain: return "heidenhain";
-    }
+const char* dialectName(Dialect d, DialectUse use) {
+    for (const DialectNameRow& row : kDialectNames)
+        if (row.dialect == d && (row.listed & static_cast<unsigned>(use))) return row.name.data();
+    for (const DialectNameRow& row : kDialectNames)
+        if (row.dialect == d && row.listed) return row.name.data();
     return "?";
+}
+
+std::string dialectNames(DialectUse use) {
+    std::string out;
+    for (const DialectNameRow& row : kDialectNames)
+        if ((row.uses & static_cast<unsigned>(use)) && (row.listed & static_cast<unsigned>(use))) {
+            if (!out.empty()) out += ", ";
+            out += row.name;
+        }
+    return out;
 }
 
 namespace {

@@ -2,6 +2,7 @@
 // G-code dialects the post-processor reads and writes, and auto-detection from the head of a program.
 // Free of Eigen and fmt so that the lexer and its fuzz target build on their own.
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace cnccomp::pp {
@@ -14,10 +15,19 @@ enum class Dialect {
     Heidenhain, ///< HEIDENHAIN conversational (Klartext): numbered blocks, BEGIN PGM, L/CC/C; read by postproc/klartext_blocks.*
 };
 
-/// "rs274ngc" (or "linuxcnc"), "fanuc", "sinumerik", "printer" (or "marlin", "reprap"); nullopt otherwise.
-/// (Heidenhain is detected from BEGIN PGM, not named here; `correct --dialect heidenhain` names it.)
-std::optional<Dialect> parseDialect(std::string_view name);
-const char* dialectName(Dialect d);
+/// Where a dialect name is accepted (one name table, postproc/dialect.cpp, serves them all): reading programs
+/// (`poses`, the lexer's tests), correcting them (`correct`: also HEIDENHAIN Klartext, which is otherwise detected from
+/// BEGIN PGM), or writing test programs (`testprog`, `verify`: LinuxCNC, Fanuc, Sinumerik, HEIDENHAIN; no printer).
+enum class DialectUse : unsigned char { Read = 1, Correct = 2, Write = 4 };
+
+/// The dialect a name stands for in `use`, case-insensitive: "rs274ngc" (or "linuxcnc", "rs274", "ngc"), "fanuc" (or
+/// "haas"), "sinumerik" (or "siemens"), "printer" (or "marlin", "reprap", "3d-printer"), "heidenhain" (or "klartext",
+/// "tnc"), each where that use accepts it; nullopt otherwise.
+std::optional<Dialect> parseDialect(std::string_view name, DialectUse use = DialectUse::Read);
+/// The name of a dialect as `use` lists it ("rs274ngc" in reading and correcting, "linuxcnc" for test programs).
+const char* dialectName(Dialect d, DialectUse use = DialectUse::Read);
+/// The names `use` accepts, one per dialect, as an error message lists them: "rs274ngc, fanuc, sinumerik, printer".
+std::string dialectNames(DialectUse use);
 
 struct DetectedDialect {
     Dialect dialect = Dialect::Rs274ngc;

@@ -35,7 +35,7 @@
 #include <iosfwd>
 
 #include "postproc/line_reader.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 
 namespace cnccomp::pp {
 

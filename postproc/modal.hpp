@@ -17,6 +17,9 @@
 namespace cnccomp::pp {
 
 using AxisMask = uint32_t;
+struct BlockWords;  // postproc/interp_read.hpp
+struct GCodes;      // postproc/interp_check.hpp
+struct Refusal;     // postproc/interp_check.hpp
 
 /// Which program letter drives which machine axis, and how.
 struct AxisLayout {
@@ -170,6 +173,31 @@ private:
     const char* computeTargets(const LexedBlock& b, BlockResult& r, bool machineCoordinates) const;
     void commit(const BlockResult& r);
     bool arcGeometry(const LexedBlock& b, BlockResult& r, const char*& why);
+    /// The result fields of a new block, before it is read (start = end = the current position).
+    void beginBlock(BlockResult& r);
+
+    // Convert: apply a read and checked block, in the RS274NGC order of execution (postproc/interp_convert.cpp).
+    /// Passes the block through; its positions (and with why.forgetMotion its motion mode) become unknown.
+    void refuse(BlockResult& r, const Refusal& why);
+    /// Every modal code of the block, in order; a refusal stops the block (the codes before it have taken effect).
+    Refusal convertModalCodes(const BlockWords& w, const GCodes& g, const LexedBlock& b, BlockResult& r,
+                              ProgramMode modeBefore);
+    void convertFeedPlaneUnits(const BlockWords& w, const GCodes& g, BlockResult& r);
+    void convertToolLength(const BlockWords& w, const GCodes& g, const LexedBlock& b, BlockResult& r);
+    Refusal convertWorkOffset(const BlockWords& w, const GCodes& g);
+    void convertModes(const BlockWords& w, const GCodes& g, const LexedBlock& b, BlockResult& r, ProgramMode modeBefore);
+    Refusal convertMotionMode(const BlockWords& w, const GCodes& g, BlockResult& r);
+    /// The non-modal code that uses the axis words for something else (G4, G10, G28, G52, G92, G31 …); true when it
+    /// ends the block.
+    bool convertNonModal(const BlockWords& w, const GCodes& g, const LexedBlock& b, BlockResult& r);
+    void convertOffsetData(const BlockWords& w, const LexedBlock& b, BlockResult& r);
+    /// The block's tool vector in TCP vector mode (Fanuc G43.5 I J K, Sinumerik A3= B3= C3=).
+    Refusal convertToolVector(const BlockWords& w, const LexedBlock& b, BlockResult& r);
+    /// The block's axis motion: its targets, a move evaluated or the reason it is not.
+    void convertMotion(const BlockWords& w, const LexedBlock& b, BlockResult& r, bool onlyModal, bool machineCoordinates);
+    /// A move that is not corrected (machine coordinates, transformation, cycle, unknown position …): true when it was
+    /// passed through.
+    bool refuseMove(const BlockWords& w, BlockResult& r, bool machineCoordinates, const char* targetProblem);
 
     AxisLayout layout_;
     InterpreterOptions options_;

@@ -8,7 +8,7 @@
 #include "postproc/block_writer.hpp"
 #include "postproc/klartext_reader.hpp"
 #include "postproc/line_reader.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 
 namespace cnccomp::pp {
 

@@ -12,7 +12,7 @@
 
 #include "cnccomp/io/deviation_csv.hpp"
 #include "postproc/dialect.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::pp {

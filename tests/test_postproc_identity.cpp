@@ -9,7 +9,7 @@
 
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::pp {

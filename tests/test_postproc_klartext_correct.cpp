@@ -26,7 +26,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/plan_xml.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 #include "postproc/testprog/test_program.hpp"
 #include "test_postproc_xyzac.hpp"
 #include "test_support.hpp"
@@ -324,7 +324,7 @@ TEST(PostprocKlartextCorrect, ZeroDeviationsKeepEveryByte) {
     for (const auto& [machine, plan] : {std::pair{"table-table-ac", "dbb5-table-table-ac"}, std::pair{"multitasking", "multitasking-six-circles"}}) {
         const MachineModel& m = test::sampleMachine(machine);
         testprog::TestProgramOptions o;
-        o.dialect = testprog::ProgramDialect::Heidenhain;
+        o.dialect = pp::Dialect::Heidenhain;
         for (const auto& p : testprog::makeTestPrograms(m, readPlanXml(test::sourcePath(fmt::format("samples/plans/{}.xml", plan))), o).programs) {
             CorrectOptions co;
             co.setup.defaultToolLength = 100;

@@ -261,5 +261,36 @@ TEST(PostprocDialect, DetectsUnambiguousProgramsOnly) {
     EXPECT_FALSE(parseDialect("heidenhain"));
 }
 
+// One name table for reading, correcting and writing test programs. Oracle: the names each command accepted before the
+// two tables (pp::parseDialect, testprog::parseProgramDialect) were made one, transcribed from those two functions and
+// the CLI (`correct` added heidenhain and klartext to the reader's names).
+TEST(PostprocDialect, OneNameTableServesEveryUse) {
+    using U = DialectUse;
+    const auto accepted = [](U use) {
+        std::vector<std::string> names;
+        for (const char* n : {"rs274ngc", "linuxcnc", "rs274", "ngc", "fanuc", "haas", "sinumerik", "siemens", "printer",
+                              "marlin", "reprap", "3d-printer", "heidenhain", "klartext", "tnc", "auto", "iso"})
+            if (parseDialect(n, use)) names.emplace_back(n);
+        return names;
+    };
+    using V = std::vector<std::string>;
+    EXPECT_EQ(accepted(U::Read), (V{"rs274ngc", "linuxcnc", "rs274", "ngc", "fanuc", "haas", "sinumerik", "siemens",
+                                    "printer", "marlin", "reprap", "3d-printer"}));
+    EXPECT_EQ(accepted(U::Correct), (V{"rs274ngc", "linuxcnc", "rs274", "ngc", "fanuc", "haas", "sinumerik", "siemens",
+                                       "printer", "marlin", "reprap", "3d-printer", "heidenhain", "klartext"}));
+    EXPECT_EQ(accepted(U::Write), (V{"rs274ngc", "linuxcnc", "ngc", "fanuc", "sinumerik", "siemens", "heidenhain",
+                                     "klartext", "tnc"}));
+    EXPECT_EQ(parseDialect("TNC", U::Write), Dialect::Heidenhain);  // case-insensitive
+    EXPECT_EQ(parseDialect("klartext", U::Correct), Dialect::Heidenhain);
+    // The names the error messages list, and the names the programs and summaries carry.
+    EXPECT_EQ(dialectNames(U::Read), "rs274ngc, fanuc, sinumerik, printer");
+    EXPECT_EQ(dialectNames(U::Correct), "rs274ngc, fanuc, sinumerik, printer, heidenhain");
+    EXPECT_EQ(dialectNames(U::Write), "linuxcnc, fanuc, sinumerik, heidenhain");
+    EXPECT_STREQ(dialectName(Dialect::Rs274ngc), "rs274ngc");
+    EXPECT_STREQ(dialectName(Dialect::Rs274ngc, U::Write), "linuxcnc");
+    EXPECT_STREQ(dialectName(Dialect::Heidenhain), "heidenhain");
+    EXPECT_STREQ(dialectName(Dialect::Printer, U::Write), "printer");
+}
+
 }  // namespace
 }  // namespace cnccomp::pp

@@ -11,7 +11,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
 #include "postproc/lexer.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::pp {

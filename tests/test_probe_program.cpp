@@ -25,29 +25,29 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
     // for the ISO dialects) and every rapid (readPoses, the post-processor's modal reader) against the commands.
     const MachineModel& m = tableTable();
     const MeasurementPlan plan = samplePlan();
-    for (auto d : {testprog::ProgramDialect::LinuxCnc, testprog::ProgramDialect::Fanuc, testprog::ProgramDialect::Sinumerik,
-                   testprog::ProgramDialect::Heidenhain}) {
+    for (auto d : {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
+                   pp::Dialect::Heidenhain}) {
         testprog::ProbeProgramOptions o;
         o.dialect = d;
         const testprog::ProbeProgram p = testprog::makeProbeProgram(m, plan, o);
         ASSERT_EQ(p.touches, 115);
         ASSERT_EQ(p.targets.size(), 115u);
         const std::string& text = p.files[0].text;
-        const auto targets = testprog::readProbeTargets(m, text, testprog::readerDialect(d), p.files[0].file);
-        ASSERT_EQ(targets.size(), p.targets.size()) << testprog::programDialectName(d);
+        const auto targets = testprog::readProbeTargets(m, text, d, p.files[0].file);
+        ASSERT_EQ(targets.size(), p.targets.size()) << pp::dialectName(d, pp::DialectUse::Write);
         for (size_t i = 0; i < targets.size(); ++i)
             EXPECT_LT((targets[i] - p.targets[i].target).cwiseAbs().maxCoeff(), 1e-6)
-                << testprog::programDialectName(d) << " touch " << i;
+                << pp::dialectName(d, pp::DialectUse::Write) << " touch " << i;
         // Lines < 255 characters (LinuxCNC's LINELEN), the header says the kinematics mode.
         std::istringstream in(text);
         for (std::string l; std::getline(in, l);) EXPECT_LT(l.size(), 255u) << l;
-        if (d == testprog::ProgramDialect::Heidenhain) {
+        if (d == pp::Dialect::Heidenhain) {
             ASSERT_EQ(p.files.size(), 2u);  // the FN 16 format file
             EXPECT_NE(p.files[1].text.find("TOUCH %1.0LF"), std::string::npos);
             continue;
         }
         // Every approach point is a rapid the modal reader finds, in order.
-        const auto rows = testprog::readPoses(m, text, testprog::readerDialect(d), p.files[0].file);
+        const auto rows = testprog::readPoses(m, text, d, p.files[0].file);
         size_t next = 0;
         for (const auto& r : rows) {
             if (next == p.targets.size()) break;
@@ -59,7 +59,7 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
             }
             if (same) ++next;
         }
-        EXPECT_EQ(next, p.targets.size()) << testprog::programDialectName(d);
+        EXPECT_EQ(next, p.targets.size()) << pp::dialectName(d, pp::DialectUse::Write);
     }
 }
 

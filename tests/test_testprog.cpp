@@ -26,10 +26,9 @@
 namespace cnccomp {
 namespace {
 
-using testprog::ProgramDialect;
 
-constexpr ProgramDialect kDialects[] = {ProgramDialect::LinuxCnc, ProgramDialect::Fanuc, ProgramDialect::Sinumerik,
-                                        ProgramDialect::Heidenhain};
+constexpr pp::Dialect kDialects[] = {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
+                                        pp::Dialect::Heidenhain};
 
 struct SamplePlan {
     std::string file;
@@ -93,15 +92,15 @@ TEST(TestPrograms, EveryDialectReadsBackToTheSimulationsPosesForEverySamplePlan)
     ASSERT_GE(samplePlans().size(), 8u);
     for (const SamplePlan& sp : samplePlans()) {
         const auto motions = testprog::planMotions(sp.machine, sp.plan);
-        for (ProgramDialect d : kDialects) {
+        for (pp::Dialect d : kDialects) {
             testprog::TestProgramOptions o;
             o.dialect = d;
             const auto set = testprog::makeTestPrograms(sp.machine, sp.plan, o);
             ASSERT_EQ(set.programs.size(), motions.size());
             for (size_t i = 0; i < motions.size(); ++i) {
                 const auto& r = motions[i];
-                const std::string where = sp.file + " " + testprog::programDialectName(d) + " run " + r.name;
-                const auto back = testprog::readTestProgram(sp.machine, r, set.programs[i].text, testprog::readerDialect(d), where);
+                const std::string where = sp.file + " " + pp::dialectName(d, pp::DialectUse::Write) + " run " + r.name;
+                const auto back = testprog::readTestProgram(sp.machine, r, set.programs[i].text, d, where);
                 expectSamePose(sp.machine, back.setup, simulationSetup(sp.machine, r), where + " setup");
                 const std::vector<double> samples = simulationSamples(r);
                 ASSERT_EQ(back.passes.size(), 2u) << where;
@@ -331,30 +330,30 @@ TEST(TestPrograms, ProgramsStartAndEndInTheirDialectsFrame) {
         if (sp.file == "multitasking-six-circles.xml") six = &sp;
     ASSERT_TRUE(six);
     const auto motions = testprog::planMotions(six->machine, six->plan);
-    const auto text = [&](ProgramDialect d) {
+    const auto text = [&](pp::Dialect d) {
         testprog::TestProgramOptions o;
         o.dialect = d;
         return testprog::makeTestProgram(six->machine, motions[3], 4, o).text;
     };
-    const std::string fanuc = text(ProgramDialect::Fanuc);
+    const std::string fanuc = text(pp::Dialect::Fanuc);
     EXPECT_EQ(fanuc.rfind("%\nO1004 (TP04_C_RADIAL)\n", 0), 0u) << fanuc.substr(0, 40);
     EXPECT_NE(fanuc.find("G10 L2 P1 X0.000000 Y0.000000 Z0.000000 B0.000000 C0.000000"), std::string::npos);
     EXPECT_EQ(fanuc.substr(fanuc.size() - 2), "%\n");
-    const std::string siemens = text(ProgramDialect::Sinumerik);
+    const std::string siemens = text(pp::Dialect::Sinumerik);
     EXPECT_NE(siemens.find("G500"), std::string::npos);
     EXPECT_NE(siemens.find("; CNCCOMP PASS 1 CW BEGIN"), std::string::npos);
-    const std::string ngc = text(ProgramDialect::LinuxCnc);
+    const std::string ngc = text(pp::Dialect::Rs274ngc);
     EXPECT_NE(ngc.find("(MSG, MOUNT THE BAR"), std::string::npos);
     EXPECT_NE(ngc.find(" G2 X"), std::string::npos) << "C-radial circles: XY plane, CW first";
     EXPECT_EQ(ngc.find("G18"), std::string::npos);
-    const std::string h = text(ProgramDialect::Heidenhain);
+    const std::string h = text(pp::Dialect::Heidenhain);
     EXPECT_EQ(h.find(" CC X"), std::string::npos) << "C turns with the circle: straight blocks on a TNC [G]";
     EXPECT_NE(h.find(" L X+"), std::string::npos);
     // A DBB5 linear circle has no rotary axis in it: CC and C blocks, clockwise first.
     for (const auto& sp : samplePlans())
         if (sp.file == "dbb5-table-table-ac.xml") {
             testprog::TestProgramOptions o;
-            o.dialect = ProgramDialect::Heidenhain;
+            o.dialect = pp::Dialect::Heidenhain;
             const auto p = testprog::makeTestProgram(sp.machine, testprog::planMotions(sp.machine, sp.plan)[0], 1, o);
             EXPECT_TRUE(p.arcs);
             EXPECT_NE(p.text.find(" CC X+0.000000 Y+0.000000"), std::string::npos);
@@ -384,7 +383,7 @@ TEST(TestPrograms, LinearCircleEveryDialectReadsBackThePlansCircleFeedAndDirecti
     const MeasurementPlan plan = readPlanXml(dir.file("p.xml"));
     const auto motions = testprog::planMotions(m, plan);
     ASSERT_EQ(motions.size(), 2u);
-    for (ProgramDialect d : kDialects) {
+    for (pp::Dialect d : kDialects) {
         testprog::TestProgramOptions o;
         o.dialect = d;
         o.feed = 333;          // the plan's feed wins for circles
@@ -394,7 +393,7 @@ TEST(TestPrograms, LinearCircleEveryDialectReadsBackThePlansCircleFeedAndDirecti
         for (size_t i = 0; i < 2; ++i) {
             const testprog::TestProgram& p = set.programs[i];
             const LinearCircleRun& c = plan.circleRuns[i];
-            const std::string where = std::string(testprog::programDialectName(d)) + " " + c.name;
+            const std::string where = std::string(pp::dialectName(d, pp::DialectUse::Write)) + " " + c.name;
             EXPECT_TRUE(p.arcs) << where;
             EXPECT_EQ(p.kind, testprog::RunKind::LinearCircle);
             EXPECT_EQ(p.firstPass, i == 0 ? "CCW" : "CW") << where;
@@ -402,7 +401,7 @@ TEST(TestPrograms, LinearCircleEveryDialectReadsBackThePlansCircleFeedAndDirecti
             EXPECT_EQ(p.samples, c.dataAnglesDeg().size());
             EXPECT_NE(p.text.find(fmt::format("F{:g}", c.capture.feed)), std::string::npos) << where;
             EXPECT_EQ(p.text.find("F333"), std::string::npos) << where;
-            const auto back = testprog::readTestProgram(m, motions[i], p.text, testprog::readerDialect(d), where);
+            const auto back = testprog::readTestProgram(m, motions[i], p.text, d, where);
             expectSamePose(m, back.setup, linearCircleCentreCommands(m, c), where + " setup");
             ASSERT_EQ(back.passes.size(), 2u);
             EXPECT_EQ(back.passes[0].label, i == 0 ? "CCW" : "CW") << where;

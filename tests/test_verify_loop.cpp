@@ -20,7 +20,7 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "app/verify.hpp"
 #include "app/verify_sources.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 #include "postproc/testprog/test_program.hpp"
 #include "test_support.hpp"
 
@@ -309,8 +309,8 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
     for (const Case& c : kCases) {
         const Loop l = load(c);
         const DeviationSet identified = c.correctWithTruth ? *l.truth : simulateAndIdentify(l, 0.0);
-        for (const auto& [dialect, reader] : {std::pair{testprog::ProgramDialect::LinuxCnc, pp::Dialect::Rs274ngc},
-                                              std::pair{testprog::ProgramDialect::Heidenhain, pp::Dialect::Heidenhain}}) {
+        for (const auto& [dialect, reader] : {std::pair{pp::Dialect::Rs274ngc, pp::Dialect::Rs274ngc},
+                                              std::pair{pp::Dialect::Heidenhain, pp::Dialect::Heidenhain}}) {
             // testprog → cnccomp correct (with the run's tool length, as each program's header says) → verify.
             const auto motions = testprog::planMotions(l.machine, l.plan);
             testprog::TestProgramOptions to;

@@ -47,7 +47,7 @@
 namespace cnccomp::testprog {
 
 struct ProbeProgramOptions {
-    ProgramDialect dialect = ProgramDialect::LinuxCnc;
+    pp::Dialect dialect = pp::Dialect::Rs274ngc;
     std::string log = "cnccomp-probe.txt";  ///< result file the program writes (LinuxCNC LOGOPEN, Sinumerik WRITE, …)
     int decimals = 6;
     std::string machineFile, planFile;      ///< for the header (file names only)
@@ -69,7 +69,7 @@ struct ProbeProgram {
 };
 
 /// File name of the probing program: "probe" + the dialect's extension ("PROBE.h" for HEIDENHAIN).
-std::string probeProgramFileName(ProgramDialect d);
+std::string probeProgramFileName(pp::Dialect d);
 
 /// The probing program of the plan's sphere runs. Throws ModelError (sphereCommands) naming the run, pose and touch
 /// for a point outside the travel; the plan must have sphere runs.

@@ -9,44 +9,15 @@
 
 namespace cnccomp::testprog {
 
-std::optional<ProgramDialect> parseProgramDialect(std::string_view name) {
-    std::string n;
-    for (char c : name) n.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
-    if (n == "linuxcnc" || n == "rs274ngc" || n == "ngc") return ProgramDialect::LinuxCnc;
-    if (n == "fanuc") return ProgramDialect::Fanuc;
-    if (n == "sinumerik" || n == "siemens") return ProgramDialect::Sinumerik;
-    if (n == "heidenhain" || n == "klartext" || n == "tnc") return ProgramDialect::Heidenhain;
-    return std::nullopt;
-}
-
-const char* programDialectName(ProgramDialect d) {
+const char* programExtension(pp::Dialect d) {
     switch (d) {
-        case ProgramDialect::LinuxCnc: return "linuxcnc";
-        case ProgramDialect::Fanuc: return "fanuc";
-        case ProgramDialect::Sinumerik: return "sinumerik";
-        case ProgramDialect::Heidenhain: return "heidenhain";
-    }
-    return "?";
-}
-
-const char* programExtension(ProgramDialect d) {
-    switch (d) {
-        case ProgramDialect::LinuxCnc: return ".ngc";
-        case ProgramDialect::Fanuc: return ".nc";
-        case ProgramDialect::Sinumerik: return ".mpf";
-        case ProgramDialect::Heidenhain: return ".h";
+        case pp::Dialect::Rs274ngc: return ".ngc";
+        case pp::Dialect::Fanuc: return ".nc";
+        case pp::Dialect::Sinumerik: return ".mpf";
+        case pp::Dialect::Heidenhain: return ".h";
+        case pp::Dialect::Printer: break;
     }
     return ".nc";
-}
-
-pp::Dialect readerDialect(ProgramDialect d) {
-    switch (d) {
-        case ProgramDialect::LinuxCnc: return pp::Dialect::Rs274ngc;
-        case ProgramDialect::Fanuc: return pp::Dialect::Fanuc;
-        case ProgramDialect::Sinumerik: return pp::Dialect::Sinumerik;
-        case ProgramDialect::Heidenhain: return pp::Dialect::Heidenhain;
-    }
-    return pp::Dialect::Rs274ngc;
 }
 
 std::string ProgramSyntax::number(double v, bool plus) const {
@@ -100,25 +71,25 @@ namespace {
 /// The ISO (DIN 66025) family: every code block numbered N1, N2, …; I/J/K incremental arc centres.
 class IsoSyntax : public ProgramSyntax {
 public:
-    IsoSyntax(ProgramDialect d, const MachineModel& m, int decimals) : ProgramSyntax(m, decimals), d_(d) {}
+    IsoSyntax(pp::Dialect d, const MachineModel& m, int decimals) : ProgramSyntax(m, decimals), d_(d) {}
 
     void begin(const std::string& name, int number) override {
-        if (d_ == ProgramDialect::Fanuc) {
+        if (d_ == pp::Dialect::Fanuc) {
             emit("%");
             emit(fmt::format("O{:04d} ({})", number, clean(name, true, true)));
         }
     }
     void comment(std::string_view text) override {
         switch (d_) {
-            case ProgramDialect::LinuxCnc: emit(fmt::format("({})", clean(text, true, false))); break;
-            case ProgramDialect::Fanuc: emit(fmt::format("({})", clean(text, true, true))); break;
+            case pp::Dialect::Rs274ngc: emit(fmt::format("({})", clean(text, true, false))); break;
+            case pp::Dialect::Fanuc: emit(fmt::format("({})", clean(text, true, true))); break;
             default: emit(fmt::format("; {}", clean(text, false, false))); break;
         }
     }
     void init() override {
         const std::string datum = fmt::format(" {}", axisWords(AxisVector::Zero(machine_.axisCount()), allAxes(), false));
         switch (d_) {
-            case ProgramDialect::LinuxCnc:
+            case pp::Dialect::Rs274ngc:
                 block("G17 G21 G40 G49 G80 G90 G94");
                 block("G91.1 G61");                 // arc centres incremental; exact path (no blending)
                 block("G10 L2 P1" + datum);          // G54 = machine coordinates
@@ -128,7 +99,7 @@ public:
                     zShift_ = toolLength_;
                 }
                 break;
-            case ProgramDialect::Fanuc:
+            case pp::Dialect::Fanuc:
                 block("G17 G21 G40 G49 G80 G90 G94");
                 block("G10 L2 P1" + datum);          // G54 = machine coordinates (programmable data input)
                 block("G54");
@@ -168,7 +139,7 @@ public:
     }
     bool arcsWithRotaryAxes() const override { return true; }
     bool passToolLength(double length) override {
-        if (d_ != ProgramDialect::LinuxCnc || length == 0 || machine_.axisIndex("Z") < 0 ||
+        if (d_ != pp::Dialect::Rs274ngc || length == 0 || machine_.axisIndex("Z") < 0 ||
             machine_.axisLink(machine_.axisIndex("Z")).kind != AxisKind::Linear)
             return false;
         toolLength_ = length;
@@ -176,30 +147,30 @@ public:
     }
     void dwell(double seconds) override {
         switch (d_) {
-            case ProgramDialect::LinuxCnc: block("G4 P" + plain(seconds)); break;
-            case ProgramDialect::Fanuc: block(fmt::format("G4 P{}", static_cast<long>(std::lround(seconds * 1000)))); break;
+            case pp::Dialect::Rs274ngc: block("G4 P" + plain(seconds)); break;
+            case pp::Dialect::Fanuc: block(fmt::format("G4 P{}", static_cast<long>(std::lround(seconds * 1000)))); break;
             default: block("G4 F" + plain(seconds)); break;
         }
     }
     void stop(std::string_view message) override {
         switch (d_) {
-            case ProgramDialect::LinuxCnc:
+            case pp::Dialect::Rs274ngc:
                 emit("(MSG, " + clean(message, true, false) + ")");
                 block("M0");
                 break;
-            case ProgramDialect::Fanuc: block("M0 (" + clean(message, true, true) + ")"); break;
+            case pp::Dialect::Fanuc: block("M0 (" + clean(message, true, true) + ")"); break;
             default: block("M0 ; " + clean(message, false, false)); break;
         }
     }
     void end() override {
         if (zShift_ != 0) block("G49");
         block("M30");
-        if (d_ == ProgramDialect::Fanuc) emit("%");
+        if (d_ == pp::Dialect::Fanuc) emit("%");
     }
     std::vector<std::string> unconfirmed() const override {
         switch (d_) {
-            case ProgramDialect::LinuxCnc: return {};
-            case ProgramDialect::Fanuc:
+            case pp::Dialect::Rs274ngc: return {};
+            case pp::Dialect::Fanuc:
                 return {"[G] circular blocks carry the rotary axes as additional helical axes (helical interpolation B)",
                         "[G] G10 L2 P1 needs programmable data input; six decimals need increment system IS-C or finer"};
             default:
@@ -221,7 +192,7 @@ private:
             if (mask & (1u << a)) pos_[a] = p[a];
     }
 
-    ProgramDialect d_;
+    pp::Dialect d_;
     long n_ = 0;
     int plane_ = 17;
     double toolLength_ = 0;  ///< passToolLength's L; zShift_ takes it only once G43.1 is written (init's G10 datum
@@ -297,9 +268,12 @@ private:
 
 }  // namespace
 
-std::unique_ptr<ProgramSyntax> ProgramSyntax::make(ProgramDialect d, const MachineModel& machine, int decimals) {
+std::unique_ptr<ProgramSyntax> ProgramSyntax::make(pp::Dialect d, const MachineModel& machine, int decimals) {
     if (decimals < 0 || decimals > 9) throw ModelError(fmt::format("decimals must be between 0 and 9, not {}", decimals));
-    if (d == ProgramDialect::Heidenhain) return std::make_unique<KlartextSyntax>(machine, decimals);
+    if (d == pp::Dialect::Printer)
+        throw ModelError(fmt::format("test programs are written in {}, not for a printer",
+                                     pp::dialectNames(pp::DialectUse::Write)));
+    if (d == pp::Dialect::Heidenhain) return std::make_unique<KlartextSyntax>(machine, decimals);
     return std::make_unique<IsoSyntax>(d, machine, decimals);
 }
 

@@ -18,15 +18,12 @@
 
 namespace cnccomp::testprog {
 
-enum class ProgramDialect { LinuxCnc, Fanuc, Sinumerik, Heidenhain };
+// The dialect of a test program is pp::Dialect (postproc/dialect.hpp; its names for test programs:
+// pp::parseDialect / pp::dialectName with pp::DialectUse::Write): Rs274ngc (LinuxCNC), Fanuc, Sinumerik, Heidenhain.
+// Printer is not a test-program dialect: ProgramSyntax::make refuses it.
 
-/// "linuxcnc" (or "rs274ngc"), "fanuc", "sinumerik" (or "siemens"), "heidenhain" (or "klartext", "tnc"); nullopt otherwise.
-std::optional<ProgramDialect> parseProgramDialect(std::string_view name);
-const char* programDialectName(ProgramDialect d);
 /// File extension with the dot: ".ngc", ".nc", ".mpf", ".h".
-const char* programExtension(ProgramDialect d);
-/// The post-processor dialect that reads such a program back (`cnccomp poses`).
-pp::Dialect readerDialect(ProgramDialect d);
+const char* programExtension(pp::Dialect d);
 
 /// Plane of a circular block: 17 (X, Y), 18 (Z, X), 19 (Y, Z).
 struct ArcBlock {
@@ -39,7 +36,7 @@ struct ArcBlock {
 class ProgramSyntax {
 public:
     /// `decimals`: digits after the point of positions (mm and deg).
-    static std::unique_ptr<ProgramSyntax> make(ProgramDialect d, const MachineModel& machine, int decimals);
+    static std::unique_ptr<ProgramSyntax> make(pp::Dialect d, const MachineModel& machine, int decimals);
     virtual ~ProgramSyntax() = default;
 
     /// Program start; `number` is the Fanuc O number.

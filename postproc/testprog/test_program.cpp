@@ -17,7 +17,7 @@
 
 namespace cnccomp::testprog {
 
-std::string programFileName(const std::string& run, int order, ProgramDialect d) {
+std::string programFileName(const std::string& run, int order, pp::Dialect d) {
     std::string s = fmt::format("TP{:02d}_", order);
     for (char c : run) s.push_back(std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_');
     return s + programExtension(d);
@@ -206,13 +206,13 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
         syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no work offset; "
                                     "G43.1 Z{:g} gives the tool length: LinuxCNC adds it to every Z word, so Z is written as "
                                     "the machine coordinate minus {:g}",
-                                    programDialectName(o.dialect), r.toolLength, r.toolLength));
+                                    pp::dialectName(o.dialect, pp::DialectUse::Write), r.toolLength, r.toolLength));
         syntax->comment("cnccomp's LinuxCNC kinematics component (emit --controller linuxcnc) keeps the tool tip at that length exact "
                         "where the tool axis cannot follow");
     } else {
         syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no tool length or "
                                     "work offset active",
-                                    programDialectName(o.dialect)));
+                                    pp::dialectName(o.dialect, pp::DialectUse::Write)));
     }
     // The mode the controller must run the program in, which verify also runs it in.
     syntax->comment(kKinematicsModeLine);

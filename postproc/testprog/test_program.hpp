@@ -29,7 +29,7 @@ inline constexpr const char* kKinematicsModeLine =
     "Sinumerik TRAORI off, Heidenhain M128/FUNCTION TCPM off, Fanuc G43.4/G43.5 off)";
 
 struct TestProgramOptions {
-    ProgramDialect dialect = ProgramDialect::LinuxCnc;
+    pp::Dialect dialect = pp::Dialect::Rs274ngc;
     double feed = 1000.0;        ///< mm/min along the sweep and the overshoot arcs
     double approachFeed = 500.0; ///< mm/min onto the setup and start poses
     double overshootDeg = 10.0;  ///< feed-in / feed-out overshoot, in units of the sweep parameter (deg); reduced where
@@ -60,7 +60,7 @@ struct TestProgramSet {
 
 /// File name of the program of run number `order` (from 1): "TP01_<run>" with characters other than letters,
 /// digits and '_' replaced by '_', plus the dialect's extension.
-std::string programFileName(const std::string& run, int order, ProgramDialect d);
+std::string programFileName(const std::string& run, int order, pp::Dialect d);
 
 /// The program of one run. Throws ModelError naming the run and the axis when a command the measurement needs (setup,
 /// approach, sweep) leaves an axis' travel; the overshoot is shortened instead.

@@ -244,7 +244,7 @@ void volumetric(const MachineModel& m, const DeviationSet& simulated, const cont
 /// post-processor).
 RunCommands writtenCommands(const MachineModel& m, const testprog::RunMotion& r, const testprog::TestProgram& prog,
                             const VerifyOptions& options) {
-    return samplesOf(r, testprog::readTestProgram(m, r, prog.text, testprog::readerDialect(options.dialect), prog.file));
+    return samplesOf(r, testprog::readTestProgram(m, r, prog.text, options.dialect, prog.file));
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const 
                                                                           const DeviationSet& identified);
 
 struct VerifyOptions {
-    testprog::ProgramDialect dialect = testprog::ProgramDialect::LinuxCnc;  ///< the in-memory test programs
+    pp::Dialect dialect = pp::Dialect::Rs274ngc;  ///< the in-memory test programs
     int volumetricPerAxis = 5;  ///< grid over the plan's workspace: samples per axis
 };
 

@@ -80,9 +80,9 @@ namespace {
 
 std::optional<pp::Dialect> dialectOfExtension(std::string ext) {
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    for (auto d : {testprog::ProgramDialect::LinuxCnc, testprog::ProgramDialect::Fanuc, testprog::ProgramDialect::Sinumerik,
-                   testprog::ProgramDialect::Heidenhain})
-        if (ext == testprog::programExtension(d)) return testprog::readerDialect(d);
+    for (auto d : {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
+                   pp::Dialect::Heidenhain})
+        if (ext == testprog::programExtension(d)) return d;
     return std::nullopt;
 }
 
@@ -123,7 +123,7 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
     std::vector<std::string> missing;
     std::optional<pp::Dialect> dialect;
     for (size_t i = 0; i < motions.size(); ++i) {
-        const std::string stem = testprog::programFileName(motions[i].name, static_cast<int>(i) + 1, testprog::ProgramDialect::LinuxCnc);
+        const std::string stem = testprog::programFileName(motions[i].name, static_cast<int>(i) + 1, pp::Dialect::Rs274ngc);
         const std::string base = stem.substr(0, stem.rfind('.'));
         const controllers::OutputFile* found = nullptr;
         for (const auto& f : files)

@@ -32,13 +32,13 @@ double componentSpan(const std::vector<Vec3>& d) {
 }  // namespace
 
 std::vector<VerifyRun> verifySphereRuns(const MachineModel& m, const MeasurementPlan& plan, const Kinematics& k,
-                                        const controllers::AppliedCompensation& model, testprog::ProgramDialect dialect) {
+                                        const controllers::AppliedCompensation& model, pp::Dialect dialect) {
     testprog::ProbeProgramOptions po;
     po.dialect = dialect;
     const testprog::ProbeProgram prog = testprog::makeProbeProgram(m, plan, po);
     // The probing targets as written, read back by cnccomp's reader.
     const std::vector<AxisVector> targets =
-        testprog::readProbeTargets(m, prog.files[0].text, testprog::readerDialect(dialect), prog.files[0].file);
+        testprog::readProbeTargets(m, prog.files[0].text, dialect, prog.files[0].file);
     if (targets.size() != prog.targets.size())
         throw ModelError(fmt::format("verify: the probing program reads back {} probing moves, the plan has {}", targets.size(),
                                      prog.targets.size()));

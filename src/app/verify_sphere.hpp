@@ -11,6 +11,6 @@ namespace cnccomp::app {
 /// frame), span = largest span of a component (as the R-test's displacements). `model` null = no compensation after.
 /// Throws ModelError naming the pose and touch when a probing move misses the sphere.
 std::vector<VerifyRun> verifySphereRuns(const MachineModel& machine, const MeasurementPlan& plan, const Kinematics& simulated,
-                                        const controllers::AppliedCompensation& model, testprog::ProgramDialect dialect);
+                                        const controllers::AppliedCompensation& model, pp::Dialect dialect);
 
 }  // namespace cnccomp::app

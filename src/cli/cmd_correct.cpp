@@ -15,7 +15,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/io/text_util.hpp"
-#include "postproc/processor.hpp"
+#include "postproc/correct_program.hpp"
 
 namespace cnccomp::cli {
 namespace {
@@ -55,11 +55,11 @@ pp::Setup setupOf(const std::string& file, const std::string& toolTable, const s
 
 std::optional<pp::Dialect> dialectOf(const std::string& name) {
     if (name == "auto") return std::nullopt;
-    if (name == "heidenhain" || name == "klartext") return pp::Dialect::Heidenhain;  // also detected from BEGIN PGM
-    const auto d = pp::parseDialect(name);
+    // HEIDENHAIN Klartext is also detected from BEGIN PGM.
+    const auto d = pp::parseDialect(name, pp::DialectUse::Correct);
     if (!d)
         throw InputError("--dialect", 0,
-                         fmt::format("unknown dialect '{}' (auto, rs274ngc, fanuc, sinumerik, printer, heidenhain)", name));
+                         fmt::format("unknown dialect '{}' (auto, {})", name, pp::dialectNames(pp::DialectUse::Correct)));
     return d;
 }
 

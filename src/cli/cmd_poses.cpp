@@ -26,7 +26,7 @@ void run(const Options& o) {
     if (o.dialect != "auto") {
         po.dialect = pp::parseDialect(o.dialect);
         if (!po.dialect)
-            throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, rs274ngc, fanuc, sinumerik, printer)", o.dialect));
+            throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, {})", o.dialect, pp::dialectNames(pp::DialectUse::Read)));
     }
     if (!o.setup.empty()) po.setup.readFile(o.setup);
     if (!o.toolTable.empty()) po.setup.readToolTable(o.toolTable);

@@ -20,8 +20,8 @@ struct Options {
 };
 
 void run(Options o) {
-    const auto d = testprog::parseProgramDialect(o.dialect);
-    if (!d) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (linuxcnc, fanuc, sinumerik, heidenhain)", o.dialect));
+    const auto d = pp::parseDialect(o.dialect, pp::DialectUse::Write);
+    if (!d) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' ({})", o.dialect, pp::dialectNames(pp::DialectUse::Write)));
     o.program.dialect = *d;
     const MachineModel m = readMachineXml(o.machine);
     const MeasurementPlan plan = readPlanXml(o.plan);

@@ -91,8 +91,8 @@ void run(const Options& o) {
     const MeasurementPlan plan = readPlanXml(o.plan);
     const std::string source = !o.compensation.empty() ? o.compensation : o.identified;
     if (source.empty()) throw InputError("--compensation", 0, "give the compensation to verify (deviation CSV or folder)");
-    const auto dialect = testprog::parseProgramDialect(o.dialect);
-    if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (linuxcnc, fanuc, sinumerik, heidenhain)", o.dialect));
+    const auto dialect = pp::parseDialect(o.dialect, pp::DialectUse::Write);
+    if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' ({})", o.dialect, pp::dialectNames(pp::DialectUse::Write)));
     if (o.maxResidualUm && !(*o.maxResidualUm >= 0)) throw InputError("--max-residual-um", 0, "expected a number >= 0");
     if (o.maxVolumetricUm && !(*o.maxVolumetricUm >= 0)) throw InputError("--max-volumetric-um", 0, "expected a number >= 0");
     namespace fs = std::filesystem;
