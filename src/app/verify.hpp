@@ -118,7 +118,7 @@ struct VerifyRemaining {
 /// error (max) after exceeds the one before by more than its allowance. Allowance = max(0.1 µm, 1 % of before).
 /// Why: verify simulates the readings without noise, so after and before differ only by what the compensation does
 /// and by the rounding of the values in its files; 0.1 µm is what the closed loop holds every backend to for what it
-/// claims (tests/test_verify_loop.cpp, README "Test programs and verification"), and below the 0.2–0.5 µm reading noise
+/// claims (tests/app/test_verify_loop.cpp, README "Test programs and verification"), and below the 0.2–0.5 µm reading noise
 /// the samples simulate for a ball bar. The 1 % leaves alone a compensation that changes a large error by less than
 /// an engineer would act on ([G] a judgement, not a figure of a standard).
 struct VerifyWorse {

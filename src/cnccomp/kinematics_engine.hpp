@@ -9,7 +9,7 @@
 // KinematicsModel is immutable and may be shared between threads. KinematicsData holds everything an evaluation
 // reuses from the previous ones (the last two poses of each chain, the last angles' cosines and sines); give each
 // thread its own. A Data follows the model it was last used with: handed to another model it starts empty.
-// Every evaluation agrees with cnccomp::Kinematics (tests/test_kinematics_engine.cpp: every sample machine, random
+// Every evaluation agrees with cnccomp::Kinematics (tests/core/test_kinematics_engine.cpp: every sample machine, random
 // deviations and poses, to 1e-12 mm); the last bits may differ (folded products, angle addition).
 #include <cmath>
 #include <cstdint>

@@ -15,7 +15,7 @@
 //      requested flat deviation indices followed by the nuisance parameters. DifferentiableMachine gives
 //      the exact derivative of any tool point seen from the workpiece (toolPointJacobian) and of any point
 //      fixed on either chain (bedPointJacobian). Returning false makes the engine use central finite
-//      differences on predict(). tests/test_lsq_jacobian.cpp checks every analytic Jacobian against them:
+//      differences on predict(). tests/core/identification/test_lsq_jacobian.cpp checks every analytic Jacobian against them:
 //      add a case there for a new kind.
 //   5. Build the observations of a plan with a factory (see ballbarObservations below) and hand them to
 //      identify() (identification/lsq.hpp) as std::vector<std::unique_ptr<ObservationModel>>.

@@ -7,7 +7,7 @@
 // rotary axes' location errors and with whatever the model lacks (an error motion of the table). Fitted together, the
 // squareness absorbs part of what is missing from the rotary runs: on the DBB5 B/C sample with C error motions of
 // 4–6 µm, EB0Z came out 3.86″ for a true 6.00″ and EC0Y −4.27″ for −3.00″. Fitted first from the circles of the
-// linear axes, they are 5.9″ and −3.0″ whatever the rotary runs hold (tests/test_lsq_staged_fit.cpp).
+// linear axes, they are 5.9″ and −3.0″ whatever the rotary runs hold (tests/core/identification/test_lsq_staged_fit.cpp).
 //
 // How.
 //  1. Stage 1: the runs whose observation says movesOnlyLinearAxes() are fitted alone with every requested deviation;

@@ -414,7 +414,7 @@ void ktExpectTcp(const char* what, const std::string& on, const std::string& off
     if (imp.empty()) GTEST_SKIP() << "no impeller program in ../shared/gcode-corpus";
     // Tool 1 with DL+0.5: the programmed point is the tip 30.5 mm from the spindle, for the controller's inverse too
     // (on this table machine the tool stays vertical: a length the corrector and the controller share does not move
-    // the tip; DL itself is checked by the reader's tests, tests/test_testprog_klartext.cpp).
+    // the tip; DL itself is checked by the reader's tests, tests/postproc/testprog/test_testprog_klartext.cpp).
     std::vector<std::string> blocks{"BEGIN PGM TCP MM", "TOOL CALL 1 Z S600 DL+0.5", on};
     blocks.insert(blocks.end(), imp.begin(), imp.end());
     blocks.push_back(off);

@@ -42,7 +42,7 @@ const std::vector<SamplePlan>& samplePlans() {
         std::vector<SamplePlan> out;
         for (const auto& e : std::filesystem::directory_iterator(test::sourcePath("samples/plans"))) {
             SamplePlan s{e.path().filename().string(), readPlanXml(e.path().string()), MachineModel{}};
-            if (!s.plan.sphereRuns.empty()) continue;  // probing programs: tests/test_probe_program.cpp
+            if (!s.plan.sphereRuns.empty()) continue;  // probing programs: tests/postproc/testprog/test_probe_program.cpp
             s.machine = readMachineXml(test::sourcePath("samples/machines/" + s.plan.machine + ".xml"));
             out.push_back(std::move(s));
         }

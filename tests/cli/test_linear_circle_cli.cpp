@@ -312,7 +312,7 @@ TEST(LinearCircleCli, Dbb5LinearCirclesOnAThreeAxisMachinePointToCircleRuns) {
     EXPECT_NE(r.out.find("write them as <circle> runs"), std::string::npos) << r.out;
 }
 
-// verify re-simulates the circles (tests/test_verify_circles.cpp for the figures): with the truth itself as the
+// verify re-simulates the circles (tests/app/test_verify_circles.cpp for the figures): with the truth itself as the
 // compensation only the programs' rounding is left, and the JSON is written.
 TEST(LinearCircleCli, VerifyReSimulatesTheCirclesWithTheCompensation) {
     test::ScratchDir dir("circle-cli-verify");

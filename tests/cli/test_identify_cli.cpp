@@ -53,7 +53,7 @@ TEST(IdentifyCli, LeastSquaresIsTheDefaultAndRecoversAllThirteen) {
 }
 
 // ClosedFormStillWorksExactly and UnidentifiableRequestIsReportedByName call the façade now
-// (tests/test_identify_facade.cpp).
+// (tests/app/test_identify_facade.cpp).
 
 TEST(IdentifyCli, MonteCarloSolverAndStartOptions) {
     test::ScratchDir dir("id-cli-mc");

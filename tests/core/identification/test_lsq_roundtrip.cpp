@@ -220,7 +220,7 @@ TEST(LsqRoundTrip, NloptSolverWithBounds) {
     o.solver = {};
     EXPECT_THROW(identify(m, obs, o), ModelError);
     // An algorithm given to Levenberg-Marquardt is refused (solver names as text are parsed by the application
-    // layer's options: tests/test_identify_facade.cpp).
+    // layer's options: tests/app/test_identify_facade.cpp).
     o.bounds.clear();
     o.solver = {SolverKind::LevenbergMarquardt, "LD_SLSQP"};
     EXPECT_THROW(identify(m, obs, o), ModelError);

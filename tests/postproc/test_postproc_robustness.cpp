@@ -245,7 +245,7 @@ TEST(PostprocRobustness, CommandLineErrorsNameTheProblem) {
 TEST(PostprocRobustness, HeidenhainKlartextProgramGoesToTheKlartextCorrector) {
     // A Klartext program (block numbers, BEGIN PGM, L ... R0 FMAX) looks like ISO words to the G-code lexer: it is
     // recognised from BEGIN PGM whatever --dialect says and corrected by the Klartext corrector
-    // (postproc/klartext_correct.hpp; tests/test_postproc_klartext_correct.cpp checks what it writes).
+    // (postproc/klartext_correct.hpp; tests/postproc/test_postproc_klartext_correct.cpp checks what it writes).
     test::ScratchDir dir("pp-klartext");
     const std::string m = test::sourcePath("samples/machines/table-table-ac.xml");
     const std::string d = test::sourcePath("samples/deviations/table-table-ac-truth.csv");
