@@ -32,8 +32,16 @@ std::string solverText(const SolverChoice& s) {
 
 namespace {
 
-/// The bounds' syntax without a machine: the names are checked by parseBounds.
-void checkBoundsSyntax(const std::string& text) {
+/// One item of --bounds as written: NAME=LOWER:UPPER (numbers in um or arcsec, the unit applied by parseBounds).
+struct BoundItem {
+    std::string item, name;
+    double lo = 0, hi = 0;
+};
+
+/// The items of --bounds (comma-separated, empty items skipped); ModelError naming the item whose syntax is wrong.
+/// The names are checked against the machine by parseBounds.
+std::vector<BoundItem> boundItems(const std::string& text) {
+    std::vector<BoundItem> out;
     size_t pos = 0;
     while (pos < text.size()) {
         size_t end = text.find(',', pos);
@@ -47,7 +55,9 @@ void checkBoundsSyntax(const std::string& text) {
         const auto lo = parseNumber(trim(std::string_view(item).substr(eq + 1, colon - eq - 1)));
         const auto hi = parseNumber(trim(std::string_view(item).substr(colon + 1)));
         if (!lo || !hi) throw ModelError(fmt::format("--bounds item '{}': bounds must be numbers", item));
+        out.push_back({item, std::string(trim(std::string_view(item).substr(0, eq))), *lo, *hi});
     }
+    return out;
 }
 
 }  // namespace
@@ -68,7 +78,7 @@ void validateOptions(const IdentificationOptions& o) {
     if (o.monteCarlo < 0)
         throw ModelError(fmt::format("--monte-carlo {}: Monte Carlo sample count must not be negative", o.monteCarlo));
     if (o.refine > 20) throw ModelError("--refine takes 0..20 passes");
-    checkBoundsSyntax(o.bounds);
+    (void)boundItems(o.bounds);  // the syntax, before any file is read
     // The formulas refuse every least-squares option with their own reason (the method's check).
     if (o.approach == Approach::LeastSquares && !o.bounds.empty() && !nlopt)
         throw ModelError("bounds need a bounded solver: --solver nlopt:<ALGORITHM>");
@@ -76,28 +86,14 @@ void validateOptions(const IdentificationOptions& o) {
 
 std::vector<ParameterBound> parseBounds(const MachineModel& m, const std::string& text) {
     std::vector<ParameterBound> out;
-    size_t pos = 0;
-    while (pos < text.size()) {
-        size_t end = text.find(',', pos);
-        if (end == std::string::npos) end = text.size();
-        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
-        pos = end + 1;
-        if (item.empty()) continue;
-        const size_t eq = item.find('='), colon = item.find(':', eq == std::string::npos ? 0 : eq);
-        if (eq == std::string::npos || colon == std::string::npos)
-            throw ModelError(fmt::format("--bounds item '{}': expected NAME=LOWER:UPPER (um or arcsec)", item));
-        const std::string name(trim(std::string_view(item).substr(0, eq)));
-        const auto lo = parseNumber(trim(std::string_view(item).substr(eq + 1, colon - eq - 1)));
-        const auto hi = parseNumber(trim(std::string_view(item).substr(colon + 1)));
-        if (!lo || !hi) throw ModelError(fmt::format("--bounds item '{}': bounds must be numbers", item));
-        std::string base = name.substr(0, name.find('['));
-        const int di = m.deviationIndex(base);
+    for (const BoundItem& b : boundItems(text)) {
+        const int di = m.deviationIndex(b.name.substr(0, b.name.find('[')));
         // Nuisance names ("run.xT") are lengths; deviations take their own unit.
         const double unit = di >= 0 && m.deviations[di].isAngle() ? kArcsec : kUm;
-        if (di < 0 && name.find('.') == std::string::npos)
-            throw ModelError(fmt::format("--bounds: unknown deviation '{}' for machine '{}'", name, m.name));
-        if (!(*lo <= *hi)) throw ModelError(fmt::format("--bounds item '{}': lower exceeds upper", item));
-        out.push_back({name, *lo * unit, *hi * unit});
+        if (di < 0 && b.name.find('.') == std::string::npos)
+            throw ModelError(fmt::format("--bounds: unknown deviation '{}' for machine '{}'", b.name, m.name));
+        if (!(b.lo <= b.hi)) throw ModelError(fmt::format("--bounds item '{}': lower exceeds upper", b.item));
+        out.push_back({b.name, b.lo * unit, b.hi * unit});
     }
     return out;
 }
