@@ -23,6 +23,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -96,6 +97,48 @@ std::string program(const MachineModel& m, const vs::Setup& s, const std::string
     return p + fmt::format("G0 Z{:.6f}\n(LOGCLOSE)\n{}M2\n", safe + L - offset, g43 ? "G49\n" : "");
 }
 
+/// What both tests set up: the machine, cnccomp's LinuxCNC component emitted from a deviation set and installed
+/// (`kins`), the virtual sphere installed (`sphere`), the sphere's set-up (tool 150 mm, ball r 3 mm, sphere R 12.7 mm
+/// at (80, -60, 40)) and the simulation's options (component route, kServoPeriodNs, kTaskCycle, the sphere's HAL). Filled
+/// by setUp (fatal assertions need a void function); never copied (the HAL lambda refers to `s` and `sphere`).
+struct Rig {
+    std::string machineFile = sourcePath("samples/machines/table-table-ac.xml");
+    MachineModel m = readMachineXml(machineFile);
+    ScratchDir dir;
+    std::string kins, sphere;
+    double install = 0;  ///< s of halcompile
+    std::optional<sim::InstalledModule> kinsModule, sphereModule;
+    vs::Setup s;
+    sim::SimOptions o;
+    explicit Rig(const std::string& tag) : dir(tag) {}
+    Rig(const Rig&) = delete;
+    Rig& operator=(const Rig&) = delete;
+};
+
+/// Emits `deviationsCsv` (saved as deviations.csv) with `cnccomp emit --controller linuxcnc`, installs the component
+/// as `<prefix>k<pid>` and the virtual sphere as `<prefix>p<pid>`, and sets the sphere and the simulation up.
+void setUp(Rig& r, const std::string& deviationsCsv, const std::string& prefix) {
+    writeText(r.dir.file("deviations.csv"), deviationsCsv);
+    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc --machine {} --deviations {} --out {} --date 2024-01-01",
+                                              r.machineFile, r.dir.file("deviations.csv"), r.dir.file("emitted")));
+    ASSERT_EQ(emit.exitCode, 0) << emit.out;
+    r.kins = fmt::format("{}k{}", prefix, getpid() % 100000);
+    r.sphere = fmt::format("{}p{}", prefix, getpid() % 100000);
+    r.install = sim::installComponent(r.dir.path / "emitted", r.kins, r.dir.path / "build-kins") +
+                sim::installComp(vs::source(), "virtual_sphere", r.sphere, r.dir.path / "build-sphere");
+    r.kinsModule.emplace(r.kins);
+    r.sphereModule.emplace(r.sphere);
+    r.s.toolLength = 150;
+    r.s.ballRadius = 3;
+    r.s.sphereRadius = 12.7;
+    r.s.sphere = Vec3(80, -60, 40);
+    r.o.route = sim::Route::Component;
+    r.o.module = r.kins;
+    r.o.servoPeriodNs = kServoPeriodNs;
+    r.o.taskCycle = kTaskCycle;
+    r.o.extraHal = [&r](const std::string& coordinates) { return vs::hal(r.sphere, coordinates, r.s); };
+}
+
 struct Gaps {
     double minInside = 1e300, maxInside = -1e300;  ///< R + r − |ball − sphere| over the touches, mm
     void add(double v) { minInside = std::min(minInside, v), maxInside = std::max(maxInside, v); }
@@ -104,30 +147,16 @@ struct Gaps {
 TEST(LinuxcncVirtualSphere, TouchesAtTheSphereAndMoveWithTheTrueErrors) {
     if (const std::string why = sim::unavailableReason(); !why.empty()) GTEST_SKIP() << why;
     if (const std::string why = sim::componentUnavailableReason(); !why.empty()) GTEST_SKIP() << why;
-    const std::string machineFile = sourcePath("samples/machines/table-table-ac.xml");
-    const MachineModel m = readMachineXml(machineFile);
-    ScratchDir dir("linuxcnc-virtual-sphere");
-    writeText(dir.file("zero.csv"), "name,alias,value,unit\n");
-    writeText(dir.file("truth.csv"), vs::truthCsv(truth()));
-    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc --machine {} --deviations {} --out {} --date 2024-01-01",
-                                              machineFile, dir.file("zero.csv"), dir.file("emitted")));
-    ASSERT_EQ(emit.exitCode, 0) << emit.out;
-    const std::string kins = fmt::format("vsk{}", getpid() % 100000), sphere = fmt::format("vsp{}", getpid() % 100000);
-    const double install = sim::installComponent(dir.path / "emitted", kins, dir.path / "build-kins") +
-                           sim::installComp(vs::source(), "virtual_sphere", sphere, dir.path / "build-sphere");
-    const sim::InstalledModule k1{kins}, k2{sphere};
-
-    vs::Setup s;
-    s.toolLength = 150;
-    s.ballRadius = 3;
-    s.sphereRadius = 12.7;
-    s.sphere = Vec3(80, -60, 40);
-    sim::SimOptions o;
-    o.route = sim::Route::Component;
-    o.module = kins;
-    o.servoPeriodNs = kServoPeriodNs;
-    o.taskCycle = kTaskCycle;
-    o.extraHal = [&](const std::string& coordinates) { return vs::hal(sphere, coordinates, s); };
+    Rig r("linuxcnc-virtual-sphere");
+    setUp(r, "name,alias,value,unit\n", "vs");  // the component with zero deviations: the nominal machine
+    if (HasFatalFailure()) return;
+    writeText(r.dir.file("truth.csv"), vs::truthCsv(truth()));
+    const MachineModel& m = r.m;
+    const ScratchDir& dir = r.dir;
+    const std::string& sphere = r.sphere;
+    const double install = r.install;
+    vs::Setup& s = r.s;
+    sim::SimOptions& o = r.o;
     const sim::SimConfig config = sim::buildSimConfig(m, dir.path / "emitted", dir.path / "sim", {{1, 0.0}}, 0.0, o);
     writeText((config.dir / "zero.ngc").string(), program(m, s, "touches-zero.txt"));
     writeText((config.dir / "errors.ngc").string(), program(m, s, "touches-errors.txt"));
@@ -194,30 +223,16 @@ TEST(LinuxcncVirtualSphere, TouchesAtTheSphereAndMoveWithTheTrueErrors) {
 TEST(LinuxcncVirtualSphere, TheEmittedTrueSetPutsTheTouchesBackOnTheNominalSphere) {
     if (const std::string why = sim::unavailableReason(); !why.empty()) GTEST_SKIP() << why;
     if (const std::string why = sim::componentUnavailableReason(); !why.empty()) GTEST_SKIP() << why;
-    const std::string machineFile = sourcePath("samples/machines/table-table-ac.xml");
-    const MachineModel m = readMachineXml(machineFile);
-    ScratchDir dir("linuxcnc-virtual-sphere-comp");
-    writeText(dir.file("truth.csv"), vs::truthCsv(truth()));
-    const CliResult emit = runCli(fmt::format("emit --controller linuxcnc --machine {} --deviations {} --out {} --date 2024-01-01",
-                                              machineFile, dir.file("truth.csv"), dir.file("emitted")));
-    ASSERT_EQ(emit.exitCode, 0) << emit.out;
-    const std::string kins = fmt::format("vck{}", getpid() % 100000), sphere = fmt::format("vcp{}", getpid() % 100000);
-    const double install = sim::installComponent(dir.path / "emitted", kins, dir.path / "build-kins") +
-                           sim::installComp(vs::source(), "virtual_sphere", sphere, dir.path / "build-sphere");
-    const sim::InstalledModule k1{kins}, k2{sphere};
-    vs::Setup s;
-    s.toolLength = 150;
-    s.ballRadius = 3;
-    s.sphereRadius = 12.7;
-    s.sphere = Vec3(80, -60, 40);
-    s.truth = truth();
-    sim::SimOptions o;
-    o.route = sim::Route::Component;
-    o.module = kins;
-    o.servoPeriodNs = kServoPeriodNs;
-    o.wideJointLimits = true;
-    o.taskCycle = kTaskCycle;
-    o.extraHal = [&](const std::string& coordinates) { return vs::hal(sphere, coordinates, s); };
+    Rig r("linuxcnc-virtual-sphere-comp");
+    setUp(r, vs::truthCsv(truth()), "vc");  // the component with the truth
+    if (HasFatalFailure()) return;
+    r.s.truth = truth();
+    r.o.wideJointLimits = true;
+    const MachineModel& m = r.m;
+    const ScratchDir& dir = r.dir;
+    const double install = r.install;
+    const vs::Setup& s = r.s;
+    const sim::SimOptions& o = r.o;
     const sim::SimConfig config = sim::buildSimConfig(m, dir.path / "emitted", dir.path / "sim", {{1, 0.0}}, 0.0, o);
     writeText((config.dir / "compensated.ngc").string(), program(m, s, "touches.txt", true));
     const sim::RunResult run = sim::run(config, {"mdi G90 G21 G94 G17 G40 G49 G54", "auto " + (config.dir / "compensated.ngc").string()},
