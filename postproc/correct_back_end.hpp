@@ -1,6 +1,7 @@
 #pragma once
 // The back end of the RS274NGC-family corrector: checks and splits the path between corrected end points and writes
 // every line, changed words in the program's own style (postproc/correct_block_text.cpp), every other byte as read.
+#include <algorithm>
 #include <array>
 #include <string>
 #include <string_view>
@@ -58,13 +59,15 @@ private:
     void overlong(const Record& rec);
     void updateStyles(const LexedBlock& b, std::string_view text);
     void blockStyle(std::string_view text);
-    void warnings(uint64_t no);
+    // Called once per line or move, in the file that defines them: inline, so that they are inlined there.
+    inline void warnings(uint64_t no);
     void passThrough(const Line& ln, uint64_t no);
     void move(Record& rec);
     void switchMode();
     void updateOutputAfterPassThrough();
-    double toleranceFor(const MoveSpace& space, uint64_t no);
+    inline double toleranceFor(const MoveSpace& space, uint64_t no);
     // Text helpers.
+    // Called for every number written: defined below, in the header, so that they are inlined.
     int decimalsFor(char letter, bool rotary) const;
     NumberStyle styleFor(char letter, bool rotary, const Word* original, bool& increments) const;
     size_t number(char letter, bool rotary, double programValue, const Word* original, char* out, double& readBack,
@@ -117,5 +120,24 @@ private:
     bool warnedCr_ = false, warnedTolerance_ = false;
     std::string lastEol_ = "\n";
 };
+
+inline int ProgramCorrector::decimalsFor(char letter, bool rotary) const {
+    if (options_.decimals >= 0) return options_.decimals;
+    const int floor = rotary ? 4 : (r_->inch ? 5 : 4);
+    return std::max(styles_[letter - 'A'].maxDecimals, floor);
+}
+
+inline NumberStyle ProgramCorrector::styleFor(char letter, bool rotary, const Word* original, bool& increments) const {
+    const LetterStyle& ls = styles_[letter - 'A'];
+    NumberStyle st;
+    increments = r_->integerIncrements && letter != 'F' &&
+                 ((original && !original->point) || (!original && ls.sawInteger && !ls.sawPoint));
+    st.point = !increments;
+    st.decimals = decimalsFor(letter, rotary);
+    st.fixed = ls.trailingZero || fixedProgram_;
+    st.bareFraction = ls.bare;
+    st.plus = original && original->plus;
+    return st;
+}
 
 }  // namespace cnccomp::pp::iso

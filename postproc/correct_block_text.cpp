@@ -122,25 +122,6 @@ void ProgramCorrector::replaceNumber(const Word& w, const char* num, size_t n) {
     edits_.add(w.valueBegin, w.end, std::string_view(num, n));
 }
 
-int ProgramCorrector::decimalsFor(char letter, bool rotary) const {
-    if (options_.decimals >= 0) return options_.decimals;
-    const int floor = rotary ? 4 : (r_->inch ? 5 : 4);
-    return std::max(styles_[letter - 'A'].maxDecimals, floor);
-}
-
-NumberStyle ProgramCorrector::styleFor(char letter, bool rotary, const Word* original, bool& increments) const {
-    const LetterStyle& ls = styles_[letter - 'A'];
-    NumberStyle st;
-    increments = r_->integerIncrements && letter != 'F' &&
-                 ((original && !original->point) || (!original && ls.sawInteger && !ls.sawPoint));
-    st.point = !increments;
-    st.decimals = decimalsFor(letter, rotary);
-    st.fixed = ls.trailingZero || fixedProgram_;
-    st.bareFraction = ls.bare;
-    st.plus = original && original->plus;
-    return st;
-}
-
 size_t ProgramCorrector::number(char letter, bool rotary, double pv, const Word* original, char* out, double& readBack,
                                 double& resolution) const {
     bool increments = false;

@@ -37,7 +37,7 @@ private:
     void switchMode(const BlockResult& r);
     void move(Record& rec);
     void refuse(Record& rec, const char* reason);
-    void checkTravel(Record& rec);
+    inline void checkTravel(Record& rec);  // once per move, in its own file: inlined there
 
     const MachineModel& machine_;
     const CorrectOptions& options_;

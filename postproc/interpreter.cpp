@@ -149,17 +149,6 @@ bool Interpreter::forgetOverlong(const OverlongLine& l, BlockResult& r) {
     return false;
 }
 
-namespace {
-bool isDimensionLetter(const AxisLayout& layout, char c) {
-    return layout.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || c == 'U' || c == 'V' || c == 'W';
-}
-}  // namespace
-
-double Interpreter::wordValue(const Word& w, Dialect dialect, bool inch, const AxisLayout& layout) {
-    if (dialect == Dialect::Fanuc && !w.point && isDimensionLetter(layout, w.letter)) return w.value * (inch ? 1e-4 : 1e-3);
-    return w.value;
-}
-
 const AxisVector* Interpreter::offsetValues(int code) const {
     for (const auto& [c, v] : offsets_)
         if (c == code) return &v;

@@ -156,7 +156,14 @@ public:
     /// Value of a word in program units (Fanuc integer increments applied to dimension words).
     double wordValue(const Word& w) const { return wordValue(w, options_.dialect, inch_, layout_); }
     /// The same for a block read in `dialect` with G20 (`inch`) or G21 in effect (BlockResult::inch).
-    static double wordValue(const Word& w, Dialect dialect, bool inch, const AxisLayout& layout);
+    static double wordValue(const Word& w, Dialect dialect, bool inch, const AxisLayout& layout) {
+        // Called for every number read: here, so that it is inlined.
+        if (dialect != Dialect::Fanuc || w.point) return w.value;
+        const char c = w.letter;  // Fanuc: dimension words without a point count increments
+        if (layout.axis(c) >= 0 || c == 'I' || c == 'J' || c == 'K' || c == 'R' || c == 'U' || c == 'V' || c == 'W')
+            return w.value * (inch ? 1e-4 : 1e-3);
+        return w.value;
+    }
 
 private:
     /// A result for a line passed through unread: no words, start and end at the current position.
@@ -174,7 +181,7 @@ private:
     void commit(const BlockResult& r);
     bool arcGeometry(const LexedBlock& b, BlockResult& r, const char*& why);
     /// The result fields of a new block, before it is read (start = end = the current position).
-    void beginBlock(BlockResult& r);
+    inline void beginBlock(BlockResult& r);  // once per block, in interpreter.cpp: inlined there
 
     // Convert: apply a read and checked block, in the RS274NGC order of execution (postproc/interp_convert.cpp).
     /// Passes the block through; its positions (and with why.forgetMotion its motion mode) become unknown.
