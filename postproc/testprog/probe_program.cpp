@@ -9,7 +9,7 @@
 #include "cnccomp/identification/sphere_probe.hpp"
 #include "postproc/testprog/test_program.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 namespace {
 
 constexpr const char* kLetters = "XYZABC";
@@ -304,4 +304,4 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     return out;
 }
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

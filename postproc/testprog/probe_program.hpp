@@ -44,7 +44,7 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "postproc/testprog/program_syntax.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 struct ProbeProgramOptions {
     pp::Dialect dialect = pp::Dialect::Rs274ngc;
@@ -75,4 +75,4 @@ std::string probeProgramFileName(pp::Dialect d);
 /// for a point outside the travel; the plan must have sphere runs.
 ProbeProgram makeProbeProgram(const MachineModel& machine, const MeasurementPlan& plan, const ProbeProgramOptions& options);
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

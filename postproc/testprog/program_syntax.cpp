@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 const char* programExtension(pp::Dialect d) {
     switch (d) {
@@ -277,4 +277,4 @@ std::unique_ptr<ProgramSyntax> ProgramSyntax::make(pp::Dialect d, const MachineM
     return std::make_unique<IsoSyntax>(d, machine, decimals);
 }
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

@@ -16,7 +16,7 @@
 #include "cnccomp/machine.hpp"
 #include "postproc/dialect.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 // The dialect of a test program is pp::Dialect (postproc/dialect.hpp; its names for test programs:
 // pp::parseDialect / pp::dialectName with pp::DialectUse::Write): Rs274ngc (LinuxCNC), Fanuc, Sinumerik, Heidenhain.
@@ -87,4 +87,4 @@ protected:
     std::string out_;
 };
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

@@ -12,7 +12,7 @@
 #include "postproc/modal.hpp"
 #include "postproc/poses.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 std::vector<PoseRow> readPoses(const MachineModel& m, std::string_view text, pp::Dialect dialect, const std::string& source) {
     const pp::AxisLayout layout = pp::AxisLayout::fromMachine(m);
@@ -258,4 +258,4 @@ void passSamples(const RunMotion& motion, const PassCommands& pass, std::vector<
         }
 }
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

@@ -10,7 +10,7 @@
 #include "postproc/dialect.hpp"
 #include "postproc/testprog/run_motion.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 /// One row of the poses CSV: a motion endpoint, description-frame commands (mm, rad).
 struct PoseRow {
@@ -56,4 +56,4 @@ std::vector<AxisVector> readProbeTargets(const MachineModel& machine, std::strin
 /// The samples of a pass (the simulation's sample parameters, without the closing point of a whole turn), in pass order.
 void passSamples(const RunMotion& motion, const PassCommands& pass, std::vector<double>& t, std::vector<AxisVector>& q);
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

@@ -12,7 +12,7 @@
 #include "cnccomp/identification/rtest_run.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 const char* runKindName(RunKind k) {
     switch (k) {
@@ -259,4 +259,4 @@ PathShape analysePath(const MachineModel& m, const RunMotion& motion, double fro
     return s;
 }
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

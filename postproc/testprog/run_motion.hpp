@@ -14,7 +14,7 @@
 
 #include "cnccomp/io/plan_xml.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 enum class RunKind { Ballbar, AbsoluteBallbar, Rtest, Dbb5, LinearCircle };
 /// "ball bar", "absolute ball bar", "R-test", "DBB5", "linear circle".
@@ -67,4 +67,4 @@ struct PathShape {
 /// Examines motion.at in the controller's coordinates over [from, to] (any order) every `step` and half-way between.
 PathShape analysePath(const MachineModel& machine, const RunMotion& motion, double from, double to, double step);
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

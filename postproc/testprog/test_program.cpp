@@ -15,7 +15,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 std::string programFileName(const std::string& run, int order, pp::Dialect d) {
     std::string s = fmt::format("TP{:02d}_", order);
@@ -317,4 +317,4 @@ void writeTestPrograms(const TestProgramSet& set, const std::string& dir, const 
     out.commit();
 }
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

@@ -19,7 +19,7 @@
 #include "postproc/testprog/program_syntax.hpp"
 #include "postproc/testprog/run_motion.hpp"
 
-namespace cnccomp::testprog {
+namespace cnccomp::pp::testprog {
 
 /// The header line every test program carries (all dialects): the kinematics mode the controller must run it in.
 /// The words are machine coordinates, so the controller's tool-tip transformation must be off; `cnccomp verify` runs
@@ -73,4 +73,4 @@ TestProgramSet makeTestPrograms(const MachineModel& machine, const MeasurementPl
 /// temporary name first, then renamed). Refuses to overwrite any of `inputs` or a file that is not a regular file.
 void writeTestPrograms(const TestProgramSet& set, const std::string& dir, const std::vector<std::string>& inputs);
 
-}  // namespace cnccomp::testprog
+}  // namespace cnccomp::pp::testprog

@@ -80,7 +80,7 @@ struct VerifyPass {
 
 struct VerifyRun {
     std::string name;
-    testprog::RunKind kind = testprog::RunKind::Ballbar;
+    pp::testprog::RunKind kind = pp::testprog::RunKind::Ballbar;
     std::string type;      ///< "B-X", "DBB5 XY circle", "R-test", …
     double LB = 0;         ///< bar length, mm (0 for R-test)
     std::string program;   ///< the test program's file name

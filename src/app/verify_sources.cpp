@@ -82,7 +82,7 @@ std::optional<pp::Dialect> dialectOfExtension(std::string ext) {
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     for (auto d : {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
                    pp::Dialect::Heidenhain})
-        if (ext == testprog::programExtension(d)) return d;
+        if (ext == pp::testprog::programExtension(d)) return d;
     return std::nullopt;
 }
 
@@ -119,11 +119,11 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
         return out;
     }
     // Corrected test programs: TP<nn>_<run>.<ext>, one per run.
-    const std::vector<testprog::RunMotion> motions = testprog::planMotions(m, plan);
+    const std::vector<pp::testprog::RunMotion> motions = pp::testprog::planMotions(m, plan);
     std::vector<std::string> missing;
     std::optional<pp::Dialect> dialect;
     for (size_t i = 0; i < motions.size(); ++i) {
-        const std::string stem = testprog::programFileName(motions[i].name, static_cast<int>(i) + 1, pp::Dialect::Rs274ngc);
+        const std::string stem = pp::testprog::programFileName(motions[i].name, static_cast<int>(i) + 1, pp::Dialect::Rs274ngc);
         const std::string base = stem.substr(0, stem.rfind('.'));
         const controllers::OutputFile* found = nullptr;
         for (const auto& f : files)

@@ -33,12 +33,12 @@ double componentSpan(const std::vector<Vec3>& d) {
 
 std::vector<VerifyRun> verifySphereRuns(const MachineModel& m, const MeasurementPlan& plan, const Kinematics& k,
                                         const controllers::AppliedCompensation& model, pp::Dialect dialect) {
-    testprog::ProbeProgramOptions po;
+    pp::testprog::ProbeProgramOptions po;
     po.dialect = dialect;
-    const testprog::ProbeProgram prog = testprog::makeProbeProgram(m, plan, po);
+    const pp::testprog::ProbeProgram prog = pp::testprog::makeProbeProgram(m, plan, po);
     // The probing targets as written, read back by cnccomp's reader.
     const std::vector<AxisVector> targets =
-        testprog::readProbeTargets(m, prog.files[0].text, dialect, prog.files[0].file);
+        pp::testprog::readProbeTargets(m, prog.files[0].text, dialect, prog.files[0].file);
     if (targets.size() != prog.targets.size())
         throw ModelError(fmt::format("verify: the probing program reads back {} probing moves, the plan has {}", targets.size(),
                                      prog.targets.size()));
@@ -73,7 +73,7 @@ std::vector<VerifyRun> verifySphereRuns(const MachineModel& m, const Measurement
         }
         VerifyRun vr;
         vr.name = run.name;
-        vr.kind = testprog::RunKind::Rtest;
+        vr.kind = pp::testprog::RunKind::Rtest;
         vr.type = "sphere probing (centre spread)";
         vr.program = prog.files[0].file;
         VerifyPass p;

@@ -119,7 +119,7 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                 // The candidates' spans only (their volumetric figure is the fit's own, above): one volumetric point.
                 const app::VerifyResult v = verifyFiles(b, m, *plan, d, b.emit(req), rows[i].name, 1);
                 spans[static_cast<size_t>(i)] = v.residual;
-                for (const app::VerifyRun& run : v.runs) rtest = rtest || run.kind == testprog::RunKind::Rtest;
+                for (const app::VerifyRun& run : v.runs) rtest = rtest || run.kind == pp::testprog::RunKind::Rtest;
             }
         }
         const std::string spanName = rtest ? "largest R-test displacement (um)" : "largest span (um)";

@@ -16,7 +16,7 @@ namespace {
 
 struct Options {
     std::string machine, plan, dialect = "linuxcnc", out, probeLog = "cnccomp-probe.txt";
-    testprog::TestProgramOptions program;
+    pp::testprog::TestProgramOptions program;
 };
 
 void run(Options o) {
@@ -30,31 +30,31 @@ void run(Options o) {
     if (!plan.sphereRuns.empty()) {
         if (plan.runCount() != plan.sphereRuns.size())
             throw ModelError("the plan has sphere runs and other runs: put the <sphere> runs in a plan of their own");
-        testprog::ProbeProgramOptions po;
+        pp::testprog::ProbeProgramOptions po;
         po.dialect = *d;
         po.log = o.probeLog;
         po.decimals = o.program.decimals;
         po.machineFile = o.program.machineFile;
         po.planFile = o.program.planFile;
-        const testprog::ProbeProgram p = testprog::makeProbeProgram(m, plan, po);
+        const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(m, plan, po);
         OutputSet staged({o.machine, o.plan});
         staged.makeFolder(o.out);
-        for (const testprog::ProbeProgramFile& f : p.files) {
+        for (const pp::testprog::ProbeProgramFile& f : p.files) {
             const std::string text = f.text;
             staged.add(OutputSet::fileIn(o.out, f.file, o.plan), [text](std::ostream& s) { s << text; });
         }
         staged.commit();
         fmt::print("probing program for '{}' ({}) in {}: {} poses, {} touches; it writes {}\n", m.name, o.dialect, o.out,
                    p.poses, p.touches, o.probeLog);
-        for (const testprog::ProbeProgramFile& f : p.files) fmt::print("  {}\n", f.file);
+        for (const pp::testprog::ProbeProgramFile& f : p.files) fmt::print("  {}\n", f.file);
         return;
     }
     if (o.probeLog != "cnccomp-probe.txt") throw ModelError("--probe-log applies to plans with sphere runs");
-    const testprog::TestProgramSet set = testprog::makeTestPrograms(m, plan, o.program);
-    testprog::writeTestPrograms(set, o.out, {o.machine, o.plan});
+    const pp::testprog::TestProgramSet set = pp::testprog::makeTestPrograms(m, plan, o.program);
+    pp::testprog::writeTestPrograms(set, o.out, {o.machine, o.plan});
     fmt::print("{} test programs for '{}' ({}) in {}:\n", set.programs.size(), m.name, o.dialect, o.out);
-    for (const testprog::TestProgram& p : set.programs)
-        fmt::print("  {:<40} {:<18} {:<18} {:>6} samples, first {}, {}{}\n", p.file, p.run, testprog::runKindName(p.kind),
+    for (const pp::testprog::TestProgram& p : set.programs)
+        fmt::print("  {:<40} {:<18} {:<18} {:>6} samples, first {}, {}{}\n", p.file, p.run, pp::testprog::runKindName(p.kind),
                    p.samples, p.firstPass, p.arcs ? "circular blocks" : "straight blocks",
                    p.overshootStart < o.program.overshootDeg || p.overshootEnd < o.program.overshootDeg
                        ? fmt::format(", overshoot {:g}/{:g} deg", p.overshootStart, p.overshootEnd)

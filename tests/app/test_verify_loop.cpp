@@ -187,7 +187,7 @@ double lever(const Loop& l, int axis) {
     if (l.machine.axisLink(axis).kind != AxisKind::Rotary) return 1.0;
     const Kinematics k(l.machine);
     double out = 0;
-    for (const testprog::RunMotion& r : testprog::planMotions(l.machine, l.plan))
+    for (const pp::testprog::RunMotion& r : pp::testprog::planMotions(l.machine, l.plan))
         for (size_t i = 0; i < r.sampleCount; ++i) {
             const AxisVector q = r.at(r.points[i]);
             const Vec3 tip = k.baseToTool(q) * k.toolPoint(r.toolLength);
@@ -312,10 +312,10 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
         for (const auto& [dialect, reader] : {std::pair{pp::Dialect::Rs274ngc, pp::Dialect::Rs274ngc},
                                               std::pair{pp::Dialect::Heidenhain, pp::Dialect::Heidenhain}}) {
             // testprog → cnccomp correct (with the run's tool length, as each program's header says) → verify.
-            const auto motions = testprog::planMotions(l.machine, l.plan);
-            testprog::TestProgramOptions to;
+            const auto motions = pp::testprog::planMotions(l.machine, l.plan);
+            pp::testprog::TestProgramOptions to;
             to.dialect = dialect;
-            const auto set = testprog::makeTestPrograms(l.machine, l.plan, to);
+            const auto set = pp::testprog::makeTestPrograms(l.machine, l.plan, to);
             app::VerifyCompensation comp;
             comp.kind = app::VerifyCompensation::Kind::CorrectedPrograms;
             comp.description = "corrected programs";

@@ -323,9 +323,9 @@ TEST(PostprocKlartextCorrect, ZeroDeviationsKeepEveryByte) {
     // testprog's Klartext programs of two sample plans (circles as CC / C blocks, chords, cycles 7 and 9, STOP).
     for (const auto& [machine, plan] : {std::pair{"table-table-ac", "dbb5-table-table-ac"}, std::pair{"multitasking", "multitasking-six-circles"}}) {
         const MachineModel& m = test::sampleMachine(machine);
-        testprog::TestProgramOptions o;
+        pp::testprog::TestProgramOptions o;
         o.dialect = pp::Dialect::Heidenhain;
-        for (const auto& p : testprog::makeTestPrograms(m, readPlanXml(test::sourcePath(fmt::format("samples/plans/{}.xml", plan))), o).programs) {
+        for (const auto& p : pp::testprog::makeTestPrograms(m, readPlanXml(test::sourcePath(fmt::format("samples/plans/{}.xml", plan))), o).programs) {
             CorrectOptions co;
             co.setup.defaultToolLength = 100;
             std::istringstream in(p.text);

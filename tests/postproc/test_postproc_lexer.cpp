@@ -262,7 +262,7 @@ TEST(PostprocDialect, DetectsUnambiguousProgramsOnly) {
 }
 
 // One name table for reading, correcting and writing test programs. Oracle: the names each command accepted before the
-// two tables (pp::parseDialect, testprog::parseProgramDialect) were made one, transcribed from those two functions and
+// two tables (pp::parseDialect, pp::testprog::parseProgramDialect) were made one, transcribed from those two functions and
 // the CLI (`correct` added heidenhain and klartext to the reader's names).
 TEST(PostprocDialect, OneNameTableServesEveryUse) {
     using U = DialectUse;

@@ -27,13 +27,13 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
     const MeasurementPlan plan = samplePlan();
     for (auto d : {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
                    pp::Dialect::Heidenhain}) {
-        testprog::ProbeProgramOptions o;
+        pp::testprog::ProbeProgramOptions o;
         o.dialect = d;
-        const testprog::ProbeProgram p = testprog::makeProbeProgram(m, plan, o);
+        const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(m, plan, o);
         ASSERT_EQ(p.touches, 115);
         ASSERT_EQ(p.targets.size(), 115u);
         const std::string& text = p.files[0].text;
-        const auto targets = testprog::readProbeTargets(m, text, d, p.files[0].file);
+        const auto targets = pp::testprog::readProbeTargets(m, text, d, p.files[0].file);
         ASSERT_EQ(targets.size(), p.targets.size()) << pp::dialectName(d, pp::DialectUse::Write);
         for (size_t i = 0; i < targets.size(); ++i)
             EXPECT_LT((targets[i] - p.targets[i].target).cwiseAbs().maxCoeff(), 1e-6)
@@ -47,7 +47,7 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
             continue;
         }
         // Every approach point is a rapid the modal reader finds, in order.
-        const auto rows = testprog::readPoses(m, text, d, p.files[0].file);
+        const auto rows = pp::testprog::readPoses(m, text, d, p.files[0].file);
         size_t next = 0;
         for (const auto& r : rows) {
             if (next == p.targets.size()) break;
@@ -64,9 +64,9 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
 }
 
 TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
-    testprog::ProbeProgramOptions o;
+    pp::testprog::ProbeProgramOptions o;
     o.log = "run1.txt";
-    const testprog::ProbeProgram p = testprog::makeProbeProgram(tableTable(), samplePlan(), o);
+    const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(tableTable(), samplePlan(), o);
     const std::string& t = p.files[0].text;
     EXPECT_EQ(p.files[0].file, "probe.ngc");
     EXPECT_NE(t.find("(LOGOPEN,run1.txt)\n"), std::string::npos);
@@ -82,7 +82,7 @@ TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
     EXPECT_NE(t.find("G49\n(LOGCLOSE)\nM2\n"), std::string::npos);
     EXPECT_LT(t.find("(LOGOPEN"), t.find("G38.3"));
     o.log = "a,b";
-    EXPECT_THROW(testprog::makeProbeProgram(tableTable(), samplePlan(), o), ModelError);
+    EXPECT_THROW(pp::testprog::makeProbeProgram(tableTable(), samplePlan(), o), ModelError);
 }
 
 std::string rs274Path() {
@@ -99,7 +99,7 @@ TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheRead
     if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace";
     const MachineModel& m = tableTable();
     const MeasurementPlan plan = samplePlan();
-    const testprog::ProbeProgram p = testprog::makeProbeProgram(m, plan, {});
+    const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(m, plan, {});
     test::ScratchDir dir("probe-rs274");
     const std::string ngc = dir.file("probe.ngc"), out = dir.file("canon.txt"), log = dir.file("rs.log"),
                       tbl = dir.file("tool.tbl");
