@@ -187,10 +187,7 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
         Pipeline pipe;
         pipe.run(front, consume);
     }
-    buffer.flush();
-    if (options.progress) options.progress(reader.bytesConsumed());
-    s.bytesIn = reader.bytesConsumed();
-    s.bytesOut = buffer.bytesWritten();
+    finishCorrection(buffer, reader, options, s);
     return s;
 }
 

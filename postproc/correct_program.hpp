@@ -94,6 +94,12 @@ std::string formatSummary(const CorrectSummary& s, size_t maxListed = 20);
 /// A notice in the summary (the first kMaxNotices of each list) and as a line "line,kind,message" of `report`.
 void addNotice(CorrectSummary& summary, std::ostream* report, bool warning, uint64_t line, std::string message);
 
+class OutputBuffer;
+class LineReader;
+/// The end of a correction (RS274NGC family and Klartext alike): the output flushed, the last progress report, the
+/// bytes read and written in the summary.
+void finishCorrection(OutputBuffer& out, const LineReader& reader, const CorrectOptions& options, CorrectSummary& s);
+
 /// The finest path tolerance the written digits can hold at a move ending at `end` (program space): each end point is
 /// off by up to half a digit per axis — √(linear axes) half-digits of `linDecimals` (mm, or inch digits), and in joint
 /// mode √(rotary axes) half-digits of `rotDecimals` (degrees) times the rotary axes' lever arm at the pose.

@@ -5,8 +5,17 @@
 #include <fmt/format.h>
 
 #include "postproc/correct_program.hpp"
+#include "postproc/block_writer.hpp"
+#include "postproc/line_reader.hpp"
 
 namespace cnccomp::pp {
+
+void finishCorrection(OutputBuffer& out, const LineReader& reader, const CorrectOptions& options, CorrectSummary& s) {
+    out.flush();
+    if (options.progress) options.progress(reader.bytesConsumed());
+    s.bytesIn = reader.bytesConsumed();
+    s.bytesOut = out.bytesWritten();
+}
 
 void addNotice(CorrectSummary& summary, std::ostream* report, bool warning, uint64_t line, std::string message) {
     auto& list = warning ? summary.warnings : summary.passThrough;

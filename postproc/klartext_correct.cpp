@@ -594,10 +594,7 @@ CorrectSummary correctKlartextProgram(const MachineModel& machine, const Deviati
     OutputBuffer buffer(out);
     KlartextCorrector k(machine, deviations, options, s, buffer);
     k.run(reader);
-    buffer.flush();
-    if (options.progress) options.progress(reader.bytesConsumed());
-    s.bytesIn = reader.bytesConsumed();
-    s.bytesOut = buffer.bytesWritten();
+    finishCorrection(buffer, reader, options, s);
     return s;
 }
 
