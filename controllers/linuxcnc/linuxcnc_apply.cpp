@@ -124,8 +124,9 @@ AxisVector LinuxcncModel::driveCommandsForTool(const AxisVector& q, double toolL
 
 AxisVector LinuxcncModel::driveCommandsMoving(const AxisVector& q, double toolLength, const AxisVector& motion) const {
     const int n = static_cast<int>(coordinates_.size());
-    JointValues directions(n);
-    for (int i = 0; i < n; ++i) directions[i] = motion.size() == q.size() ? motion[jointAxis_[i]] : 0.0;
+    JointValues directions = JointValues::Zero(n);
+    if (motion.size() == q.size())
+        for (int i = 0; i < n; ++i) directions[i] = motion[jointAxis_[i]];
     const JointValues motor = motorPositions(jointPositions(program(q, toolLength), toolLength), directions);
     AxisVector c = machine_->toController(q);
     for (int i = 0; i < n; ++i) c[jointAxis_[i]] = motor[i] * unit_[i];
