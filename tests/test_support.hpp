@@ -37,4 +37,12 @@ CliResult runCli(const std::string& args);
 /// Path of the cnccomp executable (for scripts that run it themselves).
 std::string cliPath();
 
+/// LinuxCNC's standalone interpreter rs274 (Debian linuxcnc-uspace), or "" when it is not installed.
+std::string rs274Path();
+/// The shell command that runs rs274 (`rs274Path()`) in batch mode on `ngc` with the tool table `tbl`, the canonical
+/// calls to `out`, its messages to `log`, with HOME set to `home` (a test's own scratch folder): rs274 truncates and maps
+/// $HOME/.tool.mmap, and two of them on one file (ctest -j2) end in SIGBUS ("Bus error", seen on a fresh clone's run).
+std::string rs274Command(const std::string& home, const std::string& tbl, const std::string& ngc, const std::string& out,
+                         const std::string& log);
+
 }  // namespace cnccomp::test

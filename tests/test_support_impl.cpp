@@ -62,4 +62,16 @@ CliResult runCommand(const std::string& command) {
     return r;
 }
 
+std::string rs274Path() {
+    for (const char* p : {"/usr/bin/rs274", "/usr/local/bin/rs274"})
+        if (std::filesystem::exists(p)) return p;
+    return {};
+}
+
+std::string rs274Command(const std::string& home, const std::string& tbl, const std::string& ngc, const std::string& out,
+                         const std::string& log) {
+    return "HOME='" + home + "' " + rs274Path() + " -t '" + tbl + "' -g '" + ngc + "' '" + out + "' < /dev/null > '" + log +
+           "' 2>&1";
+}
+
 }  // namespace cnccomp::test

@@ -85,17 +85,11 @@ TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
     EXPECT_THROW(pp::testprog::makeProbeProgram(tableTable(), samplePlan(), o), ModelError);
 }
 
-std::string rs274Path() {
-    for (const char* p : {"/usr/bin/rs274", "/usr/local/bin/rs274"})
-        if (std::filesystem::exists(p)) return p;
-    return {};
-}
-
 TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheReaderReads) {
     // Oracle: LinuxCNC's own interpreter (rs274, standalone: no motion, so no probe trips). It must read the program
     // without error, make one STRAIGHT_PROBE per touch to the commanded target, and expand each (LOG,…) line; those
     // lines, read by the probe result reader, name the first touch as missed (#5070 = 0 without a probe).
-    const std::string rs274 = rs274Path();
+    const std::string rs274 = test::rs274Path();
     if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace";
     const MachineModel& m = tableTable();
     const MeasurementPlan plan = samplePlan();
@@ -105,8 +99,7 @@ TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheRead
                       tbl = dir.file("tool.tbl");
     test::writeText(ngc, p.files[0].text);
     test::writeText(tbl, "");
-    const std::string cmd = "cd " + dir.path.string() + " && " + rs274 + " -t " + tbl + " -g " + ngc + " " + out +
-                            " < /dev/null > " + log + " 2>&1";
+    const std::string cmd = "cd '" + dir.path.string() + "' && " + test::rs274Command(dir.path.string(), tbl, ngc, out, log);
     ASSERT_EQ(std::system(cmd.c_str()), 0) << test::readText(log);
     const std::string canon = test::readText(out);
     const std::regex probe(R"(STRAIGHT_PROBE\(([-0-9.]+), ([-0-9.]+), ([-0-9.]+), ([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\))");

@@ -157,12 +157,6 @@ TEST(TestPrograms, BallBarSweepsAreCircularBlocksCwFirstWithOvershootInsideTheTr
 
 // ---- LinuxCNC's interpreter as the oracle ------------------------------------------------------------------------
 
-std::string rs274Path() {
-    for (const char* p : {"/usr/bin/rs274", "/usr/local/bin/rs274"})
-        if (std::filesystem::exists(p)) return p;
-    return {};
-}
-
 struct CanonMove {
     long line = 0;
     std::string kind;  ///< STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED
@@ -224,7 +218,7 @@ std::vector<CanonMove> parseCanon(const std::string& text) {
 }
 
 TEST(TestPrograms, LinuxCncInterpreterReadsEveryProgramAndMakesTheSameMoves) {
-    const std::string rs274 = rs274Path();
+    const std::string rs274 = test::rs274Path();
     if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace "
                                        "(tools/deps.sh installs it)";
     test::ScratchDir dir("testprog-rs274");
@@ -238,7 +232,7 @@ TEST(TestPrograms, LinuxCncInterpreterReadsEveryProgramAndMakesTheSameMoves) {
         for (const auto& p : set.programs) {
             const std::string ngc = dir.file(p.file), out = dir.file(p.file + ".canon"), log = dir.file(p.file + ".log");
             test::writeText(ngc, p.text);
-            const std::string cmd = rs274 + " -t " + tbl + " -g " + ngc + " " + out + " < /dev/null > " + log + " 2>&1";
+            const std::string cmd = test::rs274Command(dir.path.string(), tbl, ngc, out, log);
             const int status = std::system(cmd.c_str());
             ASSERT_EQ(status, 0) << sp.file << " " << p.file << ": rs274 failed:\n" << test::readText(log);
             const std::vector<CanonMove> canon = parseCanon(test::readText(out));
@@ -418,7 +412,7 @@ TEST(TestPrograms, LinearCircleEveryDialectReadsBackThePlansCircleFeedAndDirecti
 TEST(TestPrograms, LinearCircleLinuxCncInterpreterMakesTheCircle) {
     // Oracle: LinuxCNC's own interpreter (rs274) reads the program; every arc ends on the commanded circle, turns the
     // plan's way (ARC_FEED rotation +1 = G3 = CCW), and the plane's third axis stays at the centre.
-    const std::string rs274 = rs274Path();
+    const std::string rs274 = test::rs274Path();
     if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace";
     const MachineModel& m = test::sampleMachine("mill-3axis");
     test::ScratchDir dir("testprog-circle-rs274");
@@ -432,7 +426,7 @@ TEST(TestPrograms, LinearCircleLinuxCncInterpreterMakesTheCircle) {
         const LinearCircleRun& c = plan.circleRuns[i];
         const std::string ngc = dir.file(p.file), out = dir.file(p.file + ".canon"), log = dir.file(p.file + ".log");
         test::writeText(ngc, p.text);
-        const std::string cmd = rs274 + " -t " + tbl + " -g " + ngc + " " + out + " < /dev/null > " + log + " 2>&1";
+        const std::string cmd = test::rs274Command(dir.path.string(), tbl, ngc, out, log);
         ASSERT_EQ(std::system(cmd.c_str()), 0) << p.file << ": rs274 failed:\n" << test::readText(log);
         const std::vector<CanonMove> canon = parseCanon(test::readText(out));
         const std::array<char, 2> ax = linearPlaneAxes(c.plane);
