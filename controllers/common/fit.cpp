@@ -173,6 +173,18 @@ FitFigures figuresOf(const MachineModel& m, const DeviationSet& identified, cons
     return f;
 }
 
+/// The choice among the candidates: the smallest RMS among those whose largest error is not above none's (none always
+/// qualifies); `fitted` null where no fit was made. Sets out.written and out.chosen.
+void chooseCandidate(FitOutcome& out, const DeviationSet& zero, const DeviationSet& identified, const DeviationSet* fitted) {
+    const double noneMax = out.none.maxTip;
+    const auto qualifies = [&](const FitFigures& f) { return f.maxTip <= noneMax; };
+    out.written = zero;
+    out.chosen = "none";
+    double best = out.none.rmsTip;
+    if (qualifies(out.copied) && out.copied.rmsTip < best) out.written = identified, out.chosen = "identified", best = out.copied.rmsTip;
+    if (fitted && qualifies(out.fitted) && out.fitted.rmsTip < best) out.written = *fitted, out.chosen = "fitted";
+}
+
 std::string describe(const FitFigures& f) { return fmt::format("tip max {:.3f} um, RMS {:.3f} um", f.maxTip / kUm, f.rmsTip / kUm); }
 
 }  // namespace
@@ -228,9 +240,8 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
     if (!b.fitsDeviationValues()) {
         out.fitted = out.copied;
         out.fittedValues = identified;
-        const bool copy = out.copied.maxTip <= noneMax && out.copied.rmsTip < out.none.rmsTip;
-        out.written = copy ? identified : zero;
-        out.chosen = copy ? "identified" : "none";
+        chooseCandidate(out, zero, identified, nullptr);
+        const bool copy = out.chosen == "identified";
         out.notes.push_back(fmt::format("values not fitted to this controller: its files hold the error itself, sampled over {}",
                                         workspace.description));
         out.notes.push_back(fmt::format("tool-tip error predicted on the identified machine: none {}; identified values copied {}",
@@ -376,13 +387,7 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
     }
     out.fittedValues = fitted;
 
-    // The choice: the smallest RMS among the candidates whose largest error is not above none's (none always qualifies).
-    const auto qualifies = [&](const FitFigures& f) { return f.maxTip <= noneMax; };
-    out.written = zero;
-    out.chosen = "none";
-    double best = out.none.rmsTip;
-    if (qualifies(out.copied) && out.copied.rmsTip < best) out.written = identified, out.chosen = "identified", best = out.copied.rmsTip;
-    if (qualifies(out.fitted) && out.fitted.rmsTip < best) out.written = fitted, out.chosen = "fitted", best = out.fitted.rmsTip;
+    chooseCandidate(out, zero, identified, &fitted);
 
     out.notes.push_back(fmt::format("values fitted to this controller (least squares of the tool-tip error of the identified machine) "
                                     "over {}", workspace.description));
