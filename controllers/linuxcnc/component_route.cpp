@@ -81,14 +81,17 @@ EmitResult emitComponentRoute(const EmitRequest& r) {
             const double v = r.deviations.values[def.offset + k];
             hal += fmt::format("setp {}.{} {:.17g}\n", kKinsName, pinOf(def, k), v == 0.0 ? 0.0 : v);
         }
-    // Reversal values → [JOINT_n] BACKLASH (joint n = machine axis n here; no COMP_FILE on this route).
+    // Reversal values → [JOINT_n] BACKLASH = −B̄ (joint n = machine axis n here; no COMP_FILE on this route): LinuxCNC 2.9
+    // adds +BACKLASH/2 while the joint moves +, −BACKLASH/2 while it moves −, held at rest, after backlash_filt's ramp
+    // (control.c compute_screw_comp); a negative BACKLASH (B̄ > 0) is applied with its sign (kNegativeBacklashNote). Both
+    // run on the real LinuxCNC 2.9: tests/linuxcnc/test_linuxcnc_backlash.cpp.
     for (int a = 0; a < m.axisCount(); ++a) {
         if (!r.deviations.reversalPresent[static_cast<size_t>(a)]) continue;
         const double b = backlashFromReversal(r.deviations.reversal[static_cast<size_t>(a)]);
         ini += fmt::format("\n[JOINT_{}]\n# axis {}: BACKLASH = -B{} (the reversal value of the deviation set, laser_comp.hpp){}\n"
                            "BACKLASH = {}\n",
                            a, m.axisNames[static_cast<size_t>(a)], m.axisNames[static_cast<size_t>(a)],
-                           b < 0 ? "; negative: the slide overshoots on reversal, a negative BACKLASH is untested [G]" : "",
+                           b < 0 ? kNegativeBacklashNote : "",
                            fixed(b, 6));
     }
     out.files.push_back({kKinsSourceFile, source});

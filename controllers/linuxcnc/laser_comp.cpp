@@ -32,7 +32,7 @@ std::string laserCompIniLines(const LaserPositioningResult& r, int joint, const 
                      "# Without the table, the mean reversal alone would be BACKLASH = {:.6f} (mm, = -B-bar; "
                      "no pitch-error correction then)",
                      backlash);
-    if (backlash < 0) o += "; negative: the slide overshoots on reversal, a negative BACKLASH is untested [G]";
+    if (backlash < 0) o += kNegativeBacklashNote;
     o += "\n";
     return o;
 }

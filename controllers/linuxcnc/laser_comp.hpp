@@ -31,6 +31,16 @@ CompTable compTableFromLaser(const LaserPositioningResult& r);
 double backlashFromLaser(const LaserPositioningResult& r);
 /// The same from a reversal value B̄ in mm (DeviationSet::reversal: ISO 230-2's B̄ in the laser's frame): −B̄.
 inline double backlashFromReversal(double reversalMm) { return -reversalMm; }
+/// The comment written beside a negative BACKLASH (B̄ > 0: the slide overshoots on reversal). LinuxCNC 2.9 keeps the sign:
+/// inijoint.cc loadJoint reads BACKLASH as a plain double, taskintf.cc emcJointSetBacklash and command.c
+/// EMCMOT_SET_JOINT_BACKLASH pass it on unchanged, control.c compute_screw_comp sets backlash_corr = ±0.5·backlash by
+/// the direction of motion (no fabs) and ramps backlash_filt towards it with the same S-curve for either sign of the
+/// step; motor_pos_cmd = pos_cmd + backlash_filt (output_to_hal). Run on the real LinuxCNC 2.9
+/// (tests/linuxcnc/test_linuxcnc_backlash.cpp: BACKLASH = −0.003 mm gives motor-pos-cmd = pos-cmd ∓ 0.0015 mm at rest
+/// after +/− motion, as the apply model says).
+inline constexpr const char* kNegativeBacklashNote =
+    "; negative: the slide overshoots on reversal; LinuxCNC 2.9 applies it with its sign (control.c compute_screw_comp: "
+    "+BACKLASH/2 moving +, -BACKLASH/2 moving -; run on the real LinuxCNC 2.9)";
 
 /// The lines the user adds to the INI file for joint `joint` with the table written as `fileName` (to be placed beside
 /// the INI file: usrmotintf.cc opens the name as given and scripts/linuxcnc.in runs LinuxCNC in the INI's folder), with

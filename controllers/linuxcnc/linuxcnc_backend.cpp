@@ -145,7 +145,7 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
                 iniJoints += fmt::format("\n[JOINT_{}]\n# axis {}: BACKLASH = -{} (the reversal value of the deviation set){}\n"
                                          "BACKLASH = {}\n",
                                          n, j.name, reversalName,
-                                         b < 0 ? "; negative: the slide overshoots on reversal, a negative BACKLASH is untested [G]" : "",
+                                         b < 0 ? kNegativeBacklashNote : "",
                                          fixed(b, 6));
                 out.compensated.push_back({reversalName, fmt::format("[JOINT_{}] BACKLASH = {} mm", n, fixed(b, 6))});
             }

@@ -110,7 +110,8 @@ MAX_ANGULAR_VELOCITY = 50000
 
 /// Ideal drives, estop and tool-change loopbacks, the kinematics-mode switch (M68 E3), the sampler; no geometry pin
 /// (the route's HAL file sets them).
-std::string baseHal(int joints, const std::string& coordinates, bool sampled, bool switchkins) {
+std::string baseHal(int joints, const std::string& coordinates, bool sampled, bool switchkins,
+                    const std::vector<std::string>& sampledSignals) {
     std::string s = "loadrt [KINS]KINEMATICS\n"
                     "loadrt [EMCMOT]EMCMOT servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS\n"
                     "addf motion-command-handler servo-thread\naddf motion-controller servo-thread\n";
@@ -121,7 +122,7 @@ std::string baseHal(int joints, const std::string& coordinates, bool sampled, bo
     if (switchkins) s += "net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type\n";
     if (sampled) {
         s += fmt::format("loadrt sampler depth=20000 cfg={}\naddf sampler.0 servo-thread\nsetp sampler.0.enable 0\n",
-                         std::string(2 * coordinates.size() + 1, 'f') + "s");
+                         std::string(2 * coordinates.size() + 1, 'f') + "s" + std::string(sampledSignals.size(), 'f'));
         for (int j = 0; j < joints; ++j) s += fmt::format("net j{0} => sampler.0.pin.{0}\n", j);
         for (size_t k = 0; k < coordinates.size(); ++k)
             s += fmt::format("net ax{0} axis.{0}.pos-cmd => sampler.0.pin.{1}\n",
@@ -129,6 +130,8 @@ std::string baseHal(int joints, const std::string& coordinates, bool sampled, bo
         // motion.tooloffset.z through the route's own signal (cnccomp-kins.hal adds the writer): a pin takes one net.
         s += fmt::format("net cnccomp-tool-offset => sampler.0.pin.{}\n", joints + static_cast<int>(coordinates.size()));
         s += fmt::format("net program-line motion.program-line => sampler.0.pin.{}\n", joints + static_cast<int>(coordinates.size()) + 1);
+        for (size_t k = 0; k < sampledSignals.size(); ++k)
+            s += fmt::format("net {} => sampler.0.pin.{}\n", sampledSignals[k], joints + static_cast<int>(coordinates.size() + 2 + k));
     }
     return s;
 }
@@ -206,6 +209,7 @@ SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const f
                          double backlash, const SimOptions& o) {
     SimConfig c;
     c.dir = dir;
+    c.sampledSignals = o.sampled ? o.sampledSignals.size() : 0;
     fs::create_directories(dir);
     const bool kins = o.route == Route::Component;
     // The component route's files with the module renamed (installComponent installed it under that name).
@@ -221,7 +225,7 @@ SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const f
     c.joints = static_cast<int>(c.coordinates.size());
     c.ini = dir / "sim.ini";
     writeText(c.ini.string(), mergeIni(baseIni(m, c.coordinates, backlash, o), fragment));
-    writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled, o.switchkins));
+    writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled, o.switchkins, o.sampledSignals));
     if (o.extraHal) writeText((dir / "harness.hal").string(), o.extraHal(c.coordinates));
     if (kins) {
         writeText((dir / "cnccomp-kins.hal").string(), routeText("cnccomp-kins.hal"));
@@ -357,6 +361,8 @@ RunResult run(const SimConfig& c, const std::vector<std::string>& job, const std
             for (double& x : s.motor) ls >> x;
             for (double& x : s.axis) ls >> x;
             ls >> s.toolOffset >> s.programLine;
+            s.extra.resize(c.sampledSignals);
+            for (double& x : s.extra) ls >> x;
             if (!ls) throw std::runtime_error("unreadable sample line: " + line);
             result.samples.push_back(std::move(s));
         }

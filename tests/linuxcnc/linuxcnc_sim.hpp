@@ -41,11 +41,13 @@ struct Tool {
 /// HAL fragment as a second HALFILE (its setp lines set the pins); the route's files; a tool table; driver.py.
 /// base.hal also nets motion.analog-out-03 to motion.switchkins-type (README.txt: M68 E3 Qn + M66 E0 L0 switches the
 /// kinematics mode) and, with `sampled`, a `sampler` on the servo thread that records every joint's
-/// joint.N.motor-pos-cmd and then every axis' axis.L.pos-cmd each servo cycle (driver.py runs halsampler).
+/// joint.N.motor-pos-cmd, then every axis' axis.L.pos-cmd, motion.tooloffset.z, motion.program-line and the
+/// SimOptions::sampledSignals each servo cycle (driver.py runs halsampler).
 struct SimConfig {
     std::filesystem::path dir, ini;
     int joints = 0;
     std::string coordinates;  ///< joint letters in joint order
+    size_t sampledSignals = 0;  ///< SimOptions::sampledSignals.size()
 };
 
 enum class Route { Pins, Component };
@@ -67,6 +69,10 @@ struct SimOptions {
     /// A third HAL file (`harness.hal`, loaded after the route's), made from the joint letters in joint order: the
     /// test's own components, e.g. the virtual sphere. None when empty.
     std::function<std::string(const std::string& coordinates)> extraHal;
+    /// With `sampled`: HAL signals recorded as further float columns after the program line (Sample::extra), one per
+    /// name: base.hal nets each to a sampler pin; the test's extraHal gives the signal its writer. halsampler prints
+    /// floats with %f (1e-6 of the unit): a quantity wanted finer is sampled scaled (e.g. a sum2 with gains ±1e6).
+    std::vector<std::string> sampledSignals;
 };
 
 /// Builds the configuration in `dir` from the folder `emitted` (what `cnccomp emit` wrote, read as it is).
@@ -111,6 +117,7 @@ struct Sample {
     std::vector<double> motor, axis;  ///< joint.N.motor-pos-cmd, axis.L.pos-cmd (joint order)
     double toolOffset = 0;            ///< motion.tooloffset.z
     long programLine = 0;             ///< motion.program-line (the executing motion's line of the program, 1-based)
+    std::vector<double> extra;        ///< SimOptions::sampledSignals, in their order
 };
 
 struct RunResult {
