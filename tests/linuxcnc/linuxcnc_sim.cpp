@@ -111,7 +111,7 @@ MAX_ANGULAR_VELOCITY = 50000
 /// Ideal drives, estop and tool-change loopbacks, the kinematics-mode switch (M68 E3), the sampler; no geometry pin
 /// (the route's HAL file sets them).
 std::string baseHal(int joints, const std::string& coordinates, bool sampled, bool switchkins,
-                    const std::vector<std::string>& sampledSignals) {
+                    const std::vector<std::string>& sampledSignals, int samplerDepth) {
     std::string s = "loadrt [KINS]KINEMATICS\n"
                     "loadrt [EMCMOT]EMCMOT servo_period_nsec=[EMCMOT]SERVO_PERIOD num_joints=[KINS]JOINTS\n"
                     "addf motion-command-handler servo-thread\naddf motion-controller servo-thread\n";
@@ -121,7 +121,7 @@ std::string baseHal(int joints, const std::string& coordinates, bool sampled, bo
          "net tool-change-loop iocontrol.0.tool-change => iocontrol.0.tool-changed\n";
     if (switchkins) s += "net cnccomp-kinstype motion.analog-out-03 => motion.switchkins-type\n";
     if (sampled) {
-        s += fmt::format("loadrt sampler depth=20000 cfg={}\naddf sampler.0 servo-thread\nsetp sampler.0.enable 0\n",
+        s += fmt::format("loadrt sampler depth={} cfg={}\naddf sampler.0 servo-thread\nsetp sampler.0.enable 0\n", samplerDepth,
                          std::string(2 * coordinates.size() + 1, 'f') + "s" + std::string(sampledSignals.size(), 'f'));
         for (int j = 0; j < joints; ++j) s += fmt::format("net j{0} => sampler.0.pin.{0}\n", j);
         for (size_t k = 0; k < coordinates.size(); ++k)
@@ -225,7 +225,7 @@ SimConfig buildSimConfig(const MachineModel& m, const fs::path& emitted, const f
     c.joints = static_cast<int>(c.coordinates.size());
     c.ini = dir / "sim.ini";
     writeText(c.ini.string(), mergeIni(baseIni(m, c.coordinates, backlash, o), fragment));
-    writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled, o.switchkins, o.sampledSignals));
+    writeText((dir / "base.hal").string(), baseHal(c.joints, c.coordinates, o.sampled, o.switchkins, o.sampledSignals, o.samplerDepth));
     if (o.extraHal) writeText((dir / "harness.hal").string(), o.extraHal(c.coordinates));
     if (kins) {
         writeText((dir / "cnccomp-kins.hal").string(), routeText("cnccomp-kins.hal"));

@@ -73,6 +73,9 @@ struct SimOptions {
     /// name: base.hal nets each to a sampler pin; the test's extraHal gives the signal its writer. halsampler prints
     /// floats with %f (1e-6 of the unit): a quantity wanted finer is sampled scaled (e.g. a sum2 with gains ±1e6).
     std::vector<std::string> sampledSignals;
+    /// With `sampled`: the sampler's FIFO in servo cycles. halsampler, a user process, drains it; on a loaded machine it
+    /// can fall behind by seconds, and a full FIFO loses samples (RunResult::overruns): a run at 50 us wants more.
+    int samplerDepth = 20000;
 };
 
 /// Builds the configuration in `dir` from the folder `emitted` (what `cnccomp emit` wrote, read as it is).
