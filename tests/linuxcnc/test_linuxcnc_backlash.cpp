@@ -25,8 +25,9 @@
 //   machine's INI with trivkins and no BACKLASH) and by less than 1e-6 mm with them;
 // - in motion too (the blended sequence included): once a joint's direction has held for 100 cycles, motor-pos-cmd −
 //   pos-cmd = (BACKLASH/2)·s to 1e-9 mm in every cycle;
-// - the backlash filter reaches its target after every reversal within 100 cycles, for the negative BACKLASH too, and
-//   stays between the old and the new value on the way (measured: 41–54 cycles, 2–2.7 ms).
+// - the backlash filter reaches its target after every reversal, for the negative BACKLASH too, in the time of
+//   compute_screw_comp's S-curve (2·sqrt(|BACKLASH|/a_max), a_max = 0.5·acc_limit, +2 −5 cycles: measured 41–54
+//   cycles, 2–2.7 ms), and stays between the old and the new value on the way.
 // Skipped with the reason when LinuxCNC or halcompile (root) is not there; RESOURCE_LOCK linuxcnc, RUN_SERIAL.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -61,6 +62,8 @@ using controllers::OutputFile;
 
 constexpr double kScale = 1e6;  ///< HAL gain of the sampled differences (mm → nm)
 constexpr int kSettle = 100;    ///< cycles of a rest left out (interpolation lag, backlash ramp)
+/// The harness' INI (linuxcnc_sim.cpp baseIni, checked below): [JOINT_n] MAX_ACCELERATION, [TRAJ] DEFAULT_LINEAR_ACCELERATION.
+constexpr double kJointAcceleration = 50000, kTrajAcceleration = 5000;
 
 /// Reversal values of the set (µm) and the BACKLASH written for them (mm, −B̄).
 constexpr double kB[3] = {-4.0, -2.5, 3.0};
@@ -224,6 +227,9 @@ TEST(LinuxcncBacklash, TheEmittedBacklashActsAsControlCSaysNegativeIncludedAndTa
     o.samplerDepth = 200000;
     const sim::SimConfig with = sim::buildSimConfig(m, dir.path / "emitted", dir.path / "sim-with", {}, 0.0, o);
     ASSERT_EQ(with.coordinates, "XYZ");
+    const std::string simIni = readText(with.ini.string());
+    EXPECT_NE(simIni.find(fmt::format("\nMAX_ACCELERATION = {:g}\nBACKLASH", kJointAcceleration)), std::string::npos) << simIni;
+    EXPECT_NE(simIni.find(fmt::format("\nDEFAULT_LINEAR_ACCELERATION = {:g}\n", kTrajAcceleration)), std::string::npos) << simIni;
     // Without the files: the machine's own INI (trivkins, no BACKLASH), the same program and sampling.
     fs::create_directories(dir.path / "without");
     writeText(dir.file("without/cnccomp.ini"), "[KINS]\nKINEMATICS = trivkins coordinates=XYZ\nJOINTS = 3\n");
@@ -327,6 +333,7 @@ TEST(LinuxcncBacklash, TheEmittedBacklashActsAsControlCSaysNegativeIncludedAndTa
     // The ramp (compute_screw_comp's S-curve of backlash_filt): after each reversal the filter leaves the old value and
     // reaches the new one within kSettle cycles, never outside the two (negative BACKLASH included).
     int longestRamp = 0, ramps = 0;
+    double rampModel = 0;  ///< largest |measured − S-curve| in cycles
     std::string rampList;  ///< joint letter and cycles from the axis pin's reversal to the filter's target
     double outside = 0;
     for (int j = 0; j < 3; ++j) {
@@ -349,6 +356,16 @@ TEST(LinuxcncBacklash, TheEmittedBacklashActsAsControlCSaysNegativeIncludedAndTa
             }
             EXPECT_GE(n, 0) << "joint " << j << ": the filter did not reach " << to << " within " << kSettle << " cycles of cycle "
                             << runWith.samples[k].cycle;
+            // The S-curve of compute_screw_comp from rest: accelerate at a_max = 0.5·acc_limit, decelerate at a_max (v_max
+            // 0.5·MAX_VELOCITY is never reached for µm): |Δ| = 2 BACKLASH/2 in 2·sqrt(|Δ|/a_max). acc_limit is the joint's
+            // MAX_ACCELERATION capped at the trajectory's acceleration (control.c get_pos_cmds, free mode, which homing
+            // passes through: joint->acc_limit = emcmotStatus->acc = [TRAJ] DEFAULT_LINEAR_ACCELERATION, initraj.cc).
+            // The count starts at the axis pin's reversal, which the joint follows a cycle or two later.
+            const double aMax = 0.5 * std::min(kJointAcceleration, kTrajAcceleration);
+            const double cycles = 2.0 * std::sqrt(std::abs(to - from) / aMax) / (o.servoPeriodNs * 1e-9);
+            EXPECT_GE(n, cycles - 2) << "joint " << j << " at cycle " << runWith.samples[k].cycle;
+            EXPECT_LE(n, cycles + 5) << "joint " << j << " at cycle " << runWith.samples[k].cycle;
+            rampModel = std::max(rampModel, std::abs(n - cycles));
             longestRamp = std::max(longestRamp, n);
             rampList += fmt::format(" {}{}", "XYZ"[j], n);
             ++ramps;
@@ -362,10 +379,10 @@ TEST(LinuxcncBacklash, TheEmittedBacklashActsAsControlCSaysNegativeIncludedAndTa
         "50 us, runs {:.1f} s + {:.1f} s, halcompile {:.1f} s; {} samples at rest in {} rests ({} after reversals): "
         "|motor-pos-cmd - (pos-cmd + BACKLASH/2 s)| max {:.1e} mm; component model vs real {:.1e} mm, pins model vs real {:.1e} mm; "
         "pos-cmd - command {:.1e} mm; in motion (direction held {} cycles) {} joint samples, max {:.1e} mm; lost-motion machine: with the files max {:.1e} mm, without min {:.4f} um (|B|/2 to {:.1e} "
-        "mm); {} ramps, longest {} cycles ({}), overshoot {:.1e} mm\n",
+        "mm); {} ramps, longest {} cycles ({}), S-curve of control.c within {:.1f} cycles, overshoot {:.1e} mm\n",
         -kB[0] / 1000, -kB[1] / 1000, -kB[2] / 1000, runWith.samples.size(), runWithout.samples.size(), runWith.seconds,
         runWithout.seconds, install, checked, rests.size(), reversalRests, worstExpect, worstComponent, worstPins, worstJoint,
-        kSettle, moving, worstMoving, worstWith, smallestWithout / kUm, worstWithoutDiff, ramps, longestRamp, rampList, outside);
+        kSettle, moving, worstMoving, worstWith, smallestWithout / kUm, worstWithoutDiff, ramps, longestRamp, rampList, rampModel, outside);
 }
 
 }  // namespace
