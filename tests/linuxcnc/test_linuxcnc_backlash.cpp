@@ -247,7 +247,8 @@ TEST(LinuxcncBacklash, TheEmittedBacklashActsAsControlCSaysNegativeIncludedAndTa
     EXPECT_EQ(runWithout.overruns, 0);
     const Trace tw = traceOf(runWith, 3), to = traceOf(runWithout, 3);
     const std::vector<Rest> rests = restsOf(tw, 300), restsWithout = restsOf(to, 300);
-    // The start (before the program), 11 dwells, the end; the same in both runs.
+    // The start (before the program) and the 10 dwells (the last running into the end); on a loaded machine a stop
+    // between two moves can last 300 cycles too (a further rest, checked the same way).
     ASSERT_GE(rests.size(), 11u) << runWith.samples.size() << " samples";
     ASSERT_GE(restsWithout.size(), 11u) << runWithout.samples.size() << " samples";
 
