@@ -5,16 +5,34 @@
 
 namespace cnccomp::pp {
 
-OutputBuffer::OutputBuffer(std::ostream& out, size_t capacity) : out_(out), buf_(capacity < 64 ? 64 : capacity) {}
+OutputBuffer::OutputBuffer(std::ostream& out, size_t capacity) : out_(out), capacity_(std::max<size_t>(capacity, 64)) {
+    resize(std::min<size_t>(capacity_, 4096));
+}
 
 OutputBuffer::~OutputBuffer() {
     // flush() is explicit: a destructor must not throw, and a failed run must not look complete.
 }
 
-void OutputBuffer::flushSome(size_t) { flush(); }
+void OutputBuffer::resize(size_t size) {
+    std::unique_ptr<char[]> grown(new char[size]);  // default-initialised: no zero fill
+    if (used_) std::memcpy(grown.get(), buf_.get(), used_);
+    buf_ = std::move(grown);
+    size_ = size;
+}
+
+bool OutputBuffer::makeRoom(size_t need) {
+    if (need <= capacity_ - used_) {  // fits once the storage has grown
+        resize(std::min(capacity_, std::max(2 * size_, used_ + need)));
+        return true;
+    }
+    flush();
+    if (need > capacity_) return false;
+    if (need > size_) resize(std::min(capacity_, std::max(2 * size_, need)));
+    return true;
+}
 
 void OutputBuffer::flush() {
-    if (used_) out_.write(buf_.data(), static_cast<std::streamsize>(used_));
+    if (used_) out_.write(buf_.get(), static_cast<std::streamsize>(used_));
     written_ += used_;
     used_ = 0;
 }

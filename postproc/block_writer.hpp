@@ -1,35 +1,48 @@
 #pragma once
-// Writing blocks: a fixed-size output buffer over a stream, and the edits of one block (replace a byte span,
+// Writing blocks: an output buffer over a stream, and the edits of one block (replace a byte span,
 // insert text) applied to the original line so that every byte outside the edits is kept.
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <ostream>
 #include <string_view>
 #include <vector>
 
 namespace cnccomp::pp {
 
+/// Buffered writes to a stream: at most `capacity` bytes are held before they are written. The storage is not
+/// allocated at full capacity up front: it starts at 4 KiB and doubles as the output grows (never zero-filled), so a
+/// short output (a few blocks, a fuzz input) costs a small allocation, not a 1 MiB zero-filled one (measured under
+/// AddressSanitizer: the zero fill of 1 MiB per call was 80 % of the Klartext reader's fuzz target, ~330 page faults
+/// an input). The bytes reach the stream in the same order whatever the storage size.
 class OutputBuffer {
 public:
     explicit OutputBuffer(std::ostream& out, size_t capacity = size_t{1} << 20);
     ~OutputBuffer();
+    OutputBuffer(const OutputBuffer&) = delete;
+    OutputBuffer& operator=(const OutputBuffer&) = delete;
     void write(std::string_view s) {
-        if (s.size() > buf_.size() - used_) flushSome(s.size());
-        if (s.size() > buf_.size()) {
+        if (s.size() > size_ - used_ && !makeRoom(s.size())) {
             out_.write(s.data(), static_cast<std::streamsize>(s.size()));
             written_ += s.size();
             return;
         }
-        std::copy(s.begin(), s.end(), buf_.begin() + static_cast<std::ptrdiff_t>(used_));
+        std::copy(s.begin(), s.end(), buf_.get() + used_);
         used_ += s.size();
     }
     void flush();
     uint64_t bytesWritten() const { return written_ + used_; }
 
 private:
-    void flushSome(size_t need);
+    /// Grows the storage (up to the capacity) or flushes so that `need` more bytes fit; false when `need` exceeds the
+    /// capacity (the buffer is flushed and the caller writes the bytes directly).
+    bool makeRoom(size_t need);
+    void resize(size_t size);
     std::ostream& out_;
-    std::vector<char> buf_;
+    size_t capacity_;
+    std::unique_ptr<char[]> buf_;
+    size_t size_ = 0;  ///< allocated bytes of buf_ (<= capacity_)
     size_t used_ = 0;
     uint64_t written_ = 0;
 };
