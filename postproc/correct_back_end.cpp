@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "postproc/correct_move.hpp"
 
 namespace cnccomp::pp::iso {
 
@@ -176,14 +177,7 @@ void ProgramCorrector::move(Record& rec) {
         summary_.maxTipResidual = std::max(summary_.maxTipResidual, rec.tipResidual);
         summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, rec.axisResidual);
         if (rec.unconverged) ++summary_.unconverged;
-        for (int a = 0; a < n; ++a) {
-            const double d = std::fabs(cEnd[a] - cNom[a]);
-            if (layout_.rotary[a]) {
-                if (d > summary_.maxRotaryCorrection) summary_.maxRotaryCorrection = d, summary_.maxRotaryLine = no;
-            } else if (d > summary_.maxLinearCorrection) {
-                summary_.maxLinearCorrection = d, summary_.maxLinearLine = no;
-            }
-        }
+        countCorrection(summary_, layout_, cNom, cEnd, no);
     }
     if (rec.outsideTravel) ++summary_.outsideTravel;
     // Program position of the corrected end point (the nominal one when nothing was corrected).
@@ -201,15 +195,8 @@ void ProgramCorrector::move(Record& rec) {
     ctx.outStart.p = outPos_;
     ctx.outStart.v = outVector_;
     ctx.guess = cNom;
-    if (!identity && outStartKnown && nomStartKnown && offCourse_) {
-        // The output starts off the corrected nominal start (a block before it was passed through, or TCP was just
-        // switched on): splitting cannot remove that offset, so it is blended out along the move, not measured.
-        AxisVector c0, cOut;
-        if (corrector_.toJoints(space, nomStart, cNom, c0) && corrector_.toJoints(space, ctx.outStart, cNom, cOut)) {
-            ctx.startOffset = corrector_.actualTip(cOut, space.toolLength) - corrector_.nominalTip(c0, space.toolLength);
-            if (ctx.startOffset.norm() > options_.corrector.toleranceMm) ++summary_.offPathStarts;
-        }
-    }
+    if (!identity && outStartKnown && nomStartKnown && offCourse_)
+        blendStartOffset(corrector_, nomStart, options_.corrector.toleranceMm, ctx, summary_);
     ctx.tolerance = identity ? options_.corrector.toleranceMm : toleranceFor(space, no);
     if (isArc) {
         if (!outStartKnown) {
@@ -253,11 +240,7 @@ void ProgramCorrector::move(Record& rec) {
         if (measurable && !isRapid) corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
         else pieces_.push_back({1.0, qEnd});
     }
-    summary_.maxPathDeviation = std::max(summary_.maxPathDeviation, stats.maxDeviation);
-    if (stats.limited) {
-        ++summary_.limited;
-        notice(true, no, fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
-    }
+    countPath(stats, summary_, options_.report, no);
     const bool inverseTime = r_->feedMode == FeedMode::InverseTime;
     if (pieces_.size() > 1 && inverseTime && r_->feedWord < 0)
         notice(true, no, "inverse-time move without F split: the pieces carry no feed");
