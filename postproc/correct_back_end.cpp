@@ -149,18 +149,13 @@ void ProgramCorrector::switchMode() {
 }
 
 void ProgramCorrector::move(Record& rec) {
-    const int n = layout_.count;
     const Line ln{rec.text, rec.eolView(), rec.number, false, true, true};
     const uint64_t no = rec.number;
     const MoveSpace space = rec.space;
     const bool tcp = space.mode != ProgramMode::Joints;
     const bool identity = corrector_.identity();
-    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
-    const bool isRapid = r_->motion == Motion::Rapid && !r_->rapidIsFeed;
     const bool vector = space.mode == ProgramMode::TcpVector;
     bool outStartKnown = (outKnown_ & all_) == all_;
-    const bool nomStartKnown = rec.nomStartKnown;
-    const ProgramPoint& nomStart = rec.nomStart;
     const ProgramPoint& nomEnd = rec.nomEnd;
     const AxisVector& cNom = rec.cNom;
     const AxisVector& cEnd = rec.cEnd;
@@ -184,12 +179,36 @@ void ProgramCorrector::move(Record& rec) {
     ProgramPoint qEnd = nomEnd;
     if (rec.corrected) corrector_.toProgram(space, cEnd, qEnd);
 
-    // Pieces.
+    MovePieces pieces;
+    pieces.outStartKnown = outStartKnown;
+    if (!findPieces(rec, qEnd, pieces)) {
+        r_->reason = "arc from an output position that is not known";
+        r_->report = true;
+        --summary_.moves;
+        passThrough(ln, no);
+        return;
+    }
+    writeMove(rec, ln, pieces);
+}
+
+bool ProgramCorrector::findPieces(const Record& rec, ProgramPoint qEnd, MovePieces& p) {
+    const uint64_t no = rec.number;
+    const MoveSpace space = rec.space;
+    const bool identity = corrector_.identity();
+    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
+    const bool isRapid = r_->motion == Motion::Rapid && !r_->rapidIsFeed;
+    const bool vector = space.mode == ProgramMode::TcpVector;
+    const bool outStartKnown = p.outStartKnown, nomStartKnown = rec.nomStartKnown;
+    const ProgramPoint& nomStart = rec.nomStart;
+    const ProgramPoint& nomEnd = rec.nomEnd;
+    const AxisVector& cNom = rec.cNom;
     pieces_.clear();
     SplitStats stats;
-    bool arcKept = false, arcToLines = false;
-    ArcFit fit;
-    const AxisVector outStart = outPos_;
+    bool& arcKept = p.arcKept;
+    bool& arcToLines = p.arcToLines;
+    ArcFit& fit = p.fit;
+    p.outStart = outPos_;
+    const AxisVector& outStart = p.outStart;
     PathContext ctx;
     ctx.space = space;
     ctx.outStart.p = outPos_;
@@ -199,13 +218,7 @@ void ProgramCorrector::move(Record& rec) {
         blendStartOffset(corrector_, nomStart, options_.corrector.toleranceMm, ctx, summary_);
     ctx.tolerance = identity ? options_.corrector.toleranceMm : toleranceFor(space, no);
     if (isArc) {
-        if (!outStartKnown) {
-            r_->reason = "arc from an output position that is not known";
-            r_->report = true;
-            --summary_.moves;
-            passThrough(ln, no);
-            return;
-        }
+        if (!outStartKnown) return false;
         MovePath path = MovePath::arc(r_->start, r_->end, r_->arc);
         path.vector = vector;
         path.v0 = nomStart.v;
@@ -244,7 +257,21 @@ void ProgramCorrector::move(Record& rec) {
     const bool inverseTime = r_->feedMode == FeedMode::InverseTime;
     if (pieces_.size() > 1 && inverseTime && r_->feedWord < 0)
         notice(true, no, "inverse-time move without F split: the pieces carry no feed");
+    return true;
+}
 
+void ProgramCorrector::writeMove(const Record& rec, const Line& ln, const MovePieces& p) {
+    const int n = layout_.count;
+    const uint64_t no = rec.number;
+    const MoveSpace space = rec.space;
+    const bool identity = corrector_.identity();
+    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
+    const bool vector = space.mode == ProgramMode::TcpVector;
+    const bool inverseTime = r_->feedMode == FeedMode::InverseTime;
+    const bool arcKept = p.arcKept, arcToLines = p.arcToLines, outStartKnown = p.outStartKnown;
+    const ArcFit& fit = p.fit;
+    const AxisVector& outStart = p.outStart;
+    const AxisVector& cEnd = rec.cEnd;
     // Piece 1 goes onto the original block.
     edits_.clear();
     const Motion pieceMotion = arcToLines ? Motion::Linear : r_->motion;
