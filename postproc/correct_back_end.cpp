@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "postproc/correct_move.hpp"
 
 namespace cnccomp::pp::iso {
 
@@ -148,18 +149,13 @@ void ProgramCorrector::switchMode() {
 }
 
 void ProgramCorrector::move(Record& rec) {
-    const int n = layout_.count;
     const Line ln{rec.text, rec.eolView(), rec.number, false, true, true};
     const uint64_t no = rec.number;
     const MoveSpace space = rec.space;
     const bool tcp = space.mode != ProgramMode::Joints;
     const bool identity = corrector_.identity();
-    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
-    const bool isRapid = r_->motion == Motion::Rapid && !r_->rapidIsFeed;
     const bool vector = space.mode == ProgramMode::TcpVector;
     bool outStartKnown = (outKnown_ & all_) == all_;
-    const bool nomStartKnown = rec.nomStartKnown;
-    const ProgramPoint& nomStart = rec.nomStart;
     const ProgramPoint& nomEnd = rec.nomEnd;
     const AxisVector& cNom = rec.cNom;
     const AxisVector& cEnd = rec.cEnd;
@@ -176,49 +172,53 @@ void ProgramCorrector::move(Record& rec) {
         summary_.maxTipResidual = std::max(summary_.maxTipResidual, rec.tipResidual);
         summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, rec.axisResidual);
         if (rec.unconverged) ++summary_.unconverged;
-        for (int a = 0; a < n; ++a) {
-            const double d = std::fabs(cEnd[a] - cNom[a]);
-            if (layout_.rotary[a]) {
-                if (d > summary_.maxRotaryCorrection) summary_.maxRotaryCorrection = d, summary_.maxRotaryLine = no;
-            } else if (d > summary_.maxLinearCorrection) {
-                summary_.maxLinearCorrection = d, summary_.maxLinearLine = no;
-            }
-        }
+        countCorrection(summary_, layout_, cNom, cEnd, no);
     }
     if (rec.outsideTravel) ++summary_.outsideTravel;
     // Program position of the corrected end point (the nominal one when nothing was corrected).
     ProgramPoint qEnd = nomEnd;
     if (rec.corrected) corrector_.toProgram(space, cEnd, qEnd);
 
-    // Pieces.
+    MovePieces pieces;
+    pieces.outStartKnown = outStartKnown;
+    if (!findPieces(rec, qEnd, pieces)) {
+        r_->reason = "arc from an output position that is not known";
+        r_->report = true;
+        --summary_.moves;
+        passThrough(ln, no);
+        return;
+    }
+    writeMove(rec, ln, pieces);
+}
+
+bool ProgramCorrector::findPieces(const Record& rec, ProgramPoint qEnd, MovePieces& p) {
+    const uint64_t no = rec.number;
+    const MoveSpace space = rec.space;
+    const bool identity = corrector_.identity();
+    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
+    const bool isRapid = r_->motion == Motion::Rapid && !r_->rapidIsFeed;
+    const bool vector = space.mode == ProgramMode::TcpVector;
+    const bool outStartKnown = p.outStartKnown, nomStartKnown = rec.nomStartKnown;
+    const ProgramPoint& nomStart = rec.nomStart;
+    const ProgramPoint& nomEnd = rec.nomEnd;
+    const AxisVector& cNom = rec.cNom;
     pieces_.clear();
     SplitStats stats;
-    bool arcKept = false, arcToLines = false;
-    ArcFit fit;
-    const AxisVector outStart = outPos_;
+    bool& arcKept = p.arcKept;
+    bool& arcToLines = p.arcToLines;
+    ArcFit& fit = p.fit;
+    p.outStart = outPos_;
+    const AxisVector& outStart = p.outStart;
     PathContext ctx;
     ctx.space = space;
     ctx.outStart.p = outPos_;
     ctx.outStart.v = outVector_;
     ctx.guess = cNom;
-    if (!identity && outStartKnown && nomStartKnown && offCourse_) {
-        // The output starts off the corrected nominal start (a block before it was passed through, or TCP was just
-        // switched on): splitting cannot remove that offset, so it is blended out along the move, not measured.
-        AxisVector c0, cOut;
-        if (corrector_.toJoints(space, nomStart, cNom, c0) && corrector_.toJoints(space, ctx.outStart, cNom, cOut)) {
-            ctx.startOffset = corrector_.actualTip(cOut, space.toolLength) - corrector_.nominalTip(c0, space.toolLength);
-            if (ctx.startOffset.norm() > options_.corrector.toleranceMm) ++summary_.offPathStarts;
-        }
-    }
+    if (!identity && outStartKnown && nomStartKnown && offCourse_)
+        blendStartOffset(corrector_, nomStart, options_.corrector.toleranceMm, ctx, summary_);
     ctx.tolerance = identity ? options_.corrector.toleranceMm : toleranceFor(space, no);
     if (isArc) {
-        if (!outStartKnown) {
-            r_->reason = "arc from an output position that is not known";
-            r_->report = true;
-            --summary_.moves;
-            passThrough(ln, no);
-            return;
-        }
+        if (!outStartKnown) return false;
         MovePath path = MovePath::arc(r_->start, r_->end, r_->arc);
         path.vector = vector;
         path.v0 = nomStart.v;
@@ -253,15 +253,25 @@ void ProgramCorrector::move(Record& rec) {
         if (measurable && !isRapid) corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
         else pieces_.push_back({1.0, qEnd});
     }
-    summary_.maxPathDeviation = std::max(summary_.maxPathDeviation, stats.maxDeviation);
-    if (stats.limited) {
-        ++summary_.limited;
-        notice(true, no, fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
-    }
+    countPath(stats, summary_, options_.report, no);
     const bool inverseTime = r_->feedMode == FeedMode::InverseTime;
     if (pieces_.size() > 1 && inverseTime && r_->feedWord < 0)
         notice(true, no, "inverse-time move without F split: the pieces carry no feed");
+    return true;
+}
 
+void ProgramCorrector::writeMove(const Record& rec, const Line& ln, const MovePieces& p) {
+    const int n = layout_.count;
+    const uint64_t no = rec.number;
+    const MoveSpace space = rec.space;
+    const bool identity = corrector_.identity();
+    const bool isArc = r_->motion == Motion::ArcCw || r_->motion == Motion::ArcCcw;
+    const bool vector = space.mode == ProgramMode::TcpVector;
+    const bool inverseTime = r_->feedMode == FeedMode::InverseTime;
+    const bool arcKept = p.arcKept, arcToLines = p.arcToLines, outStartKnown = p.outStartKnown;
+    const ArcFit& fit = p.fit;
+    const AxisVector& outStart = p.outStart;
+    const AxisVector& cEnd = rec.cEnd;
     // Piece 1 goes onto the original block.
     edits_.clear();
     const Motion pieceMotion = arcToLines ? Motion::Linear : r_->motion;

@@ -62,7 +62,20 @@ private:
     // Called once per line or move, in the file that defines them: inline, so that they are inlined there.
     inline void warnings(uint64_t no);
     void passThrough(const Line& ln, uint64_t no);
+    /// What the path check decided for one move: its pieces are pieces_.
+    struct MovePieces {
+        bool outStartKnown = false;
+        bool arcKept = false, arcToLines = false;
+        ArcFit fit;
+        AxisVector outStart;  ///< the output's position at the start of the move
+    };
+    /// A move: the summary's counts, then its pieces (findPieces), then its words (writeMove).
     void move(Record& rec);
+    /// The pieces of the move ending at the corrected program position `qEnd`: the arc kept (refitted), the arc as
+    /// lines, or the line split where the tolerance needs it. False: an arc from an unknown output position.
+    bool findPieces(const Record& rec, ProgramPoint qEnd, MovePieces& p);
+    /// Piece 1 onto the block's own words, the further pieces as new lines in the block's style.
+    void writeMove(const Record& rec, const Line& ln, const MovePieces& p);
     void switchMode();
     void updateOutputAfterPassThrough();
     inline double toleranceFor(const MoveSpace& space, uint64_t no);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
 
@@ -81,22 +80,6 @@ void FrontEnd::refuse(Record& rec, const char* reason) {
     afterPassThrough(rec.r);
 }
 
-void FrontEnd::checkTravel(Record& rec) {
-    const AxisVector &cNom = rec.cNom, &c = rec.cEnd;
-    for (int a = 0; a < layout_.count; ++a) {
-        const double lo = travelMin_[a], hi = travelMax_[a];
-        const bool nomOut = cNom[a] < lo - 1e-9 || cNom[a] > hi + 1e-9;
-        const bool corOut = c[a] < lo - 1e-9 || c[a] > hi + 1e-9;
-        if (!nomOut && !corOut) continue;
-        rec.outsideTravel = true;
-        const double k = layout_.rotary[a] ? 1.0 / kDeg : 1.0;
-        const char* unit = layout_.rotary[a] ? "deg" : "mm";
-        rec.note(true, fmt::format("axis {} at {:.4f} {} ({}) is outside its travel [{:g}, {:g}] {}: corrected all the same",
-                                   layout_.letter[a], (nomOut ? cNom[a] : c[a]) * k, unit,
-                                   nomOut ? "as programmed" : "after correction", lo * k, hi * k, unit));
-    }
-}
-
 void FrontEnd::move(Record& rec) {
     BlockResult& r = rec.r;
     const MoveSpace space{r.mode, r.controlLength, r.tipLength};
@@ -145,30 +128,17 @@ void FrontEnd::move(Record& rec) {
     if (identity) {
         cEnd = cNom;
     } else {
-        // Near the previous end point's correction (warm start and continuity) and the programmed value.
-        AxisVector start;
-        if (haveDelta_) corrector_.predictStart(cNom, lastCNom_, lastDelta_, space.toolLength, start);
-        else start = cNom + lastDelta_;
-        const SolveResult s = corrector_.solve(cNom, space.toolLength, start, cEnd, haveDelta_ ? &lastDelta_ : nullptr,
-                                               Vec3::Zero(), &nomPose);
-        rec.tipResidual = s.tipError;
-        rec.axisResidual = s.axisError;
-        if (!s.converged || !(s.tipError < 1e-5)) {
-            rec.unconverged = true;
-            rec.note(true, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
-                                       s.tipError / kUm));
-            cEnd = cNom;
-        } else {
-            if (r.tipLengthAssumed && options_.requireToolLength)
-                refuseAssumedToolLength(corrector_, layout_, cNom, cEnd, space.toolLength, options_.corrector.toleranceMm,
-                                        options_.inputName, rec.number);
-            lastDelta_ = cEnd - cNom;
-            lastCNom_ = cNom;
-            haveDelta_ = true;
-            rec.corrected = true;  // the back end writes cEnd's program position (toProgram)
-        }
+        const EndPointSolver::Result s = endPoints_.solve(corrector_, layout_, options_, space.toolLength, cNom, &nomPose,
+                                                          {r.tipLengthAssumed, rec.number}, cEnd);
+        rec.tipResidual = s.tipResidual;
+        rec.axisResidual = s.axisResidual;
+        rec.unconverged = s.unconverged;
+        rec.corrected = s.corrected;  // the back end writes cEnd's program position (toProgram)
+        if (s.unconverged) rec.note(true, s.failure);
     }
-    if (!(identity && tcp && !vector)) checkTravel(rec);
+    if (!(identity && tcp && !vector) &&
+        travel_.check(cNom, cEnd, [&](std::string message) { rec.note(true, std::move(message)); }))
+        rec.outsideTravel = true;
     rec.jointsComputed = !identity || vector || !tcp;
     nomAt_ = Where{true, space, nomEnd, cNom, rec.jointsComputed, nomEnd.v, vector};
 }

@@ -2,6 +2,7 @@
 // The front end of the RS274NGC-family corrector: lines → lexed blocks → interpreted blocks → corrected end points.
 #include "cnccomp/deviations.hpp"
 #include "cnccomp/machine.hpp"
+#include "postproc/correct_move.hpp"
 #include "postproc/correct_program.hpp"
 #include "postproc/correct_record.hpp"
 #include "postproc/line_reader.hpp"
@@ -19,14 +20,10 @@ public:
           layout_(AxisLayout::fromMachine(m)),
           interp_(layout_, InterpreterOptions{dialect, o.setup, o.rotaryShortest, o.tcpOnM, o.tcpOffM}),
           corrector_(m, d, o.corrector),
-          reader_(reader) {
-        lastDelta_ = AxisVector::Zero(layout_.count);
+          reader_(reader),
+          endPoints_(layout_.count),
+          travel_(m, layout_) {
         all_ = layout_.all();
-        for (int a = 0; a < layout_.count; ++a) {  // travel in the controller's machine coordinates
-            const Link& link = m.axisLink(a);
-            travelMin_[a] = link.min - link.machineZero;
-            travelMax_[a] = link.max - link.machineZero;
-        }
     }
 
     /// The next line into `rec`; false at the end of the input.
@@ -37,7 +34,6 @@ private:
     void switchMode(const BlockResult& r);
     void move(Record& rec);
     void refuse(Record& rec, const char* reason);
-    inline void checkTravel(Record& rec);  // once per move, in its own file: inlined there
 
     const MachineModel& machine_;
     const CorrectOptions& options_;
@@ -49,9 +45,8 @@ private:
     Line line_;
     OverlongLine long_;
     Where nomAt_;
-    AxisVector lastDelta_, lastCNom_;
-    double travelMin_[kMaxAxes] = {}, travelMax_[kMaxAxes] = {};
-    bool haveDelta_ = false;  ///< lastDelta_ is the correction at the previous end point (continuity)
+    EndPointSolver endPoints_;
+    TravelCheck travel_;
     AxisMask all_ = 0;
 };
 

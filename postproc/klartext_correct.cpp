@@ -10,6 +10,7 @@
 
 #include "cnccomp/error.hpp"
 #include "postproc/block_writer.hpp"
+#include "postproc/correct_move.hpp"
 #include "postproc/correction.hpp"
 #include "postproc/klartext_blocks.hpp"
 #include "cnccomp/io/number_format.hpp"
@@ -29,7 +30,9 @@ public:
           corrector_(m, d, o.corrector),
           interp_(layout_, o.setup, o.inputName),
           summary_(s),
-          out_(out) {
+          out_(out),
+          endPoints_(layout_.count),
+          travel_(m, layout_) {
         all_ = layout_.all();
         for (int a = 0; a < layout_.count; ++a) {
             if (layout_.rotary[a]) rotary_ |= 1u << a, ++rotaryCount_;
@@ -37,7 +40,6 @@ public:
         }
         outPos_ = interp_.position();
         outKnown_ = interp_.known();
-        lastDelta_ = AxisVector::Zero(layout_.count);
         decimals_.fill(-1);
         pieces_.reserve(static_cast<size_t>(o.corrector.maxPieces) + 4);
         interp_.setConverter([this](ProgramMode from, ProgramMode to, double lc, AxisVector& pos, AxisMask known) {
@@ -68,7 +70,6 @@ private:
     void passThrough(const char* why, bool report);
     void outputAfterPassThrough();
     void move();
-    void checkTravel(const AxisVector& cNom, const AxisVector& c, bool& outside);
     double toleranceFor(const MoveSpace& space);
     int decimalsFor(int a) const;
     size_t number(int a, double pv, char* out, double& readBack, double& res) const;
@@ -102,9 +103,11 @@ private:
     AxisVector outPos_;
     AxisMask outKnown_ = 0;
     bool offCourse_ = true;
-    // Continuity of the solutions and guesses.
-    AxisVector lastDelta_, nomJoints_;
-    bool haveDelta_ = false, nomJointsValid_ = false;
+    // The end points (each from the previous one's correction) and the guesses of the nominal joints.
+    EndPointSolver endPoints_;
+    TravelCheck travel_;
+    AxisVector nomJoints_;
+    bool nomJointsValid_ = false;
     std::vector<Piece> pieces_;
     int64_t shift_ = 0;  ///< blocks inserted so far: added to every later leading block number
     bool warnedTolerance_ = false, warnedCr_ = false;
@@ -269,24 +272,6 @@ void KlartextCorrector::passThrough(const char* why, bool report) {
     if (b_.tcpOffAtEnd) outKnown_ = convert(ProgramMode::TcpAngles, ProgramMode::Joints, b_.controlLength, outPos_, outKnown_);
 }
 
-void KlartextCorrector::checkTravel(const AxisVector& cNom, const AxisVector& c, bool& outside) {
-    for (int a = 0; a < layout_.count; ++a) {
-        const Link& link = machine_.axisLink(a);
-        const double mz = link.machineZero;
-        const double lo = link.min - mz, hi = link.max - mz;
-        const bool nomOut = cNom[a] < lo - 1e-9 || cNom[a] > hi + 1e-9;
-        const bool corOut = c[a] < lo - 1e-9 || c[a] > hi + 1e-9;
-        if (!nomOut && !corOut) continue;
-        outside = true;
-        const double k = layout_.rotary[a] ? 1.0 / kDeg : 1.0;
-        const char* unit = layout_.rotary[a] ? "deg" : "mm";
-        notice(true, line_,
-               fmt::format("axis {} at {:.4f} {} ({}) is outside its travel [{:g}, {:g}] {}: corrected all the same",
-                           layout_.letter[a], (nomOut ? cNom[a] : c[a]) * k, unit, nomOut ? "as programmed" : "after correction",
-                           lo * k, hi * k, unit));
-    }
-}
-
 int KlartextCorrector::decimalsFor(int a) const {
     if (options_.decimals >= 0) return options_.decimals;
     const int floor = layout_.rotary[a] ? 4 : (interp_.inch() ? 5 : 4);
@@ -432,7 +417,6 @@ std::string KlartextCorrector::pieceWords(const ProgramPoint& q) {
 }
 
 void KlartextCorrector::move() {
-    const int n = layout_.count;
     if (b_.tcpOnAtStart) outKnown_ = convert(ProgramMode::Joints, ProgramMode::TcpAngles, b_.controlLength, outPos_, outKnown_);
     const MoveSpace space{b_.mode, b_.controlLength, b_.tipLength};
     const bool tcp = space.mode != ProgramMode::Joints;
@@ -463,38 +447,23 @@ void KlartextCorrector::move() {
     ProgramPoint nomEnd{b_.end, Vec3(0, 0, -1)}, nomStart{b_.start, Vec3(0, 0, -1)};
     const AxisVector guess = nomJointsValid_ ? nomJoints_ : b_.end;
     AxisVector cNom, cEnd;
-    if (!corrector_.toJoints(space, nomEnd, guess, cNom))
+    NominalPose nomPose;
+    if (!corrector_.toJoints(space, nomEnd, guess, cNom, &nomPose))
         return passThrough("the controller's TCP kinematics cannot reach this position", true);
     ++summary_.moves;
     if (tcp) ++summary_.tcpMoves;
-    const SolveResult s = corrector_.solve(cNom, space.toolLength, cNom + lastDelta_, cEnd, haveDelta_ ? &lastDelta_ : nullptr);
-    bool corrected = false;
-    summary_.maxTipResidual = std::max(summary_.maxTipResidual, s.tipError);
-    summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, s.axisError);
-    if (!s.converged || !(s.tipError < 1e-5)) {
+    const EndPointSolver::Result s =
+        endPoints_.solve(corrector_, layout_, options_, space.toolLength, cNom, &nomPose, {b_.tipLengthAssumed, line_}, cEnd);
+    const bool corrected = s.corrected;
+    summary_.maxTipResidual = std::max(summary_.maxTipResidual, s.tipResidual);
+    summary_.maxAxisResidual = std::max(summary_.maxAxisResidual, s.axisResidual);
+    if (s.unconverged) {
         ++summary_.unconverged;
-        notice(true, line_, fmt::format("the correction did not converge (tip residual {:.3g} um); end point left uncorrected",
-                                        s.tipError / kUm));
-        cEnd = cNom;
-    } else {
-        if (b_.tipLengthAssumed && options_.requireToolLength)
-            refuseAssumedToolLength(corrector_, layout_, cNom, cEnd, space.toolLength, options_.corrector.toleranceMm,
-                                    options_.inputName, line_);
-        lastDelta_ = cEnd - cNom;
-        haveDelta_ = true;
-        corrected = true;
+        notice(true, line_, s.failure);
     }
-    bool outside = false;
-    checkTravel(cNom, cEnd, outside);
-    if (outside) ++summary_.outsideTravel;
-    for (int a = 0; a < n; ++a) {
-        const double d = std::fabs(cEnd[a] - cNom[a]);
-        if (layout_.rotary[a]) {
-            if (d > summary_.maxRotaryCorrection) summary_.maxRotaryCorrection = d, summary_.maxRotaryLine = line_;
-        } else if (d > summary_.maxLinearCorrection) {
-            summary_.maxLinearCorrection = d, summary_.maxLinearLine = line_;
-        }
-    }
+    if (travel_.check(cNom, cEnd, [&](std::string message) { notice(true, line_, std::move(message)); }))
+        ++summary_.outsideTravel;
+    countCorrection(summary_, layout_, cNom, cEnd, line_);
     nomJoints_ = cNom;
     nomJointsValid_ = true;
     ProgramPoint qEnd = nomEnd;
@@ -508,13 +477,8 @@ void KlartextCorrector::move() {
     ctx.space = space;
     ctx.outStart.p = outPos_;
     ctx.guess = cNom;
-    if (outStartKnown && nomStartKnown && offCourse_) {
-        AxisVector c0, cOut;
-        if (corrector_.toJoints(space, nomStart, cNom, c0) && corrector_.toJoints(space, ctx.outStart, cNom, cOut)) {
-            ctx.startOffset = corrector_.actualTip(cOut, space.toolLength) - corrector_.nominalTip(c0, space.toolLength);
-            if (ctx.startOffset.norm() > options_.corrector.toleranceMm) ++summary_.offPathStarts;
-        }
-    }
+    if (outStartKnown && nomStartKnown && offCourse_)
+        blendStartOffset(corrector_, nomStart, options_.corrector.toleranceMm, ctx, summary_);
     ctx.tolerance = toleranceFor(space);
     if (isArc) {
         if (!outStartKnown) {
@@ -539,11 +503,7 @@ void KlartextCorrector::move() {
             pieces_.push_back({1.0, qEnd});
         }
     }
-    summary_.maxPathDeviation = std::max(summary_.maxPathDeviation, stats.maxDeviation);
-    if (stats.limited) {
-        ++summary_.limited;
-        notice(true, line_, fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
-    }
+    countPath(stats, summary_, options_.report, line_);
     // Piece 1 on the block itself.
     const bool rewrite = isArc || b_.polar;
     wordsOnBlock(pieces_[0].q, rewrite);
