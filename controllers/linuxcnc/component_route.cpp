@@ -63,7 +63,6 @@ EmitResult emitComponentRoute(const EmitRequest& r) {
         fmt::format("modes: switchkins-type 0 (default) joint mode: axis words = the nominal machine's commands (cnccomp "
                     "testprog's programs, G43.1 Z<tool length> with Z written minus it); switchkins-type 1 tool-tip mode: X Y Z = tool tip in workpiece coordinates"),
         "deviation pins: link values (mm, rad; component errors: basis coefficients) read back by cnccomp verify from this file"};
-    notes.insert(notes.end(), r.headerNotes.begin(), r.headerNotes.end());
     const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC 2.9 (component {})", kKinsName), out, notes);
 
     std::string ini = formatHeader(h, "# ");

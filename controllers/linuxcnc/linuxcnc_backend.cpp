@@ -207,7 +207,6 @@ EmitResult emitPinsRoute(const EmitRequest& r) {
                                     "cnccomp testprog's) get the joint tables only",
                                     module));
     }
-    notes.insert(notes.end(), r.headerNotes.begin(), r.headerNotes.end());
     const HeaderInfo h = makeHeaderInfo(r, fmt::format("LinuxCNC 2.9 ({})", module), out, notes);
 
     out.files = tables;
