@@ -26,6 +26,27 @@ void direct(const SmallMatrix& G, bool vectors, AxisConditioning& c) {
     if (vectors) c.V = eig.eigenvectors();
 }
 
+/// A⁻¹ of the symmetric positive definite A by Cholesky (Eigen::LLT), column by column (Eigen's solve with a matrix
+/// right-hand side takes its blocked GEMM path, several times the instructions at these sizes). False when A is not
+/// positive definite or the inverse is not finite.
+template <int N>
+bool invertFixed(const SmallMatrix& A, SmallMatrix& inverse) {
+    using M = Eigen::Matrix<double, N, N, 0, N == Eigen::Dynamic ? kMaxAxes : N, N == Eigen::Dynamic ? kMaxAxes : N>;
+    using V = Eigen::Matrix<double, N, 1, 0, N == Eigen::Dynamic ? kMaxAxes : N, 1>;
+    const int n = static_cast<int>(A.rows());
+    const M a = A;
+    const Eigen::LLT<M> llt(a);
+    if (llt.info() != Eigen::Success) return false;
+    V e = V::Zero(n);
+    for (int c = 0; c < n; ++c) {
+        e.setZero();
+        e[c] = 1.0;
+        llt.solveInPlace(e);
+        inverse.col(c) = e;
+    }
+    return inverse.allFinite();
+}
+
 }  // namespace
 
 void AxisConditioning::compute(const PoseJacobian& J, uint32_t mask, double scale, bool vectors) {
@@ -94,21 +115,15 @@ bool DampedNormalFactor::factor(const PoseJacobian& J, const SmallMatrix& JtJ, c
         }
     if (ridge != 0)
         for (int i = 0; i < n; ++i) A(i, i) += ridge * (1.0 + A(i, i));
-    const Eigen::LLT<SmallMatrix> llt(A);
     gain.resize(n, 6);
     inverse.resize(n, n);
-    bool ok = llt.info() == Eigen::Success;
-    if (ok) {
-        // Column by column: Eigen's solve with a matrix right-hand side takes its blocked (GEMM) path, several times
-        // the instructions of two small triangular solves per column at these sizes.
-        AxisVector e(n);
-        for (int c = 0; c < n; ++c) {
-            e.setZero();
-            e[c] = 1.0;
-            llt.solveInPlace(e);
-            inverse.col(c) = e;
-        }
-        ok = inverse.allFinite();
+    bool ok = false;
+    switch (n) {  // fixed sizes: Eigen unrolls the factorisation and the triangular solves
+        case 3: ok = invertFixed<3>(A, inverse); break;
+        case 4: ok = invertFixed<4>(A, inverse); break;
+        case 5: ok = invertFixed<5>(A, inverse); break;
+        case 6: ok = invertFixed<6>(A, inverse); break;
+        default: ok = invertFixed<Eigen::Dynamic>(A, inverse); break;
     }
     if (!ok) {  // not positive definite (NaN): no step, the solve reports non-convergence
         inverse.setZero();
