@@ -194,108 +194,6 @@ void Corrector::toProgram(const MoveSpace& s, const AxisVector& c, ProgramPoint&
     }
 }
 
-namespace {
-
-/// Inverse of the symmetric positive definite n × n matrix A (n ≤ kMaxAxes, row-major arrays) by Cholesky: a few
-/// hundred flops for the post-processor's 5 × 5 normal matrices. False when A is not positive definite.
-bool invertSpd(const double A[kMaxAxes][kMaxAxes], int n, double inv[kMaxAxes][kMaxAxes]) {
-    double L[kMaxAxes][kMaxAxes], Li[kMaxAxes][kMaxAxes];
-    for (int j = 0; j < n; ++j) {
-        double d = A[j][j];
-        for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
-        if (!(d > 0)) return false;
-        L[j][j] = std::sqrt(d);
-        for (int i = j + 1; i < n; ++i) {
-            double v = A[i][j];
-            for (int k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
-            L[i][j] = v / L[j][j];
-        }
-    }
-    for (int j = 0; j < n; ++j) {  // L⁻¹, lower triangular
-        Li[j][j] = 1.0 / L[j][j];
-        for (int i = j + 1; i < n; ++i) {
-            double v = 0;
-            for (int k = j; k < i; ++k) v -= L[i][k] * Li[k][j];
-            Li[i][j] = v / L[i][i];
-        }
-    }
-    for (int i = 0; i < n; ++i)  // A⁻¹ = L⁻ᵀ L⁻¹
-        for (int j = 0; j <= i; ++j) {
-            double v = 0;
-            for (int k = i; k < n; ++k) v += Li[k][i] * Li[k][j];
-            inv[i][j] = inv[j][i] = v;
-        }
-    return true;
-}
-
-/// Eigenvalues (ascending) and unit eigenvectors (columns of V) of the symmetric k × k matrix G.
-void symmetricEigen(const double G[kMaxAxes][kMaxAxes], int k, double lambda[kMaxAxes], double V[kMaxAxes][kMaxAxes]) {
-    if (k == 1) {
-        lambda[0] = G[0][0];
-        V[0][0] = 1.0;
-    } else if (k == 2) {
-        const double mean = 0.5 * (G[0][0] + G[1][1]), half = 0.5 * (G[0][0] - G[1][1]);
-        const double r = std::hypot(half, G[0][1]), th = 0.5 * std::atan2(G[0][1], half);
-        lambda[0] = mean - r;  // eigenvector (−sin θ, cos θ)
-        lambda[1] = mean + r;  // eigenvector (cos θ, sin θ)
-        V[0][0] = -std::sin(th), V[1][0] = std::cos(th);
-        V[0][1] = std::cos(th), V[1][1] = std::sin(th);
-    } else {
-        // Cyclic Jacobi rotations (k ≤ kMaxAxes; machines with three rotary axes or more).
-        double M[kMaxAxes][kMaxAxes];
-        for (int i = 0; i < k; ++i)
-            for (int j = 0; j < k; ++j) M[i][j] = G[i][j], V[i][j] = i == j ? 1.0 : 0.0;
-        for (int sweep = 0; sweep < 50; ++sweep) {
-            double off = 0, diag = 0;
-            for (int i = 0; i < k; ++i) {
-                diag += M[i][i] * M[i][i];
-                for (int j = i + 1; j < k; ++j) off += M[i][j] * M[i][j];
-            }
-            if (off <= 1e-30 * diag) break;
-            for (int p = 0; p < k; ++p)
-                for (int q = p + 1; q < k; ++q) {
-                    if (M[p][q] == 0.0) continue;
-                    const double th = 0.5 * std::atan2(2 * M[p][q], M[q][q] - M[p][p]);
-                    const double c = std::cos(th), s = std::sin(th);
-                    for (int i = 0; i < k; ++i) {  // M ← M Rᵀ-columns, V ← V R
-                        const double mp = M[i][p], mq = M[i][q];
-                        M[i][p] = c * mp - s * mq, M[i][q] = s * mp + c * mq;
-                        const double vp = V[i][p], vq = V[i][q];
-                        V[i][p] = c * vp - s * vq, V[i][q] = s * vp + c * vq;
-                    }
-                    for (int j = 0; j < k; ++j) {
-                        const double mp = M[p][j], mq = M[q][j];
-                        M[p][j] = c * mp - s * mq, M[q][j] = s * mp + c * mq;
-                    }
-                }
-        }
-        int order[kMaxAxes];
-        for (int i = 0; i < k; ++i) order[i] = i;
-        std::sort(order, order + k, [&](int a, int b) { return M[a][a] < M[b][b]; });
-        double W[kMaxAxes][kMaxAxes];
-        for (int e = 0; e < k; ++e) {
-            lambda[e] = M[order[e]][order[e]];
-            for (int i = 0; i < k; ++i) W[i][e] = V[i][order[e]];
-        }
-        for (int i = 0; i < k; ++i)
-            for (int e = 0; e < k; ++e) V[i][e] = W[i][e];
-    }
-}
-
-/// Smallest eigenvalue of the symmetric k × k matrix G.
-double smallestEigenvalue(const double G[kMaxAxes][kMaxAxes], int k) {
-    if (k == 1) return G[0][0];
-    if (k == 2) {
-        const double h = 0.5 * (G[0][0] - G[1][1]);
-        return 0.5 * (G[0][0] + G[1][1]) - std::sqrt(h * h + G[0][1] * G[0][1]);
-    }
-    double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
-    symmetricEigen(G, k, lambda, V);
-    return lambda[0];
-}
-
-}  // namespace
-
 bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, double toolLength) const {
     if (!cache.valid || cache.toolLength != toolLength || cache.q.size() != q.size()) return false;
     for (int i = 0; i < q.size(); ++i) {
@@ -307,12 +205,10 @@ bool Corrector::cacheUsable(const JacobianCache& cache, const AxisVector& q, dou
 
 void Corrector::refreshJacobian(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const AxisVector& q,
                                 double toolLength) const {
-    const int n = static_cast<int>(q.size());
     Vec3 tip, axis;
     k.jacobian(kd, q, toolLength, cache.J, tip, axis);
     cache.J.bottomRows<3>() *= options_.axisWeight;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j <= i; ++j) cache.JtJ[i][j] = cache.JtJ[j][i] = cache.J.col(i).dot(cache.J.col(j));
+    normalMatrix(cache.J, cache.JtJ);
     cache.q = q;
     cache.toolLength = toolLength;
     cache.valid = true;
@@ -322,32 +218,8 @@ void Corrector::refreshJacobian(const KinematicsModel& k, KinematicsData& kd, Ja
 }
 
 void Corrector::factor(JacobianCache& cache, const Damping& damping, AxisMask free) const {
-    const int n = static_cast<int>(cache.q.size());
-    double A[kMaxAxes][kMaxAxes];
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            const bool both = (free & (1u << i)) && (free & (1u << j));
-            A[i][j] = both ? cache.JtJ[i][j] + (damping.any ? damping.D[i][j] : 0.0) : (i == j ? 1.0 : 0.0);
-        }
-    for (int i = 0; i < n; ++i) A[i][i] += 1e-12 * (1.0 + A[i][i]);
-    if (!invertSpd(A, n, cache.Ainv)) {
-        for (int i = 0; i < n; ++i)  // not positive definite (NaN): no step, the solve reports non-convergence
-            for (int j = 0; j < n; ++j) cache.Ainv[i][j] = 0.0;
-    }
-    double Jt[kMaxAxes][6];  // Jᵀ as a plain array
-    for (int j = 0; j < n; ++j)
-        for (int r = 0; r < 6; ++r) Jt[j][r] = cache.J(r, j);
-    for (int i = 0; i < n; ++i) {
-        double v[6] = {0, 0, 0, 0, 0, 0};
-        if (free & (1u << i))
-            for (int j = 0; j < n; ++j) {
-                const double a = cache.Ainv[i][j];
-                for (int r = 0; r < 6; ++r) v[r] += a * Jt[j][r];
-            }
-        for (int r = 0; r < 6; ++r) cache.gain[i][r] = v[r];
-    }
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) cache.D[i][j] = damping.any ? damping.D[i][j] : 0.0;
+    cache.normal.factor(cache.J, cache.JtJ, damping.any ? &damping.D : nullptr, free);
+    if (damping.any) cache.D = damping.D;
     cache.damped = damping.any;
     cache.free = free;
     cache.factored = true;
@@ -369,11 +241,12 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
         // turn — both of the same order).
         nominal_.jacobian(nominalData_, cache.q - deltaPrev, toolLength, Jn, tip, axis);
         Jn.bottomRows<3>() *= options_.axisWeight;
+        cache.slope.resize(n, n);
         for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j) {
                 double v = 0;
-                for (int r = 0; r < 6; ++r) v += cache.gain[i][r] * (Jn(r, j) - cache.J(r, j));
-                cache.slope[i][j] = v;
+                for (int r = 0; r < 6; ++r) v += cache.normal.gain(i, r) * (Jn(r, j) - cache.J(r, j));
+                cache.slope(i, j) = v;
             }
         cache.slopeValid = cache.slopeKnown = true;
         cache.slopeLength = toolLength;
@@ -386,7 +259,7 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
     for (int j = 0; j < n; ++j) step[j] = cNom[j] - cNomPrev[j];
     for (int i = 0; i < n; ++i) {
         double v = 0;
-        for (int j = 0; j < n; ++j) v += cache.slope[i][j] * step[j];
+        for (int j = 0; j < n; ++j) v += cache.slope(i, j) * step[j];
         start[i] += v;
     }
 }
@@ -394,16 +267,12 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
 bool Corrector::factorUsable(const JacobianCache& cache, const Damping& damping, AxisMask free) const {
     if (!cache.factored || cache.free != free) return false;
     if (!damping.any && !cache.damped) return true;
-    const int n = static_cast<int>(cache.q.size());
     // The damping enters the fixed point through the gradient exactly; the factorisation only sets the rate, so a
     // close one is kept (a changed damping near a singular pose refactors).
-    double size = 0, diff = 0;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            const double d = damping.any ? damping.D[i][j] : 0.0;
-            size = std::max(size, std::fabs(d));
-            diff = std::max(diff, std::fabs(d - cache.D[i][j]));
-        }
+    if (!damping.any) return false;  // cache.damped: D ≠ 0 against none (diff > 0.1 · 0)
+    if (!cache.damped) return false;  // none against D ≠ 0
+    const double size = damping.D.cwiseAbs().maxCoeff();
+    const double diff = (damping.D - cache.D).cwiseAbs().maxCoeff();
     return diff <= 0.1 * size;
 }
 
@@ -412,64 +281,50 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
     const int n = static_cast<int>(cNom.size());
     damping.any = false;  // D is read only when `any`; it is zeroed below before the first term is added
     reference = cNom;
-    int axes[kMaxAxes], k = 0;
-    for (int i = 0; i < n; ++i)
-        if (free & rotary_ & (1u << i)) axes[k++] = i;
-    if (k == 0) return;
+    const AxisMask axes = free & rotary_;
+    if (axes == 0) return;
     // Conditioning of the orientation: singular values of the tool axis' derivatives by the rotary axes (rad/rad,
     // the sine of the angle between the tool axis and a rotary axis for one axis). First estimated from the kept
     // Jacobian of the erroneous machine near this point; where that is clearly well conditioned, nothing is damped.
     const double s0 = options_.singularSine;
-    double G[kMaxAxes][kMaxAxes];
-    auto gram = [&](const PoseJacobian& J, double scale) {
-        for (int a = 0; a < k; ++a)
-            for (int b = 0; b <= a; ++b)
-                G[a][b] = G[b][a] = J.block<3, 1>(3, axes[a]).dot(J.block<3, 1>(3, axes[b])) * scale;
-    };
+    AxisConditioning& cond = conditioning_;
     if (cache_.valid && cache_.toolLength == toolLength) {
         // The reference: the kept Jacobian of the erroneous machine (once per kept Jacobian), or the nominal one of
         // the last exact evaluation below, whichever is newer. Turning rotary axis j by δⱼ turns each column (a unit
         // rotary direction × the tool axis) by at most 2|δⱼ|, so the singular values at cNom differ from the
         // reference's by at most 2√k Σ|δⱼ| plus the deviations' share (≪ 0.01 rad).
         if (cache_.sigmaFree != free) {
-            gram(cache_.J, 1.0 / (options_.axisWeight * options_.axisWeight));
-            cache_.sigma = std::sqrt(std::max(0.0, smallestEigenvalue(G, k)));
+            cond.compute(cache_.J, axes, 1.0 / (options_.axisWeight * options_.axisWeight), false);
+            cache_.sigma = cond.smallestSingularValue();
             cache_.sigmaFree = free;
             cache_.sigmaQ = cache_.q;
         }
         double moved = 0;
-        for (int a = 0; a < k; ++a) moved += std::fabs(cache_.sigmaQ[axes[a]] - (cNom[axes[a]] + zero_[axes[a]]));
+        int k = 0;
+        for (int i = 0; i < n; ++i)
+            if (axes & (1u << i)) moved += std::fabs(cache_.sigmaQ[i] - (cNom[i] + zero_[i])), ++k;
         if (cache_.sigma >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
     }
-    // The nominal machine's at the target, exactly: D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ, φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, so
-    // that damping and continuity act only in the ill-conditioned directions and fade smoothly into the exact solution.
+    // The nominal machine's at the target, exactly: the one singular-pose policy (pose_solver.hpp), D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ,
+    // φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, λ² = rotaryDamping² + continuity², so that damping and continuity act
+    // only in the ill-conditioned directions and fade smoothly into the exact solution.
     PoseJacobian Jn;
     Vec3 tip, axis;
     nominal_.jacobian(nominalData_, cNom + zero_, toolLength, Jn, tip, axis);
-    gram(Jn, 1.0);
-    double lambda[kMaxAxes], V[kMaxAxes][kMaxAxes];
-    symmetricEigen(G, k, lambda, V);
+    cond.compute(Jn, axes, 1.0, true);
     if (cache_.valid && cache_.toolLength == toolLength && cache_.sigmaFree == free) {  // the newer reference
-        cache_.sigma = std::sqrt(std::max(0.0, lambda[0]));
+        cache_.sigma = cond.smallestSingularValue();
         cache_.sigmaQ = cNom + zero_;
     }
     const double lp2 = options_.rotaryDamping * options_.rotaryDamping;
     const double lc2 = neighbourDelta ? options_.continuity * options_.continuity : 0.0;
     const double lam2 = lp2 + lc2;
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) damping.D[i][j] = 0.0;
-    for (int e = 0; e < k; ++e) {
-        const double sigma = std::sqrt(std::max(0.0, lambda[e]));
-        if (sigma >= s0) continue;
-        const double phi = (1.0 - sigma / s0) * (1.0 - sigma / s0);
-        for (int a = 0; a < k; ++a)
-            for (int b = 0; b < k; ++b) damping.D[axes[a]][axes[b]] += lam2 * phi * V[a][e] * V[b][e];
-        damping.any = true;
-    }
+    damping.any = singularDamping({std::sqrt(lam2), s0}, cond, n, damping.D);
     // Two pulls on the rotary corrections d = c − cNom in the damped directions: λp²|d|² + λc²|d − dNeighbour|² =
     // (λp² + λc²)|d − dRef|² + const, dRef = λc² dNeighbour / (λp² + λc²).
     if (damping.any && neighbourDelta)
-        for (int a = 0; a < k; ++a) reference[axes[a]] += (lc2 / lam2) * (*neighbourDelta)[axes[a]];
+        for (int i = 0; i < n; ++i)
+            if (axes & (1u << i)) reference[i] += (lc2 / lam2) * (*neighbourDelta)[i];
 }
 
 SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const Vec3& targetTip,
@@ -482,30 +337,20 @@ SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, Jac
     if (!zeroIsZero_) q += zero_;
     const AxisVector& ref = model(reference, refScratch);
     const double w = options_.axisWeight;
-    double step[kMaxAxes], g[kMaxAxes], r[6];
+    Eigen::Matrix<double, 6, 1> r;
+    AxisVector step(n), offset(n);
     if (!cacheUsable(cache, q, toolLength)) refreshJacobian(k, kd, cache, q, toolLength);
     bool fresh = cache.q == q;  // evaluated at this very start (here or by solve())
     if (!factorUsable(cache, damping, free)) factor(cache, damping, free);
     double lastStep = HUGE_VAL, linStep = 0.0, rotStep = 0.0;
     auto newtonStep = [&]() {
-        // step = A⁻¹ (Jᵀ r − D (q − ref)); fixed axes have zero rows in A⁻¹ Jᵀ.
-        if (damping.any)
-            for (int i = 0; i < n; ++i) {
-                double v = 0;
-                for (int j = 0; j < n; ++j) v += damping.D[i][j] * (q[j] - ref[j]);
-                g[i] = v;
-            }
+        // step = A⁻¹ (Jᵀ r − D (q − ref)) (pose_solver.hpp); fixed axes have zero rows in A⁻¹ Jᵀ.
+        if (damping.any) offset = q - ref;
+        cache.normal.step(r, damping.any ? &damping.D : nullptr, offset, free, step);
         linStep = rotStep = 0.0;
         for (int i = 0; i < n; ++i) {
-            double v = 0;
-            if (free & (1u << i)) {
-                for (int j = 0; j < 6; ++j) v += cache.gain[i][j] * r[j];
-                if (damping.any)
-                    for (int j = 0; j < n; ++j) v -= cache.Ainv[i][j] * g[j];
-            }
-            step[i] = v;
-            if (rotary_ & (1u << i)) rotStep = std::max(rotStep, std::fabs(v));
-            else linStep = std::max(linStep, std::fabs(v));
+            if (rotary_ & (1u << i)) rotStep = std::max(rotStep, std::fabs(step[i]));
+            else linStep = std::max(linStep, std::fabs(step[i]));
         }
         return linStep + 100.0 * rotStep;
     };

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cnccomp/kinematics_engine.hpp"
+#include "cnccomp/pose_solver.hpp"
 #include "postproc/modal.hpp"
 #include "postproc/tcp_model.hpp"
 
@@ -196,16 +197,15 @@ private:
         double toolLength = 0;
         AxisVector q;
         PoseJacobian J;                          ///< axis rows weighted by axisWeight
-        double JtJ[kMaxAxes][kMaxAxes] = {};
+        SmallMatrix JtJ;                         ///< JᵀJ
         AxisMask free = 0;                       ///< of the factorisation
-        double D[kMaxAxes][kMaxAxes] = {};       ///< damping of the factorisation
+        SmallMatrix D;                           ///< damping of the factorisation (read only when `damped`)
         bool damped = false;                     ///< D is not all zero
-        double Ainv[kMaxAxes][kMaxAxes] = {};    ///< (JᵀJ + D)⁻¹
-        double gain[kMaxAxes][6] = {};           ///< Ainv · Jᵀ (zero rows for fixed axes)
+        DampedNormalFactor normal;               ///< (JᵀJ + D)⁻¹ and its gain (JᵀJ + D)⁻¹ Jᵀ (pose_solver.hpp)
         bool slopeValid = false;                 ///< `slope` belongs to this Jacobian and factorisation
         bool slopeKnown = false;                 ///< `slope` was computed (perhaps at an earlier Jacobian)
         double slopeLength = 0;                  ///< tool length of `slope`
-        double slope[kMaxAxes][kMaxAxes] = {};   ///< ∂(c − cNom)/∂cNom (see predictStart)
+        SmallMatrix slope;                       ///< ∂(c − cNom)/∂cNom (see predictStart)
         AxisMask sigmaFree = ~0u;                ///< free axes `sigma` was computed for (~0: not computed)
         double sigma = 0;                        ///< smallest singular value of the tool axis' derivatives by the free
                                                  ///< rotary axes at sigmaQ (J's, or the nominal one of dampingFor)
@@ -214,7 +214,7 @@ private:
     /// Rotary damping of one solve: D (n × n, non-zero in the rotary rows and columns of ill-conditioned directions).
     struct Damping {
         bool any = false;
-        double D[kMaxAxes][kMaxAxes];  ///< read only when `any` (left unset otherwise)
+        SmallMatrix D;  ///< read only when `any` (left unset otherwise)
     };
     SolveResult solveOn(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
                         double toolLength, const AxisVector& start, const AxisVector& reference, const Damping& damping,
@@ -245,6 +245,7 @@ private:
     bool identity_ = false;
     bool affine_ = false;  ///< no component errors: with rotary axes fixed, the error is affine in the linear axes
     AxisMask rotary_ = 0;
+    AxisConditioning conditioning_;  ///< scratch of dampingFor
     JacobianCache cache_;  ///< kept from one solve to the next (with the workspaces: one Corrector per thread)
     bool lastDamped_ = false;  ///< the last solve was damped (near a singular pose)
 };

@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 
+#include "cnccomp/pose_solver.hpp"
+
 namespace cnccomp {
 
 ToolPose toolPose(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame) {
@@ -40,17 +42,9 @@ void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipI
 }
 
 double rotarySingularValue(const MachineModel& m, const PoseJacobian& J) {
-    // Fixed-capacity storage: called once per Gauss–Newton iteration, no allocation.
-    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxAxes, kMaxAxes>;
-    int rotary[kMaxAxes], k = 0;
-    for (int i = 0; i < m.axisCount(); ++i)
-        if (m.axisLink(i).kind == AxisKind::Rotary) rotary[k++] = i;
-    if (k == 0) return 1.0;
-    Small G(k, k);
-    for (int a = 0; a < k; ++a)
-        for (int b = 0; b < k; ++b) G(a, b) = J.block<3, 1>(3, rotary[a]).dot(J.block<3, 1>(3, rotary[b]));
-    const double lambda = Eigen::SelfAdjointEigenSolver<Small>(G, Eigen::EigenvaluesOnly).eigenvalues()[0];
-    return std::sqrt(std::max(lambda, 0.0));
+    AxisConditioning c;  // fixed-capacity storage: called once per Gauss–Newton iteration, no allocation
+    c.compute(J, rotaryAxes(m), 1.0, false);
+    return c.smallestSingularValue();
 }
 
 /// The pull's weight at the current Jacobian (IkOptions::rotaryRegularization, singularZone).
@@ -64,32 +58,41 @@ static double pullWeight(const MachineModel& m, const PoseJacobian& J, const IkO
 
 IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& tipInToolFrame, const AxisVector& start,
                        const IkOptions& o) {
-    using System = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6 + kMaxAxes, kMaxAxes>;
-    using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6 + kMaxAxes, 1>;
     const MachineModel& m = k.machine();
     const int n = static_cast<int>(start.size());
+    const uint32_t all = n >= 32 ? ~0u : (1u << n) - 1u, rotary = rotaryAxes(m, all);
     IkResult r;
     r.q = start;
     PoseJacobian J;
-    System A(6 + n, n);
-    Rhs b(6 + n);
-    for (r.iterations = 0; r.iterations < o.maxIterations; ++r.iterations) {
+    Eigen::Matrix<double, 6, 1> b;
+    SmallMatrix JtJ, D;
+    DampedNormalFactor normal;
+    AxisConditioning cond;
+    AxisVector step(n), offset(n);
+    // The weighted residual and Jacobian at r.q (tool-axis rows × axisWeight) and JᵀJ.
+    const auto linearise = [&]() {
         const ToolPose p = toolPose(k, r.q, tipInToolFrame);
-        r.tipError = (target.tip - p.tip).norm();
-        r.axisError = (target.axis - p.axis).norm();
-        toolPoseJacobian(k, r.q, tipInToolFrame, J);
-        A.setZero();
-        A.topRows<3>() = J.topRows<3>();
-        A.middleRows<3>(3) = J.bottomRows<3>() * o.axisWeight;
         b.head<3>() = target.tip - p.tip;
-        b.segment<3>(3) = (target.axis - p.axis) * o.axisWeight;
+        b.tail<3>() = (target.axis - p.axis) * o.axisWeight;
+        toolPoseJacobian(k, r.q, tipInToolFrame, J);
         const double pull = pullWeight(m, J, o);
-        for (int i = 0; i < n; ++i) {
-            const bool rotary = m.axisLink(i).kind == AxisKind::Rotary;
-            A(6 + i, i) = rotary ? pull : 0.0;
-            b[6 + i] = rotary ? pull * (start[i] - r.q[i]) : 0.0;
-        }
-        const AxisVector step = A.colPivHouseholderQr().solve(b);
+        J.bottomRows<3>() *= o.axisWeight;
+        normalMatrix(J, JtJ);
+        return pull;
+    };
+    for (r.iterations = 0; r.iterations < o.maxIterations; ++r.iterations) {
+        const double pull = linearise();
+        r.tipError = b.head<3>().norm();
+        r.axisError = b.tail<3>().norm() / o.axisWeight;
+        // The pull as the singular-pose policy's constant damping (pose_solver.hpp, zone 0: D = pull² on the rotary
+        // axes); with singularZone its weight follows the smallest singular value (pullWeight).
+        cond.k = 0;
+        for (int i = 0; i < n; ++i)
+            if (rotary & (1u << i)) cond.axes[cond.k++] = i;
+        const bool damped = singularDamping({pull, 0.0}, cond, n, D);
+        offset = r.q - start;
+        normal.factor(J, JtJ, damped ? &D : nullptr, all, 0.0);
+        normal.step(b, damped ? &D : nullptr, offset, all, step);
         r.q += step;
         if (step.norm() <= std::max(1e-13 * (1.0 + r.q.norm()), 0.1 * o.tolerance)) {
             r.converged = true;
@@ -98,25 +101,20 @@ IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& 
         }
     }
     // Polish without the pull, so that regular poses meet the axis fully; a polish step that would swing a rotary
-    // axis (a singular direction) or does not lower the cost is refused.
+    // axis (a singular direction), that the undamped normal matrix cannot give (singular) or that does not lower the
+    // cost is refused.
     const auto cost = [&](const AxisVector& q) {
         const ToolPose p = toolPose(k, q, tipInToolFrame);
         return (target.tip - p.tip).squaredNorm() + (o.axisWeight * (target.axis - p.axis)).squaredNorm();
     };
     double current = cost(r.q);
     for (int polish = 0; polish < 4 && r.converged && o.polish; ++polish) {
-        const ToolPose p = toolPose(k, r.q, tipInToolFrame);
-        toolPoseJacobian(k, r.q, tipInToolFrame, J);
-        A.setZero();
-        A.topRows<3>() = J.topRows<3>();
-        A.middleRows<3>(3) = J.bottomRows<3>() * o.axisWeight;
-        b.setZero();
-        b.head<3>() = target.tip - p.tip;
-        b.segment<3>(3) = (target.axis - p.axis) * o.axisWeight;
-        const AxisVector step = A.topRows(6).colPivHouseholderQr().solve(b.head<6>());
+        linearise();
+        if (!normal.factor(J, JtJ, nullptr, all, 0.0)) break;
+        normal.step(b, nullptr, offset, all, step);
         double rotaryStep = 0;
         for (int i = 0; i < n; ++i)
-            if (m.axisLink(i).kind == AxisKind::Rotary) rotaryStep = std::max(rotaryStep, std::abs(step[i]));
+            if (rotary & (1u << i)) rotaryStep = std::max(rotaryStep, std::abs(step[i]));
         if (!(rotaryStep < o.rotaryRegularization / o.axisWeight)) break;
         const AxisVector trial = r.q + step;
         const double c = cost(trial);

@@ -1,20 +1,22 @@
-// The singular pose (tool axis parallel to a rotary axis) through the three inverse solvers: the core's solveToolPose
-// (IkOptions: constant rotary pull + polish), the TCP controllers' apply models (controllers/common/tcp_solver:
-// truncated pseudo-inverse) and correct (postproc/correction: damping in the ill-conditioned directions). Their
-// policies differ in form; this test fixes what they share at the singular pose: the tip is met, the rotary axis that
-// cannot turn the tool axis stays where it was commanded (no swing), and the tool-axis error that no axis can remove
-// is left, the same in all three. Oracle: the exact forward kinematics (cnccomp::Kinematics) at each solution.
+// The singular pose (tool axis parallel to a rotary axis) through the configurations of the inverse solver
+// (src/cnccomp/pose_solver.hpp, one damped step): the core's solveToolPose as the controllers' apply models and verify
+// use it (IkOptions: constant rotary pull + polish), as the LinuxCNC kinematics component mirrors it
+// (kinsSolverOptions: pull inside the singular zone only, no polish), and correct's chord Newton (postproc/correction:
+// the singular-pose policy's damping in the ill-conditioned directions). This test fixes what they share at the
+// singular pose: the tip is met, the rotary axis that cannot turn the tool axis stays where it was commanded (no
+// swing), and the tool-axis error that no axis can remove is left, the same in all three. Oracle: the exact forward
+// kinematics (cnccomp::Kinematics) at each solution.
 #include <gtest/gtest.h>
 
 #include "cnccomp/inverse_kinematics.hpp"
-#include "controllers/common/tcp_solver.hpp"
+#include "controllers/linuxcnc/kins_component.hpp"
 #include "postproc/correction.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
 namespace {
 
-TEST(SingularPose, ToolAxisParallelToCIsHandledAlikeByTheThreeSolvers) {
+TEST(SingularPose, ToolAxisParallelToCIsHandledAlikeByTheThreeConfigurations) {
     // Multitasking machine at B = 0 (and just off it): the tool axis is parallel to C; the spindle's tilt about X
     // (aBT) cannot be corrected there by any axis.
     const MachineModel& m = test::multitasking();
@@ -36,12 +38,13 @@ TEST(SingularPose, ToolAxisParallelToCIsHandledAlikeByTheThreeSolvers) {
         q[B] = bDeg * kDeg;
         const ToolPose target = toolPose(nominal, q, tip);
         const IkResult core = solveToolPose(actual, target, tip, q);
-        const AxisVector tcp = controllers::compensatedCommands(actual, target, tip, q);
+        const IkResult kins = solveToolPose(actual, target, tip, q, controllers::linuxcnc::kinsSolverOptions());
+        EXPECT_TRUE(kins.converged);
         AxisVector corrected;
         const pp::SolveResult s = corrector.solve(q, L, q, corrected);
         EXPECT_TRUE(core.converged);
         EXPECT_TRUE(s.converged);
-        for (const AxisVector* sol : std::initializer_list<const AxisVector*>{&core.q, &tcp, &corrected}) {
+        for (const AxisVector* sol : std::initializer_list<const AxisVector*>{&core.q, &kins.q, &corrected}) {
             const ToolPose got = toolPose(actual, *sol, tip);
             EXPECT_LT((got.tip - target.tip).norm(), 1e-6);         // mm: the slides meet the tip
             EXPECT_LT(std::fabs((*sol)[C] - q[C]), 1e-3);          // rad: C is not swung round
@@ -49,7 +52,7 @@ TEST(SingularPose, ToolAxisParallelToCIsHandledAlikeByTheThreeSolvers) {
             EXPECT_NEAR(axisError / kArcsec, 6.5, 0.5);           // the uncorrectable tilt is left, in all three
         }
         // The three solutions are one pose to well within the tolerance of correct (1 µm).
-        EXPECT_LT((toolPose(actual, tcp, tip).tip - toolPose(actual, core.q, tip).tip).norm(), 1e-6);
+        EXPECT_LT((toolPose(actual, kins.q, tip).tip - toolPose(actual, core.q, tip).tip).norm(), 1e-6);
         EXPECT_LT((toolPose(actual, corrected, tip).tip - toolPose(actual, core.q, tip).tip).norm(), 1e-6);
     }
 }
