@@ -86,7 +86,27 @@ void KinematicsModel::bind(KinematicsData& d) const {
     if (d.model_ == id_) return;
     d = KinematicsData();
     d.model_ = id_;
-    if (exact_) d.angles_.assign(static_cast<size_t>(rotarySlots_), KinematicsData::AngleMemo());
+    if (exact_) {
+        d.angles_.assign(static_cast<size_t>(rotarySlots_), KinematicsData::AngleMemo());
+        d.workpieceFrames_.assign(kFrameMemo, KinematicsData::FrameEntry());
+        d.toolFrames_.assign(kFrameMemo, KinematicsData::FrameEntry());
+    }
+}
+
+const Frame& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, std::vector<KinematicsData::FrameEntry>& memo,
+                                        const AxisVector& q) const {
+    static_assert(kFrameMemo == 64);
+    uint64_t h = 0;
+    for (int a : c.axes) h = (h ^ std::bit_cast<uint64_t>(q[a])) * 0x9E3779B97F4A7C15ULL;
+    KinematicsData::FrameEntry& e = memo[static_cast<size_t>(h >> 58)];
+    bool hit = e.valid;
+    for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == std::bit_cast<uint64_t>(q[c.axes[k]]);
+    if (!hit) {
+        evaluate(d, c, q, e.frame, nullptr);
+        for (size_t k = 0; k < c.axes.size(); ++k) e.key[k] = std::bit_cast<uint64_t>(q[c.axes[k]]);
+        e.valid = true;
+    }
+    return e.frame;
 }
 
 void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
@@ -338,9 +358,9 @@ const KinematicsModel::ChainEntry& KinematicsModel::cached(KinematicsData& d, co
 
 void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
     bind(d);
-    const Frame& w = cached(d, workpiece_, d.workpiece_, q, false).frame;
-    const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
     if (exact_) {  // toolPose(Kinematics, q, toolPoint(length)) in inverse_kinematics.cpp, operation for operation
+        const Frame& w = memoFrame(d, workpiece_, d.workpieceFrames_, q);
+        const Frame& t = memoFrame(d, tool_, d.toolFrames_, q);
         Pose bMw = Pose::Identity(), bMt = Pose::Identity();
         bMw.linear() = w.R;
         bMw.translation() = w.t;
@@ -351,6 +371,8 @@ void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double le
         axis = wMt.linear() * machine_->toolDirection;
         return;
     }
+    const Frame& w = cached(d, workpiece_, d.workpiece_, q, false).frame;
+    const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
     tip.noalias() = w.R.transpose() * (t.t + length * dirB - w.t);
     axis.noalias() = w.R.transpose() * dirB;

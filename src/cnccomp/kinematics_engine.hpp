@@ -36,8 +36,10 @@ struct Frame {
 
 class KinematicsModel;
 
-/// Angles whose cosine and sine a workspace keeps per rotary operation (Arithmetic::AsExactModel).
+/// Angles whose cosine and sine a workspace keeps per rotary operation, and chain frames it keeps per chain
+/// (Arithmetic::AsExactModel).
 inline constexpr int kAngleMemo = 64;
+inline constexpr int kFrameMemo = 64;
 
 /// The workspace of a KinematicsModel's evaluations (see the file comment). Copyable; no allocation per call (an
 /// Arithmetic::AsExactModel model's angle tables are allocated once, when the workspace is bound to it).
@@ -91,6 +93,14 @@ private:
     ChainCache workpiece_, tool_;
     /// Per rotary operation, with Arithmetic::AsExactModel only (empty otherwise: no cost to the fast models).
     std::vector<AngleMemo> angles_;
+    /// With Arithmetic::AsExactModel: the frames of each chain at its last axis positions (kFrameMemo entries,
+    /// direct-mapped by the bit patterns of the chain's own axes; a grid's innermost axis takes few values).
+    struct FrameEntry {
+        bool valid = false;
+        uint64_t key[kMaxAxes] = {};
+        Frame frame;
+    };
+    std::vector<FrameEntry> workpieceFrames_, toolFrames_;
 };
 
 class KinematicsModel {
@@ -185,6 +195,9 @@ private:
     /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
     const ChainEntry& cached(KinematicsData& d, const ChainOps& c, ChainCache& cache, const AxisVector& q,
                              bool lines) const;
+    /// Arithmetic::AsExactModel: the frame of chain c at q from the workspace's frame table `memo`.
+    const Frame& memoFrame(KinematicsData& d, const ChainOps& c, std::vector<KinematicsData::FrameEntry>& memo,
+                           const AxisVector& q) const;
 
     const MachineModel* machine_;
     bool exact_ = false;  ///< Arithmetic::AsExactModel
