@@ -15,9 +15,9 @@
 // (no folding across links, no affine shortcut, sin and cos of every angle as Eigen's AngleAxis, toolPose through the
 // inverse of the workpiece pose): its frames and toolPose are bit for bit those of cnccomp::Kinematics and toolPose
 // (inverse_kinematics.hpp), for outputs that must not change by a digit with the engine (the volumetric map's files).
-// It keeps the workspace's savings that change no bit: the two cached evaluations per chain (keyed by the bit patterns
-// of the chain's own axes), and the cosines and sines of the last kAngleMemo angles of each rotary operation (a grid's
-// rotary axis takes few distinct values).
+// It keeps the workspace's savings that change no bit: the last kFrameMemo frames of each chain (keyed by the bit
+// patterns of the chain's own axes) and the cosines and sines of the last kAngleMemo angles of each rotary operation (a
+// grid's innermost axis, or a rotary axis, takes few distinct values).
 #include <cmath>
 #include <cstdint>
 #include <vector>
