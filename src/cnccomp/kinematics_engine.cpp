@@ -1,6 +1,7 @@
 #include "cnccomp/kinematics_engine.hpp"
 
 #include <atomic>
+#include <bit>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -22,6 +23,25 @@ inline void rotateAboutUnit(Mat3& R, int k, double c, double s) {
     const Vec3 a = R.col(i), b = R.col(j);
     R.col(i) = c * a + s * b;
     R.col(j) = c * b - s * a;
+}
+
+/// Eigen::AngleAxisd(θ, u).toRotationMatrix() given c = cos θ and s = sin θ: Eigen 3.4's operations in its order
+/// (Eigen/src/Geometry/AngleAxis.h), so the same bits (Arithmetic::AsExactModel).
+inline Mat3 angleAxisMatrix(const Vec3& u, double c, double s) {
+    Mat3 res;
+    const Vec3 sinAxis = s * u;
+    const Vec3 cos1Axis = (1.0 - c) * u;
+    double tmp = cos1Axis.x() * u.y();
+    res(0, 1) = tmp - sinAxis.z();
+    res(1, 0) = tmp + sinAxis.z();
+    tmp = cos1Axis.x() * u.z();
+    res(0, 2) = tmp + sinAxis.y();
+    res(2, 0) = tmp - sinAxis.y();
+    tmp = cos1Axis.y() * u.z();
+    res(1, 2) = tmp - sinAxis.x();
+    res(2, 1) = tmp + sinAxis.x();
+    res.diagonal() = (cos1Axis.cwiseProduct(u)).array() + c;
+    return res;
 }
 
 }  // namespace
@@ -49,13 +69,15 @@ Pose KinematicsModel::componentError(const Op& op, const AxisVector& q) const {
     return errorTransform(e);
 }
 
-KinematicsModel::KinematicsModel(const MachineModel& machine, const DeviationSet* deviations)
+KinematicsModel::KinematicsModel(const MachineModel& machine, const DeviationSet* deviations, Arithmetic arithmetic)
     : machine_(&machine),
+      exact_(arithmetic == Arithmetic::AsExactModel),
       id_(nextModelId()),
       values_(deviations ? deviations->values : Eigen::VectorXd::Zero(machine.parameterCount())) {
     int slots = 0;
     compile(machine.workpiece, Side::Workpiece, workpiece_, slots);
     compile(machine.tool, Side::Tool, tool_, slots);
+    rotarySlots_ = slots;
 }
 
 KinematicsData::KinematicsData(const KinematicsModel& model) { model.bind(*this); }
@@ -64,6 +86,44 @@ void KinematicsModel::bind(KinematicsData& d) const {
     if (d.model_ == id_) return;
     d = KinematicsData();
     d.model_ = id_;
+    if (exact_) {
+        d.angles_.assign(static_cast<size_t>(rotarySlots_), KinematicsData::AngleMemo());
+        d.workpieceFrames_.assign(kFrameMemo, KinematicsData::FrameEntry());
+        d.toolFrames_.assign(kFrameMemo, KinematicsData::FrameEntry());
+    }
+}
+
+const Frame& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, std::vector<KinematicsData::FrameEntry>& memo,
+                                        const AxisVector& q) const {
+    static_assert(kFrameMemo == 64);
+    uint64_t h = 0;
+    for (int a : c.axes) h = (h ^ std::bit_cast<uint64_t>(q[a])) * 0x9E3779B97F4A7C15ULL;
+    KinematicsData::FrameEntry& e = memo[static_cast<size_t>(h >> 58)];
+    bool hit = e.valid;
+    for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == std::bit_cast<uint64_t>(q[c.axes[k]]);
+    if (!hit) {
+        evaluate(d, c, q, e.frame, nullptr);
+        for (size_t k = 0; k < c.axes.size(); ++k) e.key[k] = std::bit_cast<uint64_t>(q[c.axes[k]]);
+        e.valid = true;
+    }
+    return e.frame;
+}
+
+void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
+    if (!exact_) {
+        trig(d.trig_[op.slot], angle, c, s);
+        return;
+    }
+    KinematicsData::AngleMemo& m = d.angles_[static_cast<size_t>(op.slot)];
+    const uint64_t key = std::bit_cast<uint64_t>(angle);
+    const int i = static_cast<int>((key * 0x9E3779B97F4A7C15ULL) >> 58);  // kAngleMemo = 64 entries
+    static_assert(kAngleMemo == 64);
+    if (m.key[i] != key) {
+        m.key[i] = key;
+        m.c[i] = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
+        m.s[i] = std::sin(angle);
+    }
+    c = m.c[i], s = m.s[i];
 }
 
 void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
@@ -116,15 +176,24 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
             if (def.kind == DeviationKind::Location) {
                 location[def.component] += values_[def.offset];
             } else {
-                bool any = false;
+                bool any = exact_;  // the exact model multiplies by a zero component error too
                 for (int c = 0; c < def.size(); ++c) any = any || values_[def.offset + c] != 0.0;
                 if (any) components.push_back(k);
             }
         }
         const Pose placed = l.placement * errorTransform(location);
-        // pending ← pending · placed
-        pending.t = pending.R * placed.translation() + pending.t;
-        pending.R = pending.R * placed.linear();
+        if (exact_) {  // one product per link, as the exact model (an identity too: its ±0 sums are the exact model's)
+            Op op;
+            op.kind = OpKind::Constant;
+            op.R = placed.linear();
+            op.t = placed.translation();
+            ops.push_back(op);
+        }
+        // pending ← pending · placed (stays the identity with exact_: flush emits nothing)
+        if (!exact_) {
+            pending.t = pending.R * placed.translation() + pending.t;
+            pending.R = pending.R * placed.linear();
+        }
         if (l.kind == AxisKind::Fixed) continue;
         axes.push_back(l.axisIndex);
         flush();
@@ -153,7 +222,7 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
     // Affine chains (linear axes and constant transforms only: most tool chains of table-table machines).
     Affine& a = c.affine;
     a = Affine{};
-    a.ok = true;
+    a.ok = !exact_;  // t0 + Σ colₖ qₖ sums in another order than the exact model
     for (const Op& op : ops) a.ok = a.ok && (op.kind == OpKind::Constant || op.kind == OpKind::Linear);
     if (!a.ok) return;
     for (const Op& op : ops) {
@@ -184,6 +253,36 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
     }
     const std::vector<Op>& ops = c.ops;
     auto op0 = ops.begin();
+    if (exact_) {  // Kinematics::chainPose: from the identity, every product done
+        f.R.setIdentity();
+        f.t.setZero();
+        for (const Op& op : ops) {
+            switch (op.kind) {
+                case OpKind::Constant:
+                    f.t += f.R * op.t;
+                    f.R = f.R * op.R;
+                    break;
+                case OpKind::Linear:
+                    if (lines) lines->items[lines->count++] = {op.axis, false, f.R * op.dir, f.t};
+                    f.t += f.R * (op.dir * q[op.axis]);
+                    break;
+                case OpKind::Rotary: {
+                    if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
+                    double c, sn;
+                    trigOf(d, op, q[op.axis], c, sn);
+                    f.R = f.R * angleAxisMatrix(op.dir, c, sn);
+                    break;
+                }
+                case OpKind::Component: {
+                    const Pose E = componentError(op, q);
+                    f.t += f.R * E.translation();
+                    f.R = f.R * E.linear();
+                    break;
+                }
+            }
+        }
+        return;
+    }
     if (op0 != ops.end() && op0->kind == OpKind::Constant) {  // a leading constant transform is the frame so far
         f.R = op0->R;
         f.t = op0->t;
@@ -206,7 +305,7 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
             case OpKind::Rotary: {
                 if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
                 double c, sn;
-                trig(d.trig_[op.slot], q[op.axis], c, sn);
+                trigOf(d, op, q[op.axis], c, sn);
                 if (op.unit >= 0) {
                     rotateAboutUnit(f.R, op.unit, c, sn);
                 } else {
@@ -241,7 +340,8 @@ const KinematicsModel::ChainEntry& KinematicsModel::cached(KinematicsData& d, co
     }
     for (ChainEntry& e : cache.entry) {
         bool hit = e.valid && (e.hasLines || !lines);
-        for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == q[c.axes[k]];
+        for (size_t k = 0; k < c.axes.size() && hit; ++k)  // exact_: the same bits (+0 and −0 are other commands)
+            hit = exact_ ? std::bit_cast<uint64_t>(e.key[k]) == std::bit_cast<uint64_t>(q[c.axes[k]]) : e.key[k] == q[c.axes[k]];
         if (!hit) continue;
         cache.next = static_cast<int>(&e == &cache.entry[0]);  // keep the one just used
         return e;
@@ -258,6 +358,19 @@ const KinematicsModel::ChainEntry& KinematicsModel::cached(KinematicsData& d, co
 
 void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
     bind(d);
+    if (exact_) {  // toolPose(Kinematics, q, toolPoint(length)) in inverse_kinematics.cpp, operation for operation
+        const Frame& w = memoFrame(d, workpiece_, d.workpieceFrames_, q);
+        const Frame& t = memoFrame(d, tool_, d.toolFrames_, q);
+        Pose bMw = Pose::Identity(), bMt = Pose::Identity();
+        bMw.linear() = w.R;
+        bMw.translation() = w.t;
+        bMt.linear() = t.R;
+        bMt.translation() = t.t;
+        const Pose wMt = bMw.inverse(Eigen::Isometry) * bMt;
+        tip = wMt * Vec3(machine_->toolDirection * length + Vec3::Zero());
+        axis = wMt.linear() * machine_->toolDirection;
+        return;
+    }
     const Frame& w = cached(d, workpiece_, d.workpiece_, q, false).frame;
     const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
     const Vec3 dirB = t.R * machine_->toolDirection;
@@ -282,7 +395,7 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                trig(d.trig_[op.slot], q[op.axis], c, sn);
+                trigOf(d, op, q[op.axis], c, sn);
                 if constexpr (WithPoint) rotateBack(op, c, sn, point);
                 rotateBack(op, c, sn, direction);
                 break;
@@ -344,7 +457,7 @@ Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, co
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                trig(d.trig_[op.slot], q[op.axis], c, sn);
+                trigOf(d, op, q[op.axis], c, sn);
                 rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }

@@ -11,6 +11,13 @@
 // thread its own. A Data follows the model it was last used with: handed to another model it starts empty.
 // Every evaluation agrees with cnccomp::Kinematics (tests/core/test_kinematics_engine.cpp: every sample machine, random
 // deviations and poses, to 1e-12 mm); the last bits may differ (folded products, angle addition).
+// A model compiled with Arithmetic::AsExactModel does the exact model's floating-point operations in its order instead
+// (no folding across links, no affine shortcut, sin and cos of every angle as Eigen's AngleAxis, toolPose through the
+// inverse of the workpiece pose): its frames and toolPose are bit for bit those of cnccomp::Kinematics and toolPose
+// (inverse_kinematics.hpp), for outputs that must not change by a digit with the engine (the volumetric map's files).
+// It keeps the workspace's savings that change no bit: the last kFrameMemo frames of each chain (keyed by the bit
+// patterns of the chain's own axes) and the cosines and sines of the last kAngleMemo angles of each rotary operation (a
+// grid's innermost axis, or a rotary axis, takes few distinct values).
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -29,7 +36,13 @@ struct Frame {
 
 class KinematicsModel;
 
-/// The workspace of a KinematicsModel's evaluations (see the file comment). Plain data, no allocation; copyable.
+/// Angles whose cosine and sine a workspace keeps per rotary operation, and chain frames it keeps per chain
+/// (Arithmetic::AsExactModel).
+inline constexpr int kAngleMemo = 64;
+inline constexpr int kFrameMemo = 64;
+
+/// The workspace of a KinematicsModel's evaluations (see the file comment). Copyable; no allocation per call (an
+/// Arithmetic::AsExactModel model's angle tables are allocated once, when the workspace is bound to it).
 class KinematicsData {
 public:
     KinematicsData() = default;
@@ -42,6 +55,16 @@ private:
     struct Trig {
         double last = HUGE_VAL, lastC = 1, lastS = 0;
         double asked = HUGE_VAL, askedC = 1, askedS = 0;
+    };
+    /// cos and sin of the last angles of one rotary operation, exactly computed (Arithmetic::AsExactModel): a
+    /// direct-mapped table keyed by the angle's bit pattern (kEmptyAngle: no entry; it is a NaN, never a command).
+    static constexpr uint64_t kEmptyAngle = 0x7ff8dead0000beefULL;
+    struct AngleMemo {
+        uint64_t key[kAngleMemo];
+        double c[kAngleMemo], s[kAngleMemo];
+        AngleMemo() {
+            for (uint64_t& k : key) k = kEmptyAngle;
+        }
     };
     struct JointLine {
         int axis = -1;
@@ -68,19 +91,36 @@ private:
     uint64_t model_ = 0;  ///< id of the model the contents belong to (0: none)
     Trig trig_[kMaxAxes];  ///< per rotary operation (KinematicsModel's Op::slot)
     ChainCache workpiece_, tool_;
+    /// Per rotary operation, with Arithmetic::AsExactModel only (empty otherwise: no cost to the fast models).
+    std::vector<AngleMemo> angles_;
+    /// With Arithmetic::AsExactModel: the frames of each chain at its last axis positions (kFrameMemo entries,
+    /// direct-mapped by the bit patterns of the chain's own axes; a grid's innermost axis takes few values).
+    struct FrameEntry {
+        bool valid = false;
+        uint64_t key[kMaxAxes] = {};
+        Frame frame;
+    };
+    std::vector<FrameEntry> workpieceFrames_, toolFrames_;
 };
 
 class KinematicsModel {
 public:
+    /// How the model rounds (see the file comment).
+    enum class Arithmetic : uint8_t {
+        Fast,          ///< constants folded, affine chains summed, angle addition near the last angle
+        AsExactModel,  ///< the operations of cnccomp::Kinematics and toolPose in their order: their bits
+    };
     /// `deviations` nullptr: the nominal machine. The machine must outlive this object.
-    KinematicsModel(const MachineModel& machine, const DeviationSet* deviations);
+    KinematicsModel(const MachineModel& machine, const DeviationSet* deviations, Arithmetic arithmetic = Arithmetic::Fast);
 
     const MachineModel& machine() const { return *machine_; }
+    Arithmetic arithmetic() const { return exact_ ? Arithmetic::AsExactModel : Arithmetic::Fast; }
     /// A fresh workspace for this model (as KinematicsData(model)).
     KinematicsData createData() const { return KinematicsData(*this); }
 
     /// Tool point at `length` along the tool direction, and the tool axis (spindle → tip), in the workpiece frame,
-    /// at model commands q (mm, rad).
+    /// at model commands q (mm, rad). With Arithmetic::AsExactModel: toolPose(Kinematics, q, toolPoint(length)) to the
+    /// bit (the tool point as Kinematics::toolPoint, the workpiece pose inverted as an isometry).
     void toolPose(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
     Vec3 toolTip(KinematicsData& d, const AxisVector& q, double length) const;
     /// toolPose without the workpiece chain's cache: its operations inverted and applied to the tool point and
@@ -140,6 +180,9 @@ private:
     /// cos and sin of `angle` for a rotary op: the same angle again from `asked`, an angle near the last exactly
     /// computed one by angle addition, else exactly.
     static void trig(Trig& t, double angle, double& c, double& s);
+    /// cos and sin of a rotary op's angle: trig, or with Arithmetic::AsExactModel std::cos and std::sin (as Eigen's
+    /// AngleAxis) through the workspace's table of the last angles.
+    void trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const;
     /// v ← Rot(op's direction, θ)ᵀ v, given c = cos θ and s = sin θ.
     static void rotateBack(const Op& op, double c, double s, Vec3& v);
     /// A base-frame point (WithPoint) and direction into the workpiece frame at q, the workpiece chain's operations
@@ -152,8 +195,13 @@ private:
     /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
     const ChainEntry& cached(KinematicsData& d, const ChainOps& c, ChainCache& cache, const AxisVector& q,
                              bool lines) const;
+    /// Arithmetic::AsExactModel: the frame of chain c at q from the workspace's frame table `memo`.
+    const Frame& memoFrame(KinematicsData& d, const ChainOps& c, std::vector<KinematicsData::FrameEntry>& memo,
+                           const AxisVector& q) const;
 
     const MachineModel* machine_;
+    bool exact_ = false;  ///< Arithmetic::AsExactModel
+    int rotarySlots_ = 0;
     uint64_t id_;  ///< distinct for every constructed model (copies share it: same contents)
     Eigen::VectorXd values_;
     ChainOps workpiece_, tool_;

@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <barrier>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <exception>
 #include <thread>
 
@@ -13,23 +11,38 @@
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
+#include "cnccomp/kinematics_engine.hpp"
 
 namespace cnccomp {
 namespace {
 
 constexpr int kMaxGridAxes = 16;
 
+/// `d`, once Kinematics has accepted it for `m` (a set of another machine is refused with its ModelError).
+const DeviationSet& checkedFor(const MachineModel& m, const DeviationSet& d) {
+    (void)Kinematics(m, d);
+    return d;
+}
+
 /// Everything a worker needs, prepared once (the per-point kernel only reads it).
 struct Plan {
     const MapRequest* request = nullptr;
-    Kinematics nominal, actual;
+    /// The nominal machine for the inverse solver (orientation mode: solveToolPose takes the exact model).
+    Kinematics nominal;
+    /// The kinematics engine, with the exact model's arithmetic: the map's numbers are those of toolPose(Kinematics)
+    /// to the bit, so its files do not change by a digit with the engine (each worker has its own workspaces).
+    KinematicsModel nominalModel, actualModel;
     Vec3 tipInTool = Vec3::Zero();
     AxisVector base;
     std::array<int, kMaxGridAxes> target{};  ///< axes mode: machine axis index; orientation mode: 0..2 = x y z
     std::array<double, kMaxGridAxes> scale{};
     AxisVector start;  ///< orientation mode: IK start (solved once at the grid centre)
 
-    Plan(const MapRequest& r) : request(&r), nominal(r.machine), actual(r.machine, r.deviations) {}
+    Plan(const MapRequest& r)
+        : request(&r),
+          nominal(r.machine),
+          nominalModel(r.machine, nullptr, KinematicsModel::Arithmetic::AsExactModel),
+          actualModel(r.machine, &checkedFor(r.machine, r.deviations), KinematicsModel::Arithmetic::AsExactModel) {}
 };
 
 void prepare(Plan& p) {
@@ -119,48 +132,13 @@ void prepare(Plan& p) {
                                      m.name, centre.axis.x(), centre.axis.y(), centre.axis.z()));
 }
 
-/// The pose of one kinematic chain at the last commands it was evaluated at: a grid varies its last axes fastest, so
-/// one chain's axes (often the longer tool chain's) stay put over many points and its pose is reused. The reuse is
-/// exact: a chain's pose depends on its own axes only, and it is reused only when all of them have the same bit pattern.
-struct ChainMemo {
-    std::array<int, kMaxAxes> axes{};  ///< the chain's axis indices
-    int count = 0;
-    std::array<uint64_t, kMaxAxes> key{};
-    bool valid = false;
-    Pose pose = Pose::Identity();
-
-    ChainMemo(const MachineModel& m, Side side) {
-        for (const Link& l : m.chain(side).links)
-            if (l.axisIndex >= 0) axes[count++] = l.axisIndex;
-    }
-    /// True when the pose is that of `q` (else the key is set to q and the caller stores the new pose).
-    bool holds(const AxisVector& q) {
-        bool same = valid;
-        for (int i = 0; i < count; ++i) {
-            const uint64_t k = std::bit_cast<uint64_t>(q[axes[i]]);
-            same = same && key[i] == k;
-            key[i] = k;
-        }
-        valid = true;
-        return same;
-    }
-};
-
-/// One worker's scratch: the chain poses of the nominal and the actual machine.
+/// One worker's workspaces of the nominal and the actual model: each keeps the last two poses of each chain (a grid
+/// varies its last axes fastest, so one chain's axes, often the longer tool chain's, stay put over many points and its
+/// pose is reused) and the sines of the rotary axes' last angles (a grid's rotary axis takes few values).
 struct Scratch {
-    ChainMemo nominalWork, nominalTool, actualWork, actualTool;
-    explicit Scratch(const MachineModel& m)
-        : nominalWork(m, Side::Workpiece), nominalTool(m, Side::Tool), actualWork(m, Side::Workpiece), actualTool(m, Side::Tool) {}
+    KinematicsData nominal, actual;
+    explicit Scratch(const Plan& p) : nominal(p.nominalModel.createData()), actual(p.actualModel.createData()) {}
 };
-
-/// toolPose(k, q, tip) (inverse_kinematics.cpp) with the chains' poses reused from `work` and `tool` when their axes
-/// have not moved: the same operations on the same values, so the same bits.
-ToolPose toolPoseReusing(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, ChainMemo& work, ChainMemo& tool) {
-    if (!work.holds(q)) work.pose = k.baseToWorkpiece(q);
-    if (!tool.holds(q)) tool.pose = k.baseToTool(q);
-    const Pose wMt = work.pose.inverse(Eigen::Isometry) * tool.pose;
-    return {wMt * tipInToolFrame, wMt.linear() * k.machine().toolDirection};
-}
 
 /// The per-point kernel at per-axis grid indices `idx`: no allocation.
 void evaluate(const Plan& p, const long* idx, MapPoint& out, Scratch& ws) {
@@ -187,8 +165,9 @@ void evaluate(const Plan& p, const long* idx, MapPoint& out, Scratch& ws) {
         }
         q = s.q;
         // Accept only a pose that is met (the solver's "converged" means the iteration settled).
-        const ToolPose got = toolPose(p.nominal, q, p.tipInTool);
-        if (!s.converged || (got.tip - t.tip).norm() > 1e-6 || (got.axis - t.axis).norm() > 1e-8) out.ok = false;
+        Vec3 gotTip, gotAxis;
+        p.nominalModel.toolPose(ws.nominal, q, r.toolLength, gotTip, gotAxis);
+        if (!s.converged || (gotTip - t.tip).norm() > 1e-6 || (gotAxis - t.axis).norm() > 1e-8) out.ok = false;
         for (int a = 0; a < q.size() && out.ok; ++a) {
             const Link& l = r.machine.axisLink(a);
             if (q[a] < l.min - 1e-9 || q[a] > l.max + 1e-9) out.ok = false;
@@ -196,8 +175,9 @@ void evaluate(const Plan& p, const long* idx, MapPoint& out, Scratch& ws) {
     }
     out.q.fill(0.0);
     for (int a = 0; a < q.size(); ++a) out.q[a] = q[a];
-    const ToolPose n = toolPoseReusing(p.nominal, q, p.tipInTool, ws.nominalWork, ws.nominalTool);
-    const ToolPose a = toolPoseReusing(p.actual, q, p.tipInTool, ws.actualWork, ws.actualTool);
+    ToolPose n, a;
+    p.nominalModel.toolPose(ws.nominal, q, r.toolLength, n.tip, n.axis);
+    p.actualModel.toolPose(ws.actual, q, r.toolLength, a.tip, a.axis);
     out.tip = n.tip;
     out.error = a.tip - n.tip;
     const Vec3 cr = n.axis.cross(a.axis);
@@ -280,7 +260,7 @@ MapStatistics run(const Plan& plan, MapSink& sink) {
     const auto slotOf = [&](long round, int w) { return static_cast<int>(round % 2) * threads + w; };
 
     const auto worker = [&](int w) {
-        Scratch ws(r.machine);
+        Scratch ws(plan);
         std::array<long, kMaxGridAxes> idx{};
         for (long round = 0;; ++round) {
             sync.arrive_and_wait();  // round starts

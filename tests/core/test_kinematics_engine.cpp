@@ -7,6 +7,7 @@
 // poses exercise every cache path.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <filesystem>
 #include <random>
 
@@ -141,6 +142,71 @@ TEST(KinematicsEngine, InclinedRotaryAxis) {
     std::mt19937_64 rng(6);
     compare(m, DeviationSet(m), "inclined head nominal");
     compare(m, randomSet(m, rng), "inclined head with errors");
+}
+
+bool sameBits(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b) {
+    if (a.rows() != b.rows() || a.cols() != b.cols()) return false;
+    for (int i = 0; i < a.rows(); ++i)
+        for (int j = 0; j < a.cols(); ++j)
+            if (std::bit_cast<uint64_t>(a(i, j)) != std::bit_cast<uint64_t>(b(i, j))) return false;
+    return true;
+}
+
+/// Arithmetic::AsExactModel against Kinematics and toolPose (oracle: the exact model, an independent implementation;
+/// here not to a tolerance but to the bit, ±0 included): chain frames and tool pose, on poses met in a grid's order
+/// (one axis stepping, the others held, a rotary axis back to earlier angles: the cache and angle-table paths) and at
+/// random, nominal and with deviations (location and component errors).
+void compareBits(const MachineModel& m, const DeviationSet& d, const std::string& name) {
+    const Kinematics ref(m, d);
+    const KinematicsModel k(m, &d, KinematicsModel::Arithmetic::AsExactModel);
+    EXPECT_EQ(k.arithmetic(), KinematicsModel::Arithmetic::AsExactModel);
+    KinematicsData data = k.createData();
+    std::mt19937_64 rng(12);
+    std::uniform_real_distribution<double> u(-1, 1);
+    AxisVector q = AxisVector::Zero(m.axisCount());
+    int checked = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        const int a = trial % m.axisCount();
+        const bool rotary = m.axisLink(a).kind == AxisKind::Rotary;
+        if (trial % 5 == 4) {
+            for (int i = 0; i < m.axisCount(); ++i) q[i] = m.axisLink(i).kind == AxisKind::Rotary ? 3 * u(rng) : 300 * u(rng);
+        } else {
+            q[a] = rotary ? (trial % 7) * 0.5236 - 1.5 : 25.0 * (trial % 9) - 100;  // a grid's few values, again and again
+        }
+        if (trial % 11 == 0) q[a] = -0.0;
+        const Frame w = k.baseToWorkpiece(data, q), t = k.baseToTool(data, q);
+        const Pose rw = ref.baseToWorkpiece(q), rt = ref.baseToTool(q);
+        EXPECT_TRUE(sameBits(w.R, rw.linear()) && sameBits(w.t, rw.translation())) << name << " workpiece frame, trial " << trial;
+        EXPECT_TRUE(sameBits(t.R, rt.linear()) && sameBits(t.t, rt.translation())) << name << " tool frame, trial " << trial;
+        for (double L : {0.0, 120.0, 360.0}) {
+            Vec3 tip, axis;
+            k.toolPose(data, q, L, tip, axis);
+            const ToolPose r = toolPose(ref, q, ref.toolPoint(L));
+            EXPECT_TRUE(sameBits(tip, r.tip) && sameBits(axis, r.axis)) << name << " tool pose, trial " << trial << ", L " << L;
+            ++checked;
+        }
+    }
+    EXPECT_EQ(checked, 1200);
+}
+
+TEST(KinematicsEngine, AsExactModelIsTheExactKinematicsToTheBit) {
+    std::mt19937_64 rng(9);
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(test::sourcePath("samples/machines")))
+        if (e.path().extension() == ".xml") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    ASSERT_GE(files.size(), 12u);
+    for (const auto& file : files) {
+        const MachineModel m = readMachineXml(file.string());
+        const std::string name = file.stem().string();
+        compareBits(m, DeviationSet(m), name + " nominal");
+        compareBits(m, randomSet(m, rng), name + " with errors");
+    }
+    test::ScratchDir dir("pp-kin-bits");
+    test::writeText(dir.file("m.xml"), kInclinedHead);
+    const MachineModel m = readMachineXml(dir.file("m.xml"));
+    compareBits(m, DeviationSet(m), "inclined head nominal");
+    compareBits(m, randomSet(m, rng), "inclined head with errors");
 }
 
 }  // namespace
