@@ -11,7 +11,9 @@
 
 namespace cnccomp::controllers {
 
+namespace common {
 struct FitWorkspace;  // controllers/common/fit.hpp
+}  // namespace common
 
 struct EmitRequest {
     const MachineModel& machine;
@@ -21,7 +23,7 @@ struct EmitRequest {
     /// The workspace over which the values written were fitted to this controller (controllers/common/fit.hpp), or
     /// null. A backend with several routes (e.g. LinuxCNC: generated kinematics, or pins and tables) fits the routes
     /// that cannot hold every deviation over it itself.
-    const FitWorkspace* fitWorkspace = nullptr;
+    const common::FitWorkspace* fitWorkspace = nullptr;
     /// Lines every file's header carries besides the coverage lists (what was fitted over which workspace, …).
     std::vector<std::string> headerNotes{};
 };

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 OutputBuffer::OutputBuffer(std::ostream& out, size_t capacity) : out_(out), capacity_(std::max<size_t>(capacity, 64)) {
     resize(std::min<size_t>(capacity_, 4096));
@@ -92,4 +92,4 @@ void BlockEdits::apply(std::string_view line, OutputBuffer& out) {
     out.write(line.substr(pos));
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// Buffered writes to a stream: at most `capacity` bytes are held before they are written. The storage is not
 /// allocated at full capacity up front: it starts at 4 KiB and doubles as the output grows (never zero-filled), so a
@@ -80,4 +80,4 @@ private:
     bool overflow_ = false;
 };
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

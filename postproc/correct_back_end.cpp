@@ -10,7 +10,8 @@
 #include "cnccomp/error.hpp"
 #include "postproc/correct_move.hpp"
 
-namespace cnccomp::pp::iso {
+namespace cnccomp::postproc::iso {
+using namespace cnccomp::io;
 
 namespace {
 
@@ -482,4 +483,4 @@ void ProgramCorrector::line(Record& rec) {
     }
 }
 
-}  // namespace cnccomp::pp::iso
+}  // namespace cnccomp::postproc::iso

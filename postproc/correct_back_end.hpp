@@ -14,7 +14,7 @@
 #include "postproc/correct_record.hpp"
 #include "postproc/line_reader.hpp"
 
-namespace cnccomp::pp::iso {
+namespace cnccomp::postproc::iso {
 
 struct LetterStyle {
     int maxDecimals = -1;
@@ -82,7 +82,7 @@ private:
     // Text helpers.
     // Called for every number written: defined below, in the header, so that they are inlined.
     int decimalsFor(char letter, bool rotary) const;
-    NumberStyle styleFor(char letter, bool rotary, const Word* original, bool& increments) const;
+    io::NumberStyle styleFor(char letter, bool rotary, const Word* original, bool& increments) const;
     size_t number(char letter, bool rotary, double programValue, const Word* original, char* out, double& readBack,
                   double& resolution) const;
     size_t motionText(Motion m, char* out) const;
@@ -140,9 +140,9 @@ inline int ProgramCorrector::decimalsFor(char letter, bool rotary) const {
     return std::max(styles_[letter - 'A'].maxDecimals, floor);
 }
 
-inline NumberStyle ProgramCorrector::styleFor(char letter, bool rotary, const Word* original, bool& increments) const {
+inline io::NumberStyle ProgramCorrector::styleFor(char letter, bool rotary, const Word* original, bool& increments) const {
     const LetterStyle& ls = styles_[letter - 'A'];
-    NumberStyle st;
+    io::NumberStyle st;
     increments = r_->integerIncrements && letter != 'F' &&
                  ((original && !original->point) || (!original && ls.sawInteger && !ls.sawPoint));
     st.point = !increments;
@@ -153,4 +153,4 @@ inline NumberStyle ProgramCorrector::styleFor(char letter, bool rotary, const Wo
     return st;
 }
 
-}  // namespace cnccomp::pp::iso
+}  // namespace cnccomp::postproc::iso

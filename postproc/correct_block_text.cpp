@@ -9,7 +9,8 @@
 
 #include <fmt/format.h>
 
-namespace cnccomp::pp::iso {
+namespace cnccomp::postproc::iso {
+using namespace cnccomp::io;
 
 namespace {
 
@@ -295,4 +296,4 @@ size_t ProgramCorrector::arcWords(const ArcFit& fit, const AxisVector& outStart,
     return changes;
 }
 
-}  // namespace cnccomp::pp::iso
+}  // namespace cnccomp::postproc::iso

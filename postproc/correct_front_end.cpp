@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp::pp::iso {
+namespace cnccomp::postproc::iso {
 
 bool FrontEnd::next(Record& rec) {
     if (!reader_.next(line_)) return false;
@@ -143,4 +143,4 @@ void FrontEnd::move(Record& rec) {
     nomAt_ = Where{true, space, nomEnd, cNom, rec.jointsComputed, nomEnd.v, vector};
 }
 
-}  // namespace cnccomp::pp::iso
+}  // namespace cnccomp::postproc::iso

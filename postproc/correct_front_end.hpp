@@ -7,7 +7,7 @@
 #include "postproc/correct_record.hpp"
 #include "postproc/line_reader.hpp"
 
-namespace cnccomp::pp::iso {
+namespace cnccomp::postproc::iso {
 
 /// The front end: reads lines, lexes and interprets them, follows the nominal program and corrects move end points
 /// (each from the previous one's correction: warm start and continuity).
@@ -50,4 +50,4 @@ private:
     AxisMask all_ = 0;
 };
 
-}  // namespace cnccomp::pp::iso
+}  // namespace cnccomp::postproc::iso

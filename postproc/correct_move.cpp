@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 EndPointSolver::Result EndPointSolver::solve(Corrector& corrector, const AxisLayout& layout, const CorrectOptions& options,
                                              double toolLength, const AxisVector& cNom, const NominalPose* nomPose,
@@ -81,4 +81,4 @@ void countPath(const SplitStats& stats, CorrectSummary& summary, std::ostream* r
               fmt::format("tolerance not met after the subdivision limit ({:.3f} um left)", stats.maxDeviation / kUm));
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -11,7 +11,7 @@
 #include "postproc/correction.hpp"
 #include "postproc/modal.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// The end points of a program's moves, each solved from the previous end point's correction: warm start and
 /// continuity (Corrector::predictStart from the second move on).
@@ -83,4 +83,4 @@ void blendStartOffset(Corrector& corrector, const ProgramPoint& nomStart, double
 /// left the tolerance unmet.
 void countPath(const SplitStats& stats, CorrectSummary& summary, std::ostream* report, uint64_t line);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -15,7 +15,7 @@
 #include "postproc/klartext_correct.hpp"
 #include "postproc/line_reader.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 namespace {
 
@@ -191,4 +191,4 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     return s;
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

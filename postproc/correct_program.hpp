@@ -14,7 +14,7 @@
 #include "postproc/dialect.hpp"
 #include "postproc/setup.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 struct CorrectOptions {
     std::optional<Dialect> dialect;  ///< nullopt: detected from the head of the program
@@ -134,4 +134,4 @@ std::optional<HeaderToolLength> toolLengthFromHeader(std::string_view head);
 /// Refuses files that are empty or binary (NUL bytes, mostly control bytes) in their first bytes.
 void checkTextHead(std::string_view head, const std::string& name);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

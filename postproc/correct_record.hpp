@@ -14,7 +14,7 @@
 #include "postproc/lexer.hpp"
 #include "postproc/modal.hpp"
 
-namespace cnccomp::pp::iso {
+namespace cnccomp::postproc::iso {
 
 /// Where the nominal program or the output program is (unrounded), in the space it was read in; machine coordinates
 /// and the tool vector there are computed when needed.
@@ -91,4 +91,4 @@ struct Record {
     void note(bool warning, std::string message) { notices.emplace_back(warning, std::move(message)); }
 };
 
-}  // namespace cnccomp::pp::iso
+}  // namespace cnccomp::postproc::iso

@@ -8,7 +8,7 @@
 #include "postproc/block_writer.hpp"
 #include "postproc/line_reader.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 void finishCorrection(OutputBuffer& out, const LineReader& reader, const CorrectOptions& options, CorrectSummary& s) {
     out.flush();
@@ -76,4 +76,4 @@ std::string formatSummary(const CorrectSummary& s, size_t maxListed) {
     return t;
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -10,7 +10,8 @@
 #include "cnccomp/io/number_format.hpp"
 #include "postproc/correct_program.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 
 double digitsTolerance(Corrector& corrector, const MoveSpace& space, const AxisVector& end, int linDecimals,
                        int rotDecimals, bool inch, int linearAxes, int rotaryAxes) {
@@ -56,4 +57,4 @@ void refuseAssumedToolLength(Corrector& corrector, const AxisLayout& layout, con
                                  toolLength, kToolLengthProbeMm, off / kUm));
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -4,7 +4,7 @@
 #include <cmath>
 
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 namespace {
 
@@ -630,4 +630,4 @@ void Corrector::splitArc(const MovePath& path, const PathContext& ctx, const Pro
     }
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -14,7 +14,7 @@
 #include "postproc/modal.hpp"
 #include "postproc/tcp_model.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 struct CorrectorOptions {
     double toleranceMm = 1e-3;     ///< largest allowed distance of the tool tip from the nominal path
@@ -250,4 +250,4 @@ private:
     bool lastDamped_ = false;  ///< the last solve was damped (near a singular pose)
 };
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -4,7 +4,7 @@
 #include <cctype>
 #include <string>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 namespace {
 
@@ -168,4 +168,4 @@ DetectedDialect detectDialect(std::string_view head) {
     return {Dialect::Rs274ngc, false, "clues of several dialects"};
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

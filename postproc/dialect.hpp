@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 enum class Dialect {
     Rs274ngc,   ///< RS274NGC / LinuxCNC: ( ) and ; comments, #<name> parameters, o-words, G7/G8 lathe modes
@@ -43,4 +43,4 @@ DetectedDialect detectDialect(std::string_view head);
 /// Line (1-based) of a HEIDENHAIN Klartext "BEGIN PGM" header among the first lines of `head`, 0 when there is none.
 int klartextHeaderLine(std::string_view head);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -2,7 +2,7 @@
 
 #include "postproc/lexer.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 GKind classifyG(int c, Dialect d) {
     const bool fanuc = d == Dialect::Fanuc, ngc = d == Dialect::Rs274ngc, siemens = d == Dialect::Sinumerik,
@@ -161,4 +161,4 @@ Refusal checkGCodes(const BlockWords& w, Dialect dialect, GCodes& g) {
     return {};
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -10,7 +10,7 @@
 #include "postproc/dialect.hpp"
 #include "postproc/interp_read.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// What a G code does, as far as following positions is concerned.
 enum class GKind : uint8_t {
@@ -67,4 +67,4 @@ WordCheck checkWords(const BlockWords& w, Dialect dialect);
 /// (G80 beside G0/G1 is a cancel, not a second motion) and G65 macro calls.
 Refusal checkGCodes(const BlockWords& w, Dialect dialect, GCodes& g);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -8,7 +8,7 @@
 #include "postproc/interp_check.hpp"
 #include "postproc/modal.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 void Interpreter::refuse(BlockResult& r, const Refusal& why) {
     passThrough(r, why.reason, why.code);
@@ -371,4 +371,4 @@ void Interpreter::convertMotion(const BlockWords& w, const LexedBlock& b, BlockR
     commit(r);
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 namespace {
 
@@ -152,4 +152,4 @@ void readBlockWords(std::string_view line, const LexedBlock& b, const AxisLayout
     }
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -11,7 +11,7 @@
 #include "postproc/lexer.hpp"
 #include "postproc/modal.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// What one block says, as read (no modal state applied). Pointers point into the LexedBlock.
 struct BlockWords {
@@ -41,4 +41,4 @@ struct BlockWords {
 void readBlockWords(std::string_view line, const LexedBlock& b, const AxisLayout& layout,
                     const InterpreterOptions& options, BlockWords& w, BlockResult& r);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -11,7 +11,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 AxisLayout AxisLayout::fromMachine(const MachineModel& m) {
     AxisLayout l;
@@ -430,4 +430,4 @@ void Interpreter::interpret(std::string_view line, const LexedBlock& b, BlockRes
     convertMotion(w, b, r, onlyModal, machineCoordinates);
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -9,7 +9,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 std::string klartextUpper(std::string_view s) {
@@ -759,4 +760,4 @@ void KlartextInterpreter::polarBlock(const std::string& key, std::string_view te
     arcEnd(w.dr > 0, a0, a1, pc0_, pc1_, sweep, true, end, endKnown, b);
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -38,7 +38,7 @@
 
 #include "postproc/modal.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// A byte span of a block's text.
 struct KlartextToken {
@@ -183,4 +183,4 @@ private:
 /// Parses a leading block number token ("12"); false when the token is not all digits.
 bool klartextBlockNumber(std::string_view token, uint64_t& number);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -15,7 +15,8 @@
 #include "postproc/klartext_blocks.hpp"
 #include "cnccomp/io/number_format.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 constexpr char kKlartextAxisOrder[] = "XYZUVWABC";
@@ -558,4 +559,4 @@ CorrectSummary correctKlartextProgram(const MachineModel& machine, const Deviati
     return s;
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -37,7 +37,7 @@
 #include "postproc/line_reader.hpp"
 #include "postproc/correct_program.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// The comment that ends every block `correct` inserts into a Klartext program.
 inline constexpr const char* kKlartextInsertedComment = "; cnccomp";
@@ -46,4 +46,4 @@ inline constexpr const char* kKlartextInsertedComment = "; cnccomp";
 CorrectSummary correctKlartextProgram(const MachineModel& machine, const DeviationSet& deviations, LineReader& reader,
                                       std::ostream& out, const CorrectOptions& options);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

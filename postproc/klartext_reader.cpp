@@ -12,7 +12,8 @@
 #include "postproc/klartext_blocks.hpp"
 #include "postproc/line_reader.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 
 PosesSummary writeKlartextPoses(const AxisLayout& layout, LineReader& lines, std::ostream& csv, const PosesOptions& options) {
     PosesSummary s;
@@ -83,4 +84,4 @@ PosesSummary writeKlartextPoses(const AxisLayout& layout, std::istream& in, std:
     return writeKlartextPoses(layout, lines, csv, options);
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -13,7 +13,7 @@
 #include "postproc/line_reader.hpp"
 #include "postproc/poses.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// Reads the Klartext program from `in` and writes the poses CSV (header first): one row per motion block; motion
 /// "G0" (FMAX), "G1" (L, LP), "G2"/"G3" (C, CR, CT, CP with DR−/DR+), "G53" (M91/M92) or "-" when an axis position is
@@ -23,4 +23,4 @@ PosesSummary writeKlartextPoses(const AxisLayout& layout, std::istream& in, std:
 /// The same from a line reader (for `writePoses`, which has looked at the head already).
 PosesSummary writeKlartextPoses(const AxisLayout& layout, LineReader& lines, std::ostream& csv, const PosesOptions& options);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

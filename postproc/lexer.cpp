@@ -7,7 +7,8 @@
 #include <cmath>
 #include <string>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 
 const char* lexFlagReason(uint32_t flags) {
     if (flags & kOverlong) return "line longer than the reader's buffer";
@@ -398,4 +399,4 @@ void lexBlock(std::string_view s, Dialect dialect, LexedBlock& b, bool firstLine
     }
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -9,7 +9,7 @@
 
 #include "postproc/dialect.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// Why a block cannot be evaluated (bit flags of LexedBlock::flags).
 enum LexFlag : uint32_t {
@@ -110,4 +110,4 @@ struct OverlongLine {
 /// Parses a plain G-code number ("-12.500", "+.5", "3.") as the lexer does. Returns false on anything else.
 bool parseGcodeNumber(std::string_view text, double& value);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -3,7 +3,7 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 LineReader::LineReader(std::istream& in, size_t capacity) : in_(in), buf_(capacity < 16 ? 16 : capacity) {}
 
@@ -108,4 +108,4 @@ bool LineReader::next(Line& line) {
     }
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 struct Line {
     std::string_view text;  ///< the block without its line ending
@@ -46,4 +46,4 @@ private:
     uint64_t crOnly_ = 0;
 };
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -14,7 +14,7 @@
 #include "postproc/lexer.hpp"
 #include "postproc/setup.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 using AxisMask = uint32_t;
 struct BlockWords;  // postproc/interp_read.hpp
@@ -237,4 +237,4 @@ private:
     std::vector<std::pair<Warning, int>> warned_;
 };
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -10,7 +10,7 @@
 #include "postproc/line_reader.hpp"
 #include "postproc/correct_program.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream& csv, const PosesOptions& options) {
     PosesSummary s;
@@ -78,4 +78,4 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
     return s;
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -9,7 +9,7 @@
 
 #include "postproc/modal.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 struct PosesOptions {
     std::optional<Dialect> dialect;  ///< nullopt: detected
@@ -31,4 +31,4 @@ struct PosesSummary {
 /// applied), not machine coordinates.
 PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream& csv, const PosesOptions& options);
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

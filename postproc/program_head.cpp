@@ -9,7 +9,8 @@
 #include "cnccomp/io/text_util.hpp"
 #include "postproc/correct_program.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 
 std::optional<HeaderToolLength> toolLengthFromHeader(std::string_view head) {
     static constexpr std::string_view kHint = "cnccomp correct --tool-length ";
@@ -55,4 +56,4 @@ void checkTextHead(std::string_view head, const std::string& name) {
                                      head.size()));
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -10,7 +10,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 
 int offsetCodeOfG(double g, int p) {
     const int code = static_cast<int>(std::lround(g * 10));
@@ -216,4 +217,4 @@ void Setup::readToolTable(const std::string& path) {
     if (tools == 0) throw InputError(path, 0, "the tool table lists no tools");
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

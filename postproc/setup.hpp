@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 /// Work offset codes as integers: G54 → 540, G59.1 → 591, G54.1 P3 → 100003, Sinumerik G500 → 5000, G505 → 5050.
 int offsetCodeOfG(double gValue, int pValue = 0);
@@ -53,4 +53,4 @@ struct Setup {
     void readToolTable(const std::string& path);
 };
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

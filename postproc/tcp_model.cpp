@@ -2,7 +2,7 @@
 
 #include <Eigen/LU>  // Matrix3d::inverse
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 TcpModel::TcpModel(const KinematicsModel& nominal, KinematicsData& data) : nominal_(nominal) {
     const MachineModel& m = nominal.machine();
@@ -91,4 +91,4 @@ bool TcpModel::toJoints(KinematicsData& d, const AxisVector& p, double length, A
     return false;
 }
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

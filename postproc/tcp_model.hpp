@@ -16,7 +16,7 @@
 // point, the rotary slots the rotary angles (rad).
 #include "cnccomp/kinematics_engine.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 
 class TcpModel {
 public:
@@ -60,4 +60,4 @@ private:
     const char* why_ = "";
 };
 
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -26,7 +26,7 @@ namespace cnccomp::test {
 inline std::vector<AxisVector> nonSingularSamples(const MachineModel& m, int perAxis, double maxLinear = 200.0) {
     const Kinematics k(m);
     std::vector<AxisVector> out;
-    for (const AxisVector& q : controllers::workspaceSamples(m, perAxis, maxLinear)) {
+    for (const AxisVector& q : controllers::common::workspaceSamples(m, perAxis, maxLinear)) {
         const Pose bMt = k.baseToTool(q);
         const Vec3 axis = bMt.linear() * m.toolDirection;
         bool ok = true;
@@ -82,7 +82,7 @@ inline MachineModel tableXMachine() {
 )";
     ScratchDir dir("table-x");
     writeText(dir.file("table-x.xml"), xml);
-    return readMachineXml(dir.file("table-x.xml"));
+    return io::readMachineXml(dir.file("table-x.xml"));
 }
 
 /// tableXMachine() with every deviation set: location errors patterned, component coefficients fixed.
@@ -138,17 +138,17 @@ inline DeviationSet sameDeviations(const DeviationSet& d, const MachineModel& ot
     return out;
 }
 
-inline void report(const std::string& label, const controllers::CompensationFigures& f) {
+inline void report(const std::string& label, const controllers::common::CompensationFigures& f) {
     std::printf("[figures] %-48s points %5d  max %8.3f -> %8.5f um (%.2f %% left)  rms %8.3f -> %8.5f um  axis %.2f -> %.4f arcsec\n",
                 label.c_str(), f.points, f.maxBefore / kUm, f.maxAfter / kUm,
                 f.maxBefore > 0 ? 100.0 * f.maxAfter / f.maxBefore : 0.0, f.rmsBefore / kUm, f.rmsAfter / kUm,
                 f.maxAxisBefore / kArcsec, f.maxAxisAfter / kArcsec);
 }
 
-inline controllers::CompensationFigures evaluateBackend(const controllers::Backend& b, const MachineModel& m,
+inline controllers::common::CompensationFigures evaluateBackend(const controllers::Backend& b, const MachineModel& m,
                                                         const DeviationSet& truth,
                                                         const std::vector<AxisVector>& samples, double toolLength) {
-    return controllers::emitApplyEvaluate(b, m, truth, samples, toolLength);
+    return controllers::common::emitApplyEvaluate(b, m, truth, samples, toolLength);
 }
 
 /// Emits with a fixed date and compares every file with tests/data/controllers/<dir>/<name> (byte for byte;

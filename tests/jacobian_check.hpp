@@ -10,11 +10,11 @@
 namespace cnccomp::test {
 
 /// Largest |analytic − central difference| over the largest |central difference| (1e-2 µm / arcsec steps).
-inline double jacobianMismatch(const MachineModel& m, const Observations& obs, const DeviationSet& at) {
+inline double jacobianMismatch(const MachineModel& m, const identification::Observations& obs, const DeviationSet& at) {
     std::vector<int> devs;
     for (int i = 0; i < static_cast<int>(m.deviations.size()); ++i) devs.push_back(i);
-    const UnknownLayout layout(m, devs, obs);
-    const LsqProblem p(m, obs, layout, at);
+    const identification::UnknownLayout layout(m, devs, obs);
+    const identification::LsqProblem p(m, obs, layout, at);
     Eigen::MatrixXd Ja, Jn;
     p.jacobian(p.start(), Ja);
     p.numericJacobian(p.start(), Jn, 1e-2);

@@ -12,18 +12,18 @@
 namespace cnccomp::test {
 
 struct RtestFixture {
-    MeasurementPlan plan;
+    measurement::MeasurementPlan plan;
     DeviationSet truth;
-    std::vector<RtestTrace> traces;
+    std::vector<identification::RtestTrace> traces;
 };
 
 /// samples/plans/<plan>.xml simulated on samples/machines/<machine>.xml with samples/deviations/<truth>.csv.
 inline RtestFixture makeRtestFixture(const std::string& machine, const std::string& plan, const std::string& truth) {
     const MachineModel& m = sampleMachine(machine);
-    RtestFixture x{readPlanXml(sourcePath("samples/plans/" + plan + ".xml")),
-                   readDeviationCsv(sourcePath("samples/deviations/" + truth + ".csv"), m), {}};
+    RtestFixture x{io::readPlanXml(sourcePath("samples/plans/" + plan + ".xml")),
+                   io::readDeviationCsv(sourcePath("samples/deviations/" + truth + ".csv"), m), {}};
     const Kinematics k(m, x.truth);
-    for (const RtestRun& r : x.plan.rtestRuns) x.traces.push_back(simulateRtest(k, r));
+    for (const measurement::RtestRun& r : x.plan.rtestRuns) x.traces.push_back(identification::simulateRtest(k, r));
     return x;
 }
 

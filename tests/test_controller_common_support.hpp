@@ -22,12 +22,12 @@ struct Sample {
 inline const MachineModel& machine(const std::string& name) {
     static std::map<std::string, MachineModel> cache;
     auto it = cache.find(name);
-    if (it == cache.end()) it = cache.emplace(name, readMachineXml(test::sourcePath("samples/machines/" + name + ".xml"))).first;
+    if (it == cache.end()) it = cache.emplace(name, io::readMachineXml(test::sourcePath("samples/machines/" + name + ".xml"))).first;
     return it->second;
 }
 
 inline DeviationSet deviations(const Sample& s) {
-    return readDeviationCsv(test::sourcePath("samples/deviations/" + s.deviations + ".csv"), machine(s.machine));
+    return io::readDeviationCsv(test::sourcePath("samples/deviations/" + s.deviations + ".csv"), machine(s.machine));
 }
 
 /// The deviation set with only the deviations the backend lists as compensated.
@@ -62,7 +62,7 @@ inline std::vector<OutputFile> compareWithGolden(const std::string& family, cons
         golden.push_back({e.path().filename().string(), test::readText(e.path().string())});
     EXPECT_EQ(golden.size(), r.files.size()) << family << "/" << machineName;
     for (const OutputFile& f : r.files) {
-        const OutputFile* g = findFile(golden, f.name);
+        const OutputFile* g = common::findFile(golden, f.name);
         EXPECT_NE(g, nullptr) << family << "/" << machineName << "/" << f.name;
         if (g) {
             EXPECT_TRUE(g->content == f.content) << family << "/" << machineName << "/" << f.name << " differs from the golden";

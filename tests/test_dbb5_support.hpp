@@ -14,41 +14,41 @@
 namespace cnccomp::test {
 
 inline const MachineModel& tableTableBc() {
-    static const MachineModel m = readMachineXml(sourcePath("samples/machines/table-table-bc.xml"));
+    static const MachineModel m = io::readMachineXml(sourcePath("samples/machines/table-table-bc.xml"));
     return m;
 }
 
-inline const MeasurementPlan& dbb5PlanBc() {
-    static const MeasurementPlan p = readPlanXml(sourcePath("samples/plans/dbb5-table-table-bc.xml"));
+inline const measurement::MeasurementPlan& dbb5PlanBc() {
+    static const measurement::MeasurementPlan p = io::readPlanXml(sourcePath("samples/plans/dbb5-table-table-bc.xml"));
     return p;
 }
 
 /// The sample's location errors (no component errors).
 inline DeviationSet dbb5TruthBc() {
-    return readDeviationCsv(sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), tableTableBc());
+    return io::readDeviationCsv(sourcePath("samples/deviations/dbb5-table-table-bc-truth.csv"), tableTableBc());
 }
 
 /// A run of the B/C plan by name.
-inline const Dbb5Run& dbb5RunBc(const std::string& name) {
-    for (const Dbb5Run& r : dbb5PlanBc().dbb5Runs)
+inline const measurement::Dbb5Run& dbb5RunBc(const std::string& name) {
+    for (const measurement::Dbb5Run& r : dbb5PlanBc().dbb5Runs)
         if (r.name == name) return r;
     throw ModelError("the B/C plan has no run " + name);
 }
 
 /// The observations of every run of the B/C plan simulated on `truth` with Gaussian noise of `noiseUm` per sample.
-inline Observations simulateBc(const DeviationSet& truth, double noiseUm, unsigned seed) {
+inline identification::Observations simulateBc(const DeviationSet& truth, double noiseUm, unsigned seed) {
     const MachineModel& m = tableTableBc();
     const Kinematics k(m, truth);
     std::mt19937_64 rng(seed);
     std::normal_distribution<double> noise(0.0, noiseUm * kUm);
     std::vector<BallbarTrace> traces;
-    for (const Dbb5Run& r : dbb5PlanBc().dbb5Runs) {
-        BallbarTrace t = simulateDbb5(k, r);
+    for (const measurement::Dbb5Run& r : dbb5PlanBc().dbb5Runs) {
+        BallbarTrace t = identification::simulateDbb5(k, r);
         if (noiseUm > 0)
             for (double& v : t.dL) v += noise(rng);
         traces.push_back(t);
     }
-    return dbb5Observations(m, dbb5PlanBc().dbb5Runs, traces);
+    return identification::dbb5Observations(m, dbb5PlanBc().dbb5Runs, traces);
 }
 
 }  // namespace cnccomp::test

@@ -27,16 +27,16 @@ TEST(FuzzFindings, KlartextToolCallNumberOutOfRange) {
     for (const char* number : {"999999999999999999999999999999999999999999999999999999999999999991", "100001", "2.5"}) {
         std::istringstream in(std::string("0 BEGIN PGM ARC MM\n1 TOOL CALL ") + number + " Z\n2 L X+20 R0 FMAX\n3 END PGM ARC MM\n");
         std::ostringstream csv;
-        pp::PosesOptions o;
+        postproc::PosesOptions o;
         o.inputName = "fuzz.h";
-        expectInputError([&] { pp::writeKlartextPoses(pp::AxisLayout::generic(), in, csv, o); },
+        expectInputError([&] { postproc::writeKlartextPoses(postproc::AxisLayout::generic(), in, csv, o); },
                          {"fuzz.h:2", "not a tool number"});
     }
     // The largest tool number is still read.
     std::istringstream in("0 BEGIN PGM T MM\n1 TOOL CALL 100000 Z\n2 L X+20 Y+0 Z+5 R0 FMAX\n3 END PGM T MM\n");
     std::ostringstream csv;
-    pp::PosesOptions o;
-    EXPECT_NO_THROW(pp::writeKlartextPoses(pp::AxisLayout::generic(), in, csv, o));
+    postproc::PosesOptions o;
+    EXPECT_NO_THROW(postproc::writeKlartextPoses(postproc::AxisLayout::generic(), in, csv, o));
 }
 
 }  // namespace
@@ -45,9 +45,9 @@ TEST(FuzzFindings, KlartextCycleNumberOutOfRange) {
     for (const char* number : {"4444444444444444444444444444444444444444", "100000", "-7"}) {
         std::istringstream in(std::string("0 BEGIN PGM C MM\n1 CYCL DEF ") + number + " DATUM SHIFT\n2 END PGM C MM\n");
         std::ostringstream csv;
-        pp::PosesOptions o;
+        postproc::PosesOptions o;
         o.inputName = "fuzz.h";
-        expectInputError([&] { pp::writeKlartextPoses(pp::AxisLayout::generic(), in, csv, o); },
+        expectInputError([&] { postproc::writeKlartextPoses(postproc::AxisLayout::generic(), in, csv, o); },
                          {"fuzz.h:2", "cycle number from 0 to 99999"});
     }
 }

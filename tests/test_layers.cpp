@@ -15,8 +15,10 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "test_support.hpp"
@@ -207,6 +209,138 @@ TEST(Layers, NoFileIncludesUpward) {
     EXPECT_GT(scan.includesChecked, 500);
     for (const auto& u : scan.upward) ADD_FAILURE() << describe(u);
     EXPECT_TRUE(scan.upward.empty()) << scan.upward.size() << " upward includes (docs/ARCHITECTURE.md, The rule)";
+}
+
+// Namespaces match folders (docs/ARCHITECTURE.md, "Namespaces"): the first named `namespace X {` of every .hpp/.cpp
+// under src/, controllers/ and postproc/ is the namespace its folder names — src/cnccomp → cnccomp,
+// src/cnccomp/io → cnccomp::io, src/app/report → cnccomp::app::report, src/cli → cnccomp::cli,
+// controllers/fanuc → cnccomp::controllers::fanuc, postproc/testprog → cnccomp::postproc::testprog — or a namespace
+// nested in it that is not a subfolder's (cnccomp::postproc::iso, cnccomp::io::xml). A file that opens no named
+// namespace (main.cpp, a forwarding header) declares nothing in one and is not checked. The namespace is read from
+// the source text (line comments, block comments and string literals do not count), written `namespace a::b {`.
+// Oracle: the rule as written above, applied by hand to a synthetic tree (Layers.TheNamespaceScanReportsEveryMismatch),
+// then to the real tree (Layers.EveryNamespaceMatchesItsFolder).
+
+/// The namespace a file's folder names ("src/cnccomp/io/csv.cpp" → "cnccomp::io").
+std::string folderNamespace(const std::string& rel) {
+    std::string folder = fs::path(rel).parent_path().generic_string();
+    if (startsWith(folder, "src/")) folder = folder.substr(4);
+    if (folder != "cnccomp" && !startsWith(folder, "cnccomp/")) folder = "cnccomp/" + folder;
+    std::string ns;
+    for (char c : folder) ns += c == '/' ? std::string("::") : std::string(1, c);
+    return ns;
+}
+
+/// The first named namespace a source text opens ("" if none), and its 1-based line.
+std::pair<std::string, int> firstNamespace(const std::string& text) {
+    std::string code = text;  // comments and string literals blanked, newlines kept
+    for (size_t i = 0; i < code.size(); ++i) {
+        if (code.compare(i, 2, "//") == 0) {
+            while (i < code.size() && code[i] != '\n') code[i++] = ' ';
+        } else if (code.compare(i, 2, "/*") == 0) {
+            const size_t end = code.find("*/", i + 2);
+            const size_t stop = end == std::string::npos ? code.size() : end + 2;
+            for (; i < stop; ++i)
+                if (code[i] != '\n') code[i] = ' ';
+            --i;
+        } else if (code[i] == '"' && (i == 0 || code[i - 1] != '\'')) {
+            for (code[i++] = ' '; i < code.size() && code[i] != '"' && code[i] != '\n'; ++i) {
+                if (code[i] == '\\' && i + 1 < code.size()) code[i++] = ' ';
+                code[i] = ' ';
+            }
+            if (i < code.size() && code[i] == '"') code[i] = ' ';
+        }
+    }
+    static const std::regex named(R"(\bnamespace\s+([A-Za-z_]\w*(?:::[A-Za-z_]\w*)*)\s*\{)");
+    std::smatch m;
+    if (!std::regex_search(code, m, named)) return {"", 0};
+    const auto offset = static_cast<size_t>(m.position(0));
+    return {m[1], 1 + static_cast<int>(std::count(code.begin(), code.begin() + static_cast<std::ptrdiff_t>(offset), '\n'))};
+}
+
+struct NamespaceScan {
+    int filesChecked = 0;                ///< files that open a named namespace
+    std::vector<std::string> mismatches;  ///< "file:line: namespace X (the folder names Y)", sorted
+};
+
+NamespaceScan scanNamespaces(const fs::path& tree) {
+    const fs::path root = fs::canonical(tree);
+    NamespaceScan scan;
+    for (const char* top : {"src", "controllers", "postproc"}) {
+        if (!fs::is_directory(root / top)) continue;
+        for (const auto& entry : fs::recursive_directory_iterator(root / top)) {
+            const std::string ext = entry.path().extension().string();
+            if (!entry.is_regular_file() || (ext != ".hpp" && ext != ".cpp")) continue;
+            const std::string rel = entry.path().lexically_relative(root).generic_string();
+            std::ifstream in(entry.path(), std::ios::binary);
+            const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+            const auto [declared, line] = firstNamespace(text);
+            if (declared.empty()) continue;
+            ++scan.filesChecked;
+            const std::string expected = folderNamespace(rel);
+            bool ok = declared == expected;
+            if (!ok && startsWith(declared, expected + "::")) {
+                // A nested namespace of the folder's own, unless it is a subfolder's namespace.
+                const std::string rest = declared.substr(expected.size() + 2);
+                ok = !fs::is_directory(entry.path().parent_path() / rest.substr(0, rest.find(':')));
+            }
+            if (!ok)
+                scan.mismatches.push_back(rel + ":" + std::to_string(line) + ": namespace " + declared +
+                                          " (the folder names " + expected + ")");
+        }
+    }
+    std::sort(scan.mismatches.begin(), scan.mismatches.end());
+    return scan;
+}
+
+TEST(Layers, TheNamespaceScanReportsEveryMismatch) {
+    test::ScratchDir dir("layers-ns");
+    writeTree(dir.path, {
+        // Match: the core's top folder, a core subfolder, a nested namespace of the folder's own.
+        {"src/cnccomp/model.hpp", "#pragma once\n// namespace cnccomp::io { in a comment\nnamespace cnccomp {\n}\n"},
+        {"src/cnccomp/io/csv.cpp", "#include <x>\nnamespace {\n}\nnamespace cnccomp::io {\n}\n"},
+        {"src/cnccomp/io/xml.hpp", "namespace cnccomp::io::xml {\n}\n"},
+        // Mismatch: a core subfolder's file left in cnccomp (line 3: the string literal and the block comment do
+        // not count).
+        {"src/cnccomp/io/plan.cpp", "/* namespace cnccomp::io { */\nconst char* s = \"namespace cnccomp::io {\";\n"
+                                    "namespace cnccomp {\n}\n"},
+        // Mismatch: a top-level core file in a subfolder's namespace (io is a folder), and the nested form.
+        {"src/cnccomp/units.hpp", "namespace cnccomp::io {\n}\n"},
+        {"src/cnccomp/io/nested.hpp", "namespace cnccomp {\nnamespace io {\n}\n}\n"},
+        // Match: the application layer, its report folder, the CLI, a backend, postproc and its testprog folder.
+        {"src/app/verify.hpp", "namespace cnccomp::app {\n}\n"},
+        {"src/app/report/html.cpp", "namespace cnccomp::app::report {\n}\n"},
+        {"src/cli/command.cpp", "namespace cnccomp::cli {\n}\n"},
+        {"src/cli/main.cpp", "int main() { return 0; }\n"},  // no named namespace: not checked
+        {"controllers/backend.hpp", "namespace cnccomp::controllers {\n}\n"},
+        {"controllers/fanuc/fanuc.cpp", "namespace cnccomp::controllers::fanuc {\n}\n"},
+        {"postproc/dialect.hpp", "namespace cnccomp::postproc {\n}\n"},
+        {"postproc/testprog/run.cpp", "namespace cnccomp::postproc::testprog {\n}\n"},
+        // Mismatch: a backend in its parent's namespace, postproc under its old short name, testprog in postproc.
+        {"controllers/common/fit.hpp", "namespace cnccomp::controllers {\n}\n"},
+        {"postproc/modal.hpp", "namespace cnccomp::pp {\n}\n"},
+        {"postproc/testprog/plan.hpp", "namespace cnccomp::postproc {\n}\n"},
+        // Not scanned: tests/, and files that are neither .hpp nor .cpp.
+        {"tests/test_x.cpp", "namespace cnccomp::wrong {\n}\n"},
+        {"src/cnccomp/notes.txt", "namespace wrong {\n}\n"},
+    });
+    const NamespaceScan scan = scanNamespaces(dir.path);
+    const std::vector<std::string> expected{
+        "controllers/common/fit.hpp:1: namespace cnccomp::controllers (the folder names cnccomp::controllers::common)",
+        "postproc/modal.hpp:1: namespace cnccomp::pp (the folder names cnccomp::postproc)",
+        "postproc/testprog/plan.hpp:1: namespace cnccomp::postproc (the folder names cnccomp::postproc::testprog)",
+        "src/cnccomp/io/nested.hpp:1: namespace cnccomp (the folder names cnccomp::io)",
+        "src/cnccomp/io/plan.cpp:3: namespace cnccomp (the folder names cnccomp::io)",
+        "src/cnccomp/units.hpp:1: namespace cnccomp::io (the folder names cnccomp)",
+    };
+    EXPECT_EQ(scan.mismatches, expected);
+    EXPECT_EQ(scan.filesChecked, 16);
+}
+
+TEST(Layers, EveryNamespaceMatchesItsFolder) {
+    const NamespaceScan scan = scanNamespaces(fs::path(test::sourcePath("")));
+    EXPECT_GT(scan.filesChecked, 300);  // the scan saw the tree (350 files; an empty scan would pass for nothing)
+    for (const auto& m : scan.mismatches) ADD_FAILURE() << m;
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 std::vector<std::string> walkThroughCommands() {

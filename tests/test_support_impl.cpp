@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 
 namespace cnccomp::test {
+using namespace cnccomp::io;
 
 std::string sourcePath(const std::string& rel) { return std::string(CNCCOMP_SOURCE_DIR) + "/" + rel; }
 std::string sharedPath(const std::string& rel) { return std::string(CNCCOMP_SHARED_DIR) + "/" + rel; }

@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 double EquidistantTable::at(double x) const {
     const int n = static_cast<int>(values.size());
@@ -77,4 +77,4 @@ EquidistantTable gridOverTravel(const Link& axis, int maxPoints) {
     }
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

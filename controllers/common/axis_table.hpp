@@ -8,7 +8,7 @@
 
 #include "cnccomp/machine.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 struct EquidistantTable {
     double min = 0;       ///< position of point 0 (mm or deg)
@@ -35,4 +35,4 @@ double positionScale(const Link& axis);
 /// The description's command (internal units) of a controller position in file units: p / scale + machineZero.
 double commandOf(const Link& axis, double filePosition);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

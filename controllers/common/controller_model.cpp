@@ -8,7 +8,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 std::vector<int> controllerAxisOrder(const MachineModel& m) {
     static constexpr std::string_view kOrder = "XYZUVWABC";
@@ -188,4 +188,4 @@ std::string fixed(double v, int decimals) {
     return s;
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -15,7 +15,7 @@
 #include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 /// Tool length (mm from the tool reference point) the apply models assume for the TCP. With five axes the
 /// full pose (tip and axis) is matched, so the tip is right for any tool length; with four axes the tip is
@@ -105,4 +105,4 @@ Mat3 fromXyzAngles(const Vec3& abc);
 /// Fixed-point text without a negative zero ("-0.000" → "0.000").
 std::string fixed(double v, int decimals);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -6,7 +6,7 @@
 // without it is direction-free.
 #include "cnccomp/machine.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 class DirectionalCompensation {
 public:
@@ -17,4 +17,4 @@ public:
     virtual AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const = 0;
 };
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -8,7 +8,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 namespace {
 
 double angleBetween(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
@@ -94,4 +94,4 @@ CompensationFigures emitApplyEvaluate(const Backend& b, const MachineModel& m, c
     return evaluateCompensation(m, truth, *comp, programmed, toolLength);
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

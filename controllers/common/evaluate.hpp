@@ -8,7 +8,7 @@
 #include "cnccomp/deviations.hpp"
 #include "controllers/backend.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 /// Tool-tip (and tool-axis) error of the erroneous machine vs the nominal one over a set of programmed axis
 /// commands, without and with a controller's compensation applied (q_drive = comp.driveCommandsForTool(q, toolLength),
@@ -39,4 +39,4 @@ public:
     AxisVector driveCommands(const AxisVector& programmed) const override { return programmed; }
 };
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -7,7 +7,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
+using namespace cnccomp::io;
 
 const OutputFile* findFile(const std::vector<OutputFile>& files, std::string_view name) {
     for (const OutputFile& f : files)
@@ -55,4 +56,4 @@ double requireNumber(std::string_view token, const std::string& file, int line, 
     return *v;
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -7,7 +7,7 @@
 
 #include "controllers/backend.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 /// The file of that name, or nullptr.
 const OutputFile* findFile(const std::vector<OutputFile>& files, std::string_view name);
@@ -26,4 +26,4 @@ std::vector<std::string_view> tokens(std::string_view line);
 /// A finite number from a token; throws InputError(file, line, "... expected <what>").
 double requireNumber(std::string_view token, const std::string& file, int line, std::string_view what);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

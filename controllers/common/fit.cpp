@@ -37,7 +37,7 @@
 #include "cnccomp/inverse_kinematics.hpp"
 #include "controllers/common/evaluate.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 namespace {
 
 constexpr double kLengthStep = 5e-3;   ///< mm: finite-difference step of a length value (5 um)
@@ -401,4 +401,4 @@ FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const De
     return out;
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -10,7 +10,7 @@
 #include "cnccomp/deviations.hpp"
 #include "controllers/backend.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 /// Where the fit looks: programmed commands of the nominal machine (the controller's program words read as the
 /// nominal machine's commands) at each of a set of tool lengths.
@@ -68,4 +68,4 @@ FitFigures fitFigures(const Backend& b, const MachineModel& m, const DeviationSe
 FitOutcome fitControllerValues(const Backend& b, const MachineModel& m, const DeviationSet& identified,
                                const FitWorkspace& workspace);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 namespace {
 
 void line(std::string& out, std::string_view prefix, std::string_view suffix, std::string_view eol, std::string text) {
@@ -124,4 +124,4 @@ std::string formatCoverage(const EmitResult& r) {
     return out;
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

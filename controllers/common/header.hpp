@@ -8,7 +8,7 @@
 
 #include "controllers/backend.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 struct HeaderInfo {
     std::string controller;            ///< e.g. "LinuxCNC 2.9 (COMP_FILE_TYPE 1, xyzac-trt-kins)"
@@ -45,4 +45,4 @@ std::string frameNote(const MachineModel& m);
 /// The coverage report as printed by `cnccomp emit` (two indented lists).
 std::string formatCoverage(const EmitResult& result);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -7,7 +7,7 @@
 
 #include "controllers/common/set_backlash.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 LaserAxisCompensation laserAxisCompensation(const LaserPositioningResult& r, bool referenceForward) {
     LaserAxisCompensation c;
@@ -31,4 +31,4 @@ std::string servoMismatchNote(const std::string& gainParameter) {
         gainParameter);
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

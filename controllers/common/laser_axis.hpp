@@ -19,7 +19,7 @@
 
 #include "cnccomp/laser_positioning.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 struct LaserAxisCompensation {
     bool referenceForward = true;           ///< the reference point is approached in + (the table is x̄↑)
@@ -36,4 +36,4 @@ LaserAxisCompensation laserAxisCompensation(const LaserPositioningResult& r, boo
 /// gains of the interpolating axes (`gainParameter` names the control's parameter).
 std::string servoMismatchNote(const std::string& gainParameter);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

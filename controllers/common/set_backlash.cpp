@@ -2,7 +2,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 std::vector<AxisBacklash> backlashOfSet(const EmitRequest& r) {
     std::vector<AxisBacklash> out;
@@ -28,4 +28,4 @@ AxisVector withBacklashOffsets(const AxisVector& drive, const std::vector<double
     return out;
 }
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

@@ -21,7 +21,7 @@
 
 #include "controllers/backend.hpp"
 
-namespace cnccomp::controllers {
+namespace cnccomp::controllers::common {
 
 /// β (µm) from a mean reversal value B̄ (µm): −B̄, whichever the reference approach. Approach in +: moving − the slide
 /// stays x̄↓ − x̄↑ = −B̄ above the target, so the motor goes −B̄ further in its direction of motion; approach in −: moving
@@ -46,4 +46,4 @@ inline double backlashDriveOffset(double beta, double motion) { return motion < 
 /// `drive` with each axis' backlash offset (betaPerAxis in the description's units, one per axis or empty).
 AxisVector withBacklashOffsets(const AxisVector& drive, const std::vector<double>& betaPerAxis, const AxisVector& motion);
 
-}  // namespace cnccomp::controllers
+}  // namespace cnccomp::controllers::common

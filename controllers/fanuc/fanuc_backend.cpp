@@ -20,6 +20,8 @@
 #include "controllers/fanuc/tcp_parameters.hpp"
 
 namespace cnccomp::controllers::fanuc {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 
 EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
     const MachineModel& m = request.machine;

@@ -14,9 +14,9 @@ inline constexpr const char* kParameterFile = "CNCCOMP.PRM";
 
 EmitResult emitFiles(const EmitRequest& request, const PitchOptions& options);
 
-class FanucCompensation final : public AppliedCompensation, public DirectionalCompensation {
+class FanucCompensation final : public AppliedCompensation, public common::DirectionalCompensation {
 public:
-    FanucCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> tcp, std::vector<PitchTable> pitch,
+    FanucCompensation(const MachineModel& m, std::unique_ptr<const common::ControllerModel> tcp, std::vector<PitchTable> pitch,
                       double unit);
     /// With the default tool length of the TCP (kControllerToolLength).
     AxisVector driveCommands(const AxisVector& programmed) const override;
@@ -24,14 +24,14 @@ public:
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
     /// The same plus the backlash 1851 by the direction of motion (controllers/common/set_backlash.hpp).
     AxisVector driveCommandsMoving(const AxisVector& programmed, double toolLength, const AxisVector& motion) const override;
-    const TcpTransform& tcp() const { return tcp_; }
+    const common::TcpTransform& tcp() const { return tcp_; }
     const std::vector<PitchTable>& pitch() const { return pitch_; }
     /// 1851 of each axis (description order), mm; empty when the file sets none.
     std::vector<double> backlash;
 
 private:
     const MachineModel* machine_;
-    TcpTransform tcp_;
+    common::TcpTransform tcp_;
     std::vector<PitchTable> pitch_;
     double unit_;
 };

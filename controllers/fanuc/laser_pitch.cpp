@@ -10,6 +10,7 @@
 #include "controllers/fanuc/parameter_file.hpp"
 
 namespace cnccomp::controllers::fanuc {
+using namespace cnccomp::controllers::common;
 
 long backlashDetectionUnits(double backlashUm, double unitMm) { return std::lround(backlashUm * 1e-3 / unitMm); }
 

@@ -11,6 +11,8 @@
 #include "controllers/common/controller_model.hpp"
 
 namespace cnccomp::controllers::fanuc {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 
 const Parameter* ParameterFile::find(int number, int q) const {
     for (const Parameter& p : parameters)

@@ -12,6 +12,7 @@
 #include "controllers/common/controller_model.hpp"
 
 namespace cnccomp::controllers::fanuc {
+using namespace cnccomp::controllers::common;
 
 double PitchTable::correction(double x, double unit) const {
     // Section boundaries j = 0..n at machine positions (negative - 1 - reference + j) x interval; the section that ends

@@ -9,6 +9,7 @@
 #include "controllers/fanuc/pitch_error.hpp"
 
 namespace cnccomp::controllers::fanuc {
+using namespace cnccomp::controllers::common;
 namespace {
 
 constexpr int kDecimals = 4;  // IS-C: 0.0001 mm / 0.0001 deg [G]

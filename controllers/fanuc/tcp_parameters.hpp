@@ -69,7 +69,7 @@ TcpParameters tcpFromFile(const MachineModel& m, const ParameterFile& f);
 /// vector "in the machine coordinate system" with the rotation axes at 0 deg (p.82), 19709-19714 the D -> E and E -> F
 /// vectors of the tool axes (16i-MB A-78712E pp. 61-62). No parameter holds the tool's roll about its axis or the
 /// turn of the workpiece frame: those are taken from the description at machine coordinates 0.
-void tcpChains(const MachineModel& m, const TcpParameters& p, std::vector<ChainElement>& workpiece,
-               std::vector<ChainElement>& tool);
+void tcpChains(const MachineModel& m, const TcpParameters& p, std::vector<common::ChainElement>& workpiece,
+               std::vector<common::ChainElement>& tool);
 
 }  // namespace cnccomp::controllers::fanuc

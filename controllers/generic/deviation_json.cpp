@@ -9,6 +9,7 @@
 #include "cnccomp/io/json.hpp"
 
 namespace cnccomp::controllers::generic {
+using namespace cnccomp::io;
 namespace {
 const char* kComponents[] = {"x", "y", "z", "a", "b", "c"};
 const char* basisName(ComponentBasis::Type t) {

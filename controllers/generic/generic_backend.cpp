@@ -16,6 +16,8 @@
 #include "controllers/generic/grid_map.hpp"
 
 namespace cnccomp::controllers::generic {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 namespace {
 
 constexpr const char* kDevCsv = "deviations.csv";

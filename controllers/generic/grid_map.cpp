@@ -17,6 +17,8 @@
 #include "cnccomp/io/markup.hpp"
 
 namespace cnccomp::controllers::generic {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 namespace {
 
 // Machine-frame errors (version 2; version 1 had workpiece-frame columns dx_um ... dkz_urad, which the reader refuses).

@@ -11,7 +11,7 @@ namespace cnccomp::controllers::generic {
 
 std::string jsonNumber(double v) {
     if (!std::isfinite(v)) throw ModelError("JSON cannot hold a number that is not finite");
-    return cnccomp::jsonNumber(v);
+    return cnccomp::io::jsonNumber(v);
 }
 
 std::string jsonNumbers(const std::vector<double>& v) {

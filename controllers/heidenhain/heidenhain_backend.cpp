@@ -14,6 +14,8 @@
 #include "controllers/heidenhain/laser_com.hpp"
 
 namespace cnccomp::controllers::heidenhain {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 namespace {
 
 class HeidenhainCompensation final : public AppliedCompensation, public DirectionalCompensation {

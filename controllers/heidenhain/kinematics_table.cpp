@@ -18,6 +18,8 @@
 #include "controllers/heidenhain/tnc_table.hpp"
 
 namespace cnccomp::controllers::heidenhain {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 
 Vec3 letterDirection(std::string_view a) {
     if (a == "X" || a == "U" || a == "A") return Vec3::UnitX();

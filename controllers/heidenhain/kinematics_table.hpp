@@ -36,8 +36,8 @@ struct Options {
 EmitResult emitFiles(const EmitRequest& request, const Options& options);
 
 struct ParsedKinematics {
-    std::vector<ChainElement> workpiece, tool;
-    std::vector<ComponentTable> tables;
+    std::vector<common::ChainElement> workpiece, tool;
+    std::vector<common::ComponentTable> tables;
 };
 
 /// Reads the files back (InputError file:line): keys and their order as the iTNC 530 HSCI technical manual 07/2013

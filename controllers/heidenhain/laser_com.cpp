@@ -6,6 +6,7 @@
 #include "controllers/heidenhain/tnc_table.hpp"
 
 namespace cnccomp::controllers::heidenhain {
+using namespace cnccomp::controllers::common;
 
 int tncAxisIndex(const std::string& axisName) {
     return axisName == "X" ? 0 : axisName == "Y" ? 1 : axisName == "Z" ? 2 : -1;

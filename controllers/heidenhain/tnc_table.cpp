@@ -9,6 +9,7 @@
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp::controllers::heidenhain {
+using namespace cnccomp::io;
 
 int TncTable::column(const std::string& n) const {
     for (size_t i = 0; i < columns.size(); ++i)

@@ -23,6 +23,8 @@
 #include "controllers/isg/isg_model.hpp"
 
 namespace cnccomp::controllers::isg {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 namespace {
 
 constexpr const char* kLis = "volcomp.lis";

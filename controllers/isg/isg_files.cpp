@@ -9,6 +9,8 @@
 #include "controllers/common/files.hpp"
 
 namespace cnccomp::controllers::isg {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 
 std::string formatIsgConfig(const IsgConfig& c, const std::string& header) {
     std::string s = header;

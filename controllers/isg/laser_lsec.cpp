@@ -9,6 +9,7 @@
 #include "controllers/common/laser_axis.hpp"
 
 namespace cnccomp::controllers::isg {
+using namespace cnccomp::controllers::common;
 
 std::string isgAxisHead(int axisNumber, const std::string& axisName) {
     return fmt::format("kopf.achs_nr                        {}\nkopf.log_achs_name                  {}\n", axisNumber, axisName);

@@ -10,6 +10,7 @@
 #include "controllers/common/files.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
+using namespace cnccomp::controllers::common;
 
 double CompTable::trim(double p, int direction) const {
     const size_t n = nominal.size();

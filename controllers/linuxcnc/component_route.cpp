@@ -16,6 +16,7 @@
 #include "controllers/linuxcnc/laser_comp.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
+using namespace cnccomp::controllers::common;
 namespace {
 
 std::string lower(std::string s) {

@@ -59,7 +59,7 @@ struct KinsFiles {
 /// deviation values of the setp lines into `values` (every pin of the machine's deviations must be set once).
 KinsFiles readKinsFiles(const MachineModel& m, const std::vector<OutputFile>& files, DeviationSet& values);
 
-class KinsComponentModel final : public AppliedCompensation, public DirectionalCompensation {
+class KinsComponentModel final : public AppliedCompensation, public common::DirectionalCompensation {
 public:
     /// The machine must outlive the model.
     KinsComponentModel(const MachineModel& m, const std::vector<OutputFile>& files, KinsMode mode = KinsMode::Joint);

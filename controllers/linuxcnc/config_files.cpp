@@ -9,6 +9,8 @@
 #include "controllers/common/files.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 
 IniFragment parseIni(const std::string& text, const std::string& name) {
     IniFragment ini;

@@ -7,6 +7,7 @@
 #include "controllers/linuxcnc/config_files.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
+using namespace cnccomp::controllers::common;
 namespace {
 
 /// The trt module the machine's chains fit, read from the chains alone (not through the emitter's matcher): the

@@ -44,7 +44,7 @@ enum class KinsMode { Joint, ToolTip };
 /// Values per LinuxCNC joint (joint order of the INI's coordinates=), mm and deg.
 using JointValues = AxisVector;
 
-class LinuxcncModel final : public AppliedCompensation, public DirectionalCompensation {
+class LinuxcncModel final : public AppliedCompensation, public common::DirectionalCompensation {
 public:
     /// Reads cnccomp.ini, the COMP_FILEs, and for a trt module cnccomp.hal and cnccomp-g54.ngc (InputError
     /// naming file and line). The machine must outlive the model. ModelError for KinsMode::ToolTip on trivkins.

@@ -22,6 +22,7 @@
 #include "controllers/linuxcnc/linuxcnc_plan.hpp"
 
 namespace cnccomp::controllers::linuxcnc {
+using namespace cnccomp::controllers::common;
 namespace {
 
 std::string compFileName(const JointPlan& j) { return j.name + ".comp"; }

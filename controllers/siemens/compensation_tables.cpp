@@ -11,6 +11,7 @@
 #include "controllers/siemens/siemens_syntax.hpp"
 
 namespace cnccomp::controllers::siemens {
+using namespace cnccomp::controllers::common;
 namespace {
 
 int valueDecimals(const Link& l) { return l.kind == AxisKind::Rotary ? 8 : 6; }

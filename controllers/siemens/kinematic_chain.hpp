@@ -29,7 +29,7 @@ namespace cnccomp::controllers::siemens {
 std::string formatKinematicChain(const MachineModel& m, const Plan& plan, const Options& o, const std::string& header);
 
 struct ParsedChain {
-    std::vector<ChainElement> workpiece, tool;
+    std::vector<common::ChainElement> workpiece, tool;
 };
 
 /// Reads a chain data file back as K7/K12 describe it: the root from MD16800, the two subchains from its $NK_NEXT and

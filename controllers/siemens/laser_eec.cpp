@@ -9,6 +9,7 @@
 #include "controllers/common/laser_axis.hpp"
 
 namespace cnccomp::controllers::siemens {
+using namespace cnccomp::controllers::common;
 
 std::string backlashMachineData(const std::string& axis, double backlashMm) {
     return fmt::format("$MA_BACKLASH[0,{}]={:.6f}\n", axis, backlashMm);

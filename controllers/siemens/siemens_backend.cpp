@@ -13,6 +13,8 @@
 #include "controllers/siemens/kinematic_chain.hpp"
 
 namespace cnccomp::controllers::siemens {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 
 EmitResult emitFiles(const EmitRequest& request, const Options& o) {
     const MachineModel& m = request.machine;

@@ -19,15 +19,15 @@ inline constexpr const char* kBacklashFile = "CNCCOMP_BACKLASH.INI";
 /// emit with explicit controller limits (the registered backend uses the defaults).
 EmitResult emitFiles(const EmitRequest& request, const Options& options);
 
-class SiemensCompensation final : public AppliedCompensation, public DirectionalCompensation {
+class SiemensCompensation final : public AppliedCompensation, public common::DirectionalCompensation {
 public:
-    SiemensCompensation(const MachineModel& m, std::unique_ptr<const ControllerModel> chain, std::vector<CecTable> cec,
+    SiemensCompensation(const MachineModel& m, std::unique_ptr<const common::ControllerModel> chain, std::vector<CecTable> cec,
                         std::vector<EecTable> eec);
     /// With the default tool length of the TCP (kControllerToolLength).
     AxisVector driveCommands(const AxisVector& programmed) const override;
     /// The TCP with the active tool's length, then the tables at the resulting machine positions.
     AxisVector driveCommandsForTool(const AxisVector& programmed, double toolLength) const override;
-    const TcpTransform& tcp() const { return tcp_; }
+    const common::TcpTransform& tcp() const { return tcp_; }
     const std::vector<CecTable>& cec() const { return cec_; }
     const std::vector<EecTable>& eec() const { return eec_; }
     /// The same plus MD32450 by the direction of motion (controllers/common/set_backlash.hpp).
@@ -37,7 +37,7 @@ public:
 
 private:
     const MachineModel* machine_;
-    TcpTransform tcp_;
+    common::TcpTransform tcp_;
     std::vector<CecTable> cec_;
     std::vector<EecTable> eec_;
 };

@@ -10,6 +10,7 @@
 #include "controllers/common/controller_model.hpp"
 
 namespace cnccomp::controllers::siemens {
+using namespace cnccomp::controllers::common;
 
 std::string axisName(const MachineModel& m, int machineAxis) {
     return fmt::format("AX{}", controllerAxisNumber(m, machineAxis));

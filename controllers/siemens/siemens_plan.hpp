@@ -31,14 +31,14 @@ struct Options {
 /// CEC table: output axis command += value(input axis position). Values mm (linear output) or deg.
 struct CecTable {
     int input = -1, output = -1;  ///< machine axis indices
-    EquidistantTable table;       ///< positions in mm / deg of the input axis
+    common::EquidistantTable table;       ///< positions in mm / deg of the input axis
     std::vector<std::string> sources;
 };
 
 /// EEC table: the axis' positioning error (mm / deg) at its position; the NCK moves the axis by -value.
 struct EecTable {
     int axis = -1;
-    EquidistantTable table;
+    common::EquidistantTable table;
     std::vector<std::string> sources;
 };
 

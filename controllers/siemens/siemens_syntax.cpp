@@ -9,6 +9,7 @@
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp::controllers::siemens {
+using namespace cnccomp::io;
 namespace {
 
 bool isVariableChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }

@@ -9,7 +9,9 @@
 #include "cnccomp/identification/sphere_probe.hpp"
 #include "postproc/testprog/test_program.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 namespace {
 
 constexpr const char* kLetters = "XYZABC";
@@ -41,7 +43,7 @@ public:
             const bool rotary = m_.axisLink(a).kind == AxisKind::Rotary;
             if (!out.empty()) out += ' ';
             const double v = rotary ? c[a] / kDeg : l == 'Z' ? c[a] - zShift : c[a];
-            out += fmt::format("{}{}", l, num(v, d_ == pp::Dialect::Heidenhain));
+            out += fmt::format("{}{}", l, num(v, d_ == postproc::Dialect::Heidenhain));
         }
         return out;
     }
@@ -53,8 +55,8 @@ public:
         return mask;
     }
     void block(const std::string& s) {
-        if (d_ == pp::Dialect::Heidenhain) text += fmt::format("{} {}\n", n_++, s);
-        else if (d_ == pp::Dialect::Rs274ngc) text += s + "\n";
+        if (d_ == postproc::Dialect::Heidenhain) text += fmt::format("{} {}\n", n_++, s);
+        else if (d_ == postproc::Dialect::Rs274ngc) text += s + "\n";
         else text += fmt::format("N{} {}\n", ++n_, s);
     }
     void comment(std::string_view c) {
@@ -63,18 +65,18 @@ public:
             if (ch == '(') ch = '[';
             if (ch == ')') ch = ']';
             if (ch == ';' || ch == '\n') ch = ' ';
-            s.push_back(d_ == pp::Dialect::Fanuc ? static_cast<char>(std::toupper(static_cast<unsigned char>(ch))) : ch);
+            s.push_back(d_ == postproc::Dialect::Fanuc ? static_cast<char>(std::toupper(static_cast<unsigned char>(ch))) : ch);
         }
         switch (d_) {
-            case pp::Dialect::Printer:  // refused by makeProbeProgram
-            case pp::Dialect::Rs274ngc:
-            case pp::Dialect::Fanuc: text += fmt::format("({})\n", s); break;
-            case pp::Dialect::Sinumerik: text += fmt::format("; {}\n", s); break;
-            case pp::Dialect::Heidenhain: block(fmt::format("; {}", s)); break;
+            case postproc::Dialect::Printer:  // refused by makeProbeProgram
+            case postproc::Dialect::Rs274ngc:
+            case postproc::Dialect::Fanuc: text += fmt::format("({})\n", s); break;
+            case postproc::Dialect::Sinumerik: text += fmt::format("; {}\n", s); break;
+            case postproc::Dialect::Heidenhain: block(fmt::format("; {}", s)); break;
         }
     }
     void rapid(const AxisVector& q, unsigned mask) {
-        if (d_ == pp::Dialect::Heidenhain) block(fmt::format("L {} R0 FMAX", words(q, mask)));
+        if (d_ == postproc::Dialect::Heidenhain) block(fmt::format("L {} R0 FMAX", words(q, mask)));
         else block(fmt::format("G0 {}", words(q, mask)));
     }
 
@@ -83,8 +85,8 @@ public:
                double distance) {
         const std::string f = fmt::format("{:g}", feed);
         switch (d_) {
-            case pp::Dialect::Printer:  // refused by makeProbeProgram
-            case pp::Dialect::Rs274ngc:
+            case postproc::Dialect::Printer:  // refused by makeProbeProgram
+            case postproc::Dialect::Rs274ngc:
                 block(fmt::format("G38.3 {} F{}", words(to, linear()), f));
                 if (zShift != 0) {
                     // #5063 is in the program's coordinates, i.e. less the tool length: the log carries the machine Z.
@@ -94,18 +96,18 @@ public:
                     block(fmt::format("(LOG,TOUCH {} {} #5070 #5061 #5062 #5063 #5064 #5065 #5066)", pose, touch));
                 }
                 break;
-            case pp::Dialect::Fanuc:
+            case postproc::Dialect::Fanuc:
                 block(fmt::format("#100={} #101={}", pose, touch));
                 block(fmt::format("G31 {} F{}", words(to, linear()), f));
                 block("DPRNT[TOUCH*#100[40]*#101[20]" + fanucVariables() + "]");
                 break;
-            case pp::Dialect::Sinumerik:
+            case postproc::Dialect::Sinumerik:
                 block(fmt::format("MEAS=1 G01 {} F{}", words(to, linear()), f));
                 block("STOPRE");
                 block(fmt::format("LINE=\"TOUCH {} {} \"<<$AC_MEA[1]{}", pose, touch, sinumerikValues()));
                 block(fmt::format("WRITE(ERR,\"{}\",LINE)", sinumerikFile()));
                 break;
-            case pp::Dialect::Heidenhain: {
+            case postproc::Dialect::Heidenhain: {
                 // Cycle 4 probes from the current position along the incremental vector, at most DIST mm.
                 const Kinematics nominal(m_);
                 (void)from;
@@ -165,13 +167,13 @@ public:
     int n_ = 0;
     const MachineModel& m_;
     const ProbeProgramOptions& o_;
-    pp::Dialect d_;
+    postproc::Dialect d_;
 };
 
 }  // namespace
 
-std::string probeProgramFileName(pp::Dialect d) {
-    return d == pp::Dialect::Heidenhain ? "PROBE.h" : std::string("probe") + programExtension(d);
+std::string probeProgramFileName(postproc::Dialect d) {
+    return d == postproc::Dialect::Heidenhain ? "PROBE.h" : std::string("probe") + programExtension(d);
 }
 
 ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan, const ProbeProgramOptions& o) {
@@ -182,18 +184,18 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     for (const SphereRun& r : plan.sphereRuns)
         if (!(r.feed > 0) || r.feed > 1e5) throw ModelError(fmt::format("sphere run '{}': feed must be 0 .. 100000 mm/min", r.name));
     const SpherePlanCommands cmds = sphereCommands(m, plan.sphereRuns);
-    if (o.dialect == pp::Dialect::Printer)
+    if (o.dialect == postproc::Dialect::Printer)
         throw ModelError(fmt::format("probing programs are written in {}, not for a printer",
-                                     pp::dialectNames(pp::DialectUse::Write)));
+                                     postproc::dialectNames(postproc::DialectUse::Write)));
     ProbeProgram out;
     ProbeWriter w(m, o);
-    const pp::Dialect d = o.dialect;
+    const postproc::Dialect d = o.dialect;
     const std::string name = "PROBE";
     // Header.
-    if (d == pp::Dialect::Fanuc) {
+    if (d == postproc::Dialect::Fanuc) {
         w.text += "%\n";
         w.text += "O2000 (CNCCOMP SPHERE PROBING)\n";
-    } else if (d == pp::Dialect::Heidenhain) {
+    } else if (d == postproc::Dialect::Heidenhain) {
         w.block(fmt::format("BEGIN PGM {} MM", name));
     }
     w.comment(fmt::format("cnccomp sphere probing: machine {} plan {}", o.machineFile.empty() ? m.name : o.machineFile,
@@ -202,7 +204,7 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     int touches = 0;
     for (const SphereRunCommands& rc : cmds.runs) touches += static_cast<int>(rc.poses.size()) * rc.run.touchesPerPose();
     w.comment(fmt::format("{} poses, {} touches; result file {}: one line per touch TOUCH <pose> <touch> {}X Y Z A B C",
-                          cmds.poseCount(), touches, o.log, d == pp::Dialect::Fanuc || d == pp::Dialect::Heidenhain ? "" : "<flag 1 triggered 0 missed> "));
+                          cmds.poseCount(), touches, o.log, d == postproc::Dialect::Fanuc || d == postproc::Dialect::Heidenhain ? "" : "<flag 1 triggered 0 missed> "));
     for (const SphereRunCommands& rc : cmds.runs)
         w.comment(fmt::format("sphere {}: centre {:g} {:g} {:g} mm diameter {:g} stylus {:g} tool length {:g} approach {:g} "
                               "feed {:g} clearance {:g}",
@@ -210,29 +212,29 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
                               rc.run.stylusDiameter, rc.run.toolLength, rc.run.approach, rc.run.feed, rc.run.clearance));
     const AxisVector zero = AxisVector::Zero(m.axisCount());
     switch (d) {
-        case pp::Dialect::Printer:  // refused by makeProbeProgram
-        case pp::Dialect::Rs274ngc:
+        case postproc::Dialect::Printer:  // refused by makeProbeProgram
+        case postproc::Dialect::Rs274ngc:
             w.block("G17 G21 G40 G49 G80 G90 G94 G92.1");
             w.block("G61");                                 // exact path: the rapids between touches are not blended
             w.block("G10 L2 P1 " + w.words(m.fromController(zero), w.all()));  // G54 = machine coordinates
             w.block("G54");
             w.block(fmt::format("(LOGOPEN,{})", o.log));
             break;
-        case pp::Dialect::Fanuc:
+        case postproc::Dialect::Fanuc:
             w.block("G17 G21 G40 G49 G80 G90 G94");
             w.block("G10 L2 P1 " + w.words(m.fromController(zero), w.all()));
             w.block("G54");
             w.block("#102=0");
             w.block("POPEN");
             break;
-        case pp::Dialect::Sinumerik:
+        case postproc::Dialect::Sinumerik:
             w.block("DEF STRING[250] LINE");
             w.block("DEF INT ERR");
             w.block("G17 G71 G40 G90 G94 D0");
             w.block("G500");
             w.block("G60");                                 // exact stop
             break;
-        case pp::Dialect::Heidenhain:
+        case postproc::Dialect::Heidenhain:
             w.block("TOOL CALL 0 Z");
             w.block("CYCL DEF 7.0 DATUM SHIFT");
             w.block("CYCL DEF 7.1 X+0");
@@ -244,7 +246,7 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
             break;
     }
     const unsigned park = 1u << cmds.parkAxis;
-    const bool passToolLength = d == pp::Dialect::Rs274ngc && m.axisIndex("Z") >= 0;
+    const bool passToolLength = d == postproc::Dialect::Rs274ngc && m.axisIndex("Z") >= 0;
     for (const SphereRunCommands& rc : cmds.runs) {
         if (passToolLength && rc.run.toolLength != w.zShift) {
             if (rc.run.toolLength != 0) w.block("G43.1 Z" + w.num(rc.run.toolLength));  // LinuxCNC G-code reference, G43.1
@@ -277,22 +279,22 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
         }
     }
     switch (d) {
-        case pp::Dialect::Printer:  // refused by makeProbeProgram
-        case pp::Dialect::Rs274ngc:
+        case postproc::Dialect::Printer:  // refused by makeProbeProgram
+        case postproc::Dialect::Rs274ngc:
             if (w.zShift != 0) w.block("G49");
             w.block("(LOGCLOSE)");
             w.block("M2");
             break;
-        case pp::Dialect::Fanuc:
+        case postproc::Dialect::Fanuc:
             w.block("PCLOS");
             w.block("M30");
             w.text += "%\n";
             break;
-        case pp::Dialect::Sinumerik: w.block("M30"); break;
-        case pp::Dialect::Heidenhain: w.block(fmt::format("END PGM {} MM", name)); break;
+        case postproc::Dialect::Sinumerik: w.block("M30"); break;
+        case postproc::Dialect::Heidenhain: w.block(fmt::format("END PGM {} MM", name)); break;
     }
     out.files.push_back({probeProgramFileName(d), w.text});
-    if (d == pp::Dialect::Heidenhain) {
+    if (d == postproc::Dialect::Heidenhain) {
         // FN 16 format file: the text with %-formats, then the Q parameters (TNC 640 Klartext manual, FN 16).
         // Q115–Q117: the spindle position at the contact (stylus length and ball radius not compensated), i.e. the
         // machine axes' values under TOOL CALL 0 and a zero datum (TNC 640 user's manual, "Preassigned Q parameters:
@@ -304,4 +306,4 @@ ProbeProgram makeProbeProgram(const MachineModel& m, const MeasurementPlan& plan
     return out;
 }
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

@@ -44,10 +44,10 @@
 #include "cnccomp/io/plan_xml.hpp"
 #include "postproc/testprog/program_syntax.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
 
 struct ProbeProgramOptions {
-    pp::Dialect dialect = pp::Dialect::Rs274ngc;
+    postproc::Dialect dialect = postproc::Dialect::Rs274ngc;
     std::string log = "cnccomp-probe.txt";  ///< result file the program writes (LinuxCNC LOGOPEN, Sinumerik WRITE, …)
     int decimals = 6;
     std::string machineFile, planFile;      ///< for the header (file names only)
@@ -69,10 +69,10 @@ struct ProbeProgram {
 };
 
 /// File name of the probing program: "probe" + the dialect's extension ("PROBE.h" for HEIDENHAIN).
-std::string probeProgramFileName(pp::Dialect d);
+std::string probeProgramFileName(postproc::Dialect d);
 
 /// The probing program of the plan's sphere runs. Throws ModelError (sphereCommands) naming the run, pose and touch
 /// for a point outside the travel; the plan must have sphere runs.
-ProbeProgram makeProbeProgram(const MachineModel& machine, const MeasurementPlan& plan, const ProbeProgramOptions& options);
+ProbeProgram makeProbeProgram(const MachineModel& machine, const measurement::MeasurementPlan& plan, const ProbeProgramOptions& options);
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

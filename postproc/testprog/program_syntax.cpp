@@ -7,15 +7,15 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
 
-const char* programExtension(pp::Dialect d) {
+const char* programExtension(postproc::Dialect d) {
     switch (d) {
-        case pp::Dialect::Rs274ngc: return ".ngc";
-        case pp::Dialect::Fanuc: return ".nc";
-        case pp::Dialect::Sinumerik: return ".mpf";
-        case pp::Dialect::Heidenhain: return ".h";
-        case pp::Dialect::Printer: break;
+        case postproc::Dialect::Rs274ngc: return ".ngc";
+        case postproc::Dialect::Fanuc: return ".nc";
+        case postproc::Dialect::Sinumerik: return ".mpf";
+        case postproc::Dialect::Heidenhain: return ".h";
+        case postproc::Dialect::Printer: break;
     }
     return ".nc";
 }
@@ -71,25 +71,25 @@ namespace {
 /// The ISO (DIN 66025) family: every code block numbered N1, N2, …; I/J/K incremental arc centres.
 class IsoSyntax : public ProgramSyntax {
 public:
-    IsoSyntax(pp::Dialect d, const MachineModel& m, int decimals) : ProgramSyntax(m, decimals), d_(d) {}
+    IsoSyntax(postproc::Dialect d, const MachineModel& m, int decimals) : ProgramSyntax(m, decimals), d_(d) {}
 
     void begin(const std::string& name, int number) override {
-        if (d_ == pp::Dialect::Fanuc) {
+        if (d_ == postproc::Dialect::Fanuc) {
             emit("%");
             emit(fmt::format("O{:04d} ({})", number, clean(name, true, true)));
         }
     }
     void comment(std::string_view text) override {
         switch (d_) {
-            case pp::Dialect::Rs274ngc: emit(fmt::format("({})", clean(text, true, false))); break;
-            case pp::Dialect::Fanuc: emit(fmt::format("({})", clean(text, true, true))); break;
+            case postproc::Dialect::Rs274ngc: emit(fmt::format("({})", clean(text, true, false))); break;
+            case postproc::Dialect::Fanuc: emit(fmt::format("({})", clean(text, true, true))); break;
             default: emit(fmt::format("; {}", clean(text, false, false))); break;
         }
     }
     void init() override {
         const std::string datum = fmt::format(" {}", axisWords(AxisVector::Zero(machine_.axisCount()), allAxes(), false));
         switch (d_) {
-            case pp::Dialect::Rs274ngc:
+            case postproc::Dialect::Rs274ngc:
                 block("G17 G21 G40 G49 G80 G90 G94");
                 block("G91.1 G61");                 // arc centres incremental; exact path (no blending)
                 block("G10 L2 P1" + datum);          // G54 = machine coordinates
@@ -99,7 +99,7 @@ public:
                     zShift_ = toolLength_;
                 }
                 break;
-            case pp::Dialect::Fanuc:
+            case postproc::Dialect::Fanuc:
                 block("G17 G21 G40 G49 G80 G90 G94");
                 block("G10 L2 P1" + datum);          // G54 = machine coordinates (programmable data input)
                 block("G54");
@@ -139,7 +139,7 @@ public:
     }
     bool arcsWithRotaryAxes() const override { return true; }
     bool passToolLength(double length) override {
-        if (d_ != pp::Dialect::Rs274ngc || length == 0 || machine_.axisIndex("Z") < 0 ||
+        if (d_ != postproc::Dialect::Rs274ngc || length == 0 || machine_.axisIndex("Z") < 0 ||
             machine_.axisLink(machine_.axisIndex("Z")).kind != AxisKind::Linear)
             return false;
         toolLength_ = length;
@@ -147,30 +147,30 @@ public:
     }
     void dwell(double seconds) override {
         switch (d_) {
-            case pp::Dialect::Rs274ngc: block("G4 P" + plain(seconds)); break;
-            case pp::Dialect::Fanuc: block(fmt::format("G4 P{}", static_cast<long>(std::lround(seconds * 1000)))); break;
+            case postproc::Dialect::Rs274ngc: block("G4 P" + plain(seconds)); break;
+            case postproc::Dialect::Fanuc: block(fmt::format("G4 P{}", static_cast<long>(std::lround(seconds * 1000)))); break;
             default: block("G4 F" + plain(seconds)); break;
         }
     }
     void stop(std::string_view message) override {
         switch (d_) {
-            case pp::Dialect::Rs274ngc:
+            case postproc::Dialect::Rs274ngc:
                 emit("(MSG, " + clean(message, true, false) + ")");
                 block("M0");
                 break;
-            case pp::Dialect::Fanuc: block("M0 (" + clean(message, true, true) + ")"); break;
+            case postproc::Dialect::Fanuc: block("M0 (" + clean(message, true, true) + ")"); break;
             default: block("M0 ; " + clean(message, false, false)); break;
         }
     }
     void end() override {
         if (zShift_ != 0) block("G49");
         block("M30");
-        if (d_ == pp::Dialect::Fanuc) emit("%");
+        if (d_ == postproc::Dialect::Fanuc) emit("%");
     }
     std::vector<std::string> unconfirmed() const override {
         switch (d_) {
-            case pp::Dialect::Rs274ngc: return {};
-            case pp::Dialect::Fanuc:
+            case postproc::Dialect::Rs274ngc: return {};
+            case postproc::Dialect::Fanuc:
                 return {"[G] circular blocks carry the rotary axes as additional helical axes (helical interpolation B)",
                         "[G] G10 L2 P1 needs programmable data input; six decimals need increment system IS-C or finer"};
             default:
@@ -192,7 +192,7 @@ private:
             if (mask & (1u << a)) pos_[a] = p[a];
     }
 
-    pp::Dialect d_;
+    postproc::Dialect d_;
     long n_ = 0;
     int plane_ = 17;
     double toolLength_ = 0;  ///< passToolLength's L; zShift_ takes it only once G43.1 is written (init's G10 datum
@@ -268,13 +268,13 @@ private:
 
 }  // namespace
 
-std::unique_ptr<ProgramSyntax> ProgramSyntax::make(pp::Dialect d, const MachineModel& machine, int decimals) {
+std::unique_ptr<ProgramSyntax> ProgramSyntax::make(postproc::Dialect d, const MachineModel& machine, int decimals) {
     if (decimals < 0 || decimals > 9) throw ModelError(fmt::format("decimals must be between 0 and 9, not {}", decimals));
-    if (d == pp::Dialect::Printer)
+    if (d == postproc::Dialect::Printer)
         throw ModelError(fmt::format("test programs are written in {}, not for a printer",
-                                     pp::dialectNames(pp::DialectUse::Write)));
-    if (d == pp::Dialect::Heidenhain) return std::make_unique<KlartextSyntax>(machine, decimals);
+                                     postproc::dialectNames(postproc::DialectUse::Write)));
+    if (d == postproc::Dialect::Heidenhain) return std::make_unique<KlartextSyntax>(machine, decimals);
     return std::make_unique<IsoSyntax>(d, machine, decimals);
 }
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

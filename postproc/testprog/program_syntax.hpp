@@ -16,14 +16,14 @@
 #include "cnccomp/machine.hpp"
 #include "postproc/dialect.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
 
-// The dialect of a test program is pp::Dialect (postproc/dialect.hpp; its names for test programs:
-// pp::parseDialect / pp::dialectName with pp::DialectUse::Write): Rs274ngc (LinuxCNC), Fanuc, Sinumerik, Heidenhain.
+// The dialect of a test program is postproc::Dialect (postproc/dialect.hpp; its names for test programs:
+// postproc::parseDialect / postproc::dialectName with postproc::DialectUse::Write): Rs274ngc (LinuxCNC), Fanuc, Sinumerik, Heidenhain.
 // Printer is not a test-program dialect: ProgramSyntax::make refuses it.
 
 /// File extension with the dot: ".ngc", ".nc", ".mpf", ".h".
-const char* programExtension(pp::Dialect d);
+const char* programExtension(postproc::Dialect d);
 
 /// Plane of a circular block: 17 (X, Y), 18 (Z, X), 19 (Y, Z).
 struct ArcBlock {
@@ -36,7 +36,7 @@ struct ArcBlock {
 class ProgramSyntax {
 public:
     /// `decimals`: digits after the point of positions (mm and deg).
-    static std::unique_ptr<ProgramSyntax> make(pp::Dialect d, const MachineModel& machine, int decimals);
+    static std::unique_ptr<ProgramSyntax> make(postproc::Dialect d, const MachineModel& machine, int decimals);
     virtual ~ProgramSyntax() = default;
 
     /// Program start; `number` is the Fanuc O number.
@@ -87,4 +87,4 @@ protected:
     std::string out_;
 };
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

@@ -12,16 +12,17 @@
 #include "postproc/modal.hpp"
 #include "postproc/poses.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
+using namespace cnccomp::io;
 
-std::vector<PoseRow> readPoses(const MachineModel& m, std::string_view text, pp::Dialect dialect, const std::string& source) {
-    const pp::AxisLayout layout = pp::AxisLayout::fromMachine(m);
-    pp::PosesOptions o;
+std::vector<PoseRow> readPoses(const MachineModel& m, std::string_view text, postproc::Dialect dialect, const std::string& source) {
+    const postproc::AxisLayout layout = postproc::AxisLayout::fromMachine(m);
+    postproc::PosesOptions o;
     o.dialect = dialect;
     o.inputName = source;
     std::istringstream in{std::string(text)};
     std::ostringstream csv;
-    pp::writePoses(layout, in, csv, o);
+    postproc::writePoses(layout, in, csv, o);
     static constexpr char kColumns[] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
     std::vector<PoseRow> rows;
     std::istringstream lines(csv.str());
@@ -50,7 +51,7 @@ std::vector<PoseRow> readPoses(const MachineModel& m, std::string_view text, pp:
     return rows;
 }
 
-std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view text, pp::Dialect dialect,
+std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view text, postproc::Dialect dialect,
                                          const std::string& source) {
     std::vector<AxisVector> out;
     AxisVector cur = AxisVector::Zero(m.axisCount());  // controller coordinates (mm, rad)
@@ -65,7 +66,7 @@ std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view
     while (std::getline(in, raw)) {
         ++line;
         std::string_view l = trim(raw);
-        if (dialect == pp::Dialect::Heidenhain) {
+        if (dialect == postproc::Dialect::Heidenhain) {
             // "<n> L X+1.0 Y+2.0 Z+3.0 R0 FMAX", "<n> TCH PROBE 4.2 IX+0.1 IY-0.2 IZ+0.0"
             std::istringstream w{std::string(l)};
             std::vector<std::string> t;
@@ -88,34 +89,34 @@ std::vector<AxisVector> readProbeTargets(const MachineModel& m, std::string_view
         }
         std::string code(l);
         bool probe = false;
-        if (dialect == pp::Dialect::Sinumerik && code.rfind("N", 0) == 0 && code.find(" MEAS=") != std::string::npos) {
+        if (dialect == postproc::Dialect::Sinumerik && code.rfind("N", 0) == 0 && code.find(" MEAS=") != std::string::npos) {
             const size_t p = code.find(" MEAS=");
             const size_t e = code.find(' ', p + 1);
             code.erase(p, e - p);  // the measuring keyword; the rest is a G01 block
             probe = true;
         }
-        pp::LexedBlock b;
-        pp::lexBlock(code, dialect, b, line == 1);
+        postproc::LexedBlock b;
+        postproc::lexBlock(code, dialect, b, line == 1);
         bool motion = false;
         for (int i = 0; i < b.count; ++i) {
-            const pp::Word& w = b.words[static_cast<size_t>(i)];
-            if (w.letter != 'G' || w.kind != pp::ValueKind::Number) continue;
-            if (dialect == pp::Dialect::Rs274ngc && std::abs(w.value - 43.1) < 1e-9) {
+            const postproc::Word& w = b.words[static_cast<size_t>(i)];
+            if (w.letter != 'G' || w.kind != postproc::ValueKind::Number) continue;
+            if (dialect == postproc::Dialect::Rs274ngc && std::abs(w.value - 43.1) < 1e-9) {
                 // G43.1 Z<L> (LinuxCNC dynamic tool length): L is added to every later Z word.
                 for (int k = 0; k < b.count; ++k)
                     if (b.words[static_cast<size_t>(k)].letter == 'Z') zOffset = b.words[static_cast<size_t>(k)].value;
             }
-            if (dialect == pp::Dialect::Rs274ngc && w.value == 49) zOffset = 0;
+            if (dialect == postproc::Dialect::Rs274ngc && w.value == 49) zOffset = 0;
             if (w.value == 0 || w.value == 1) motion = true;
-            if (dialect == pp::Dialect::Rs274ngc && w.value >= 38.15 && w.value <= 38.55) probe = true;
-            if (dialect == pp::Dialect::Fanuc && w.value == 31) probe = true;
+            if (dialect == postproc::Dialect::Rs274ngc && w.value >= 38.15 && w.value <= 38.55) probe = true;
+            if (dialect == postproc::Dialect::Fanuc && w.value == 31) probe = true;
         }
         if (!motion && !probe) continue;
-        if (b.flags & pp::kNotEvaluable)
+        if (b.flags & postproc::kNotEvaluable)
             throw InputError(source, static_cast<int>(line), fmt::format("a motion block that cannot be evaluated ({})",
-                                                                         pp::lexFlagReason(b.flags)));
+                                                                         postproc::lexFlagReason(b.flags)));
         for (int i = 0; i < b.count; ++i) {
-            const pp::Word& w = b.words[static_cast<size_t>(i)];
+            const postproc::Word& w = b.words[static_cast<size_t>(i)];
             if (std::string_view("XYZABC").find(w.letter) != std::string_view::npos) set(w.letter, w.letter == 'Z' ? w.value + zOffset : w.value);
         }
         if (probe) out.push_back(m.fromController(cur));
@@ -133,11 +134,11 @@ struct Marker {
 };
 
 /// A block with a number: ISO "N123 …", Klartext "12 …" (not one `correct` inserted: those end with its comment).
-bool numberedBlock(std::string_view line, pp::Dialect d) {
+bool numberedBlock(std::string_view line, postproc::Dialect d) {
     line = trim(line);
     if (line.empty()) return false;
-    if (d == pp::Dialect::Heidenhain) {
-        const std::string_view mark = pp::kKlartextInsertedComment;
+    if (d == postproc::Dialect::Heidenhain) {
+        const std::string_view mark = postproc::kKlartextInsertedComment;
         const bool inserted = line.size() >= mark.size() && line.substr(line.size() - mark.size()) == mark;
         return std::isdigit(static_cast<unsigned char>(line.front())) && !inserted;
     }
@@ -148,7 +149,7 @@ bool isMove(const PoseRow& r) { return r.motion == "G0" || r.motion == "G1" || r
 
 }  // namespace
 
-ProgramCommands readTestProgram(const MachineModel& m, const RunMotion& motion, std::string_view text, pp::Dialect dialect,
+ProgramCommands readTestProgram(const MachineModel& m, const RunMotion& motion, std::string_view text, postproc::Dialect dialect,
                                 const std::string& source) {
     const std::vector<PoseRow> rows = readPoses(m, text, dialect, source);
     std::vector<std::string_view> lines;
@@ -258,4 +259,4 @@ void passSamples(const RunMotion& motion, const PassCommands& pass, std::vector<
         }
 }
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

@@ -10,7 +10,7 @@
 #include "postproc/dialect.hpp"
 #include "postproc/testprog/run_motion.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
 
 /// One row of the poses CSV: a motion endpoint, description-frame commands (mm, rad).
 struct PoseRow {
@@ -21,7 +21,7 @@ struct PoseRow {
 };
 
 /// Every row of `cnccomp poses` for a program text (the CSV parsed back). Throws InputError naming `source`.
-std::vector<PoseRow> readPoses(const MachineModel& machine, std::string_view text, pp::Dialect dialect, const std::string& source);
+std::vector<PoseRow> readPoses(const MachineModel& machine, std::string_view text, postproc::Dialect dialect, const std::string& source);
 
 struct PassCommands {
     std::string label;              ///< "CW", "CCW", "forward", "reverse" (from the marker)
@@ -42,7 +42,7 @@ struct ProgramCommands {
 /// (source:line) when markers are missing, a point has no move or an axis is unknown, or the number of points differs
 /// from the plan's.
 ProgramCommands readTestProgram(const MachineModel& machine, const RunMotion& motion, std::string_view text,
-                                pp::Dialect dialect, const std::string& source);
+                                postproc::Dialect dialect, const std::string& source);
 
 /// The commanded end points of the probing moves of a probing program (probe_program.hpp), in program order
 /// (description frame; axes a block does not give keep the value the program last commanded; a LinuxCNC G43.1 Z<L> adds L
@@ -50,10 +50,10 @@ ProgramCommands readTestProgram(const MachineModel& machine, const RunMotion& mo
 /// Fanuc G31 and Sinumerik MEAS=… G01 blocks through the post-processor's lexer (postproc/lexer.hpp); HEIDENHAIN
 /// TCH PROBE 4.2 (incremental vector) from the position of the last L block (the Klartext reader does not read TCH
 /// PROBE cycles). Throws InputError (source:line) for a probing block whose words cannot be evaluated.
-std::vector<AxisVector> readProbeTargets(const MachineModel& machine, std::string_view text, pp::Dialect dialect,
+std::vector<AxisVector> readProbeTargets(const MachineModel& machine, std::string_view text, postproc::Dialect dialect,
                                          const std::string& source);
 
 /// The samples of a pass (the simulation's sample parameters, without the closing point of a whole turn), in pass order.
 void passSamples(const RunMotion& motion, const PassCommands& pass, std::vector<double>& t, std::vector<AxisVector>& q);
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

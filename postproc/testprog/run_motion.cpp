@@ -12,7 +12,9 @@
 #include "cnccomp/identification/rtest_run.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 
 const char* runKindName(RunKind k) {
     switch (k) {
@@ -259,4 +261,4 @@ PathShape analysePath(const MachineModel& m, const RunMotion& motion, double fro
     return s;
 }
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

@@ -14,7 +14,7 @@
 
 #include "cnccomp/io/plan_xml.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
 
 enum class RunKind { Ballbar, AbsoluteBallbar, Rtest, Dbb5, LinearCircle };
 /// "ball bar", "absolute ball bar", "R-test", "DBB5", "linear circle".
@@ -41,14 +41,14 @@ struct RunMotion {
     std::string captureAction;   ///< what the operator does before the data capture starts
 
     const BallbarRun* ballbar = nullptr;  ///< the plan's run (ball bar, absolute ball bar), else null
-    const Dbb5Run* dbb5 = nullptr;
-    const RtestRun* rtest = nullptr;
+    const measurement::Dbb5Run* dbb5 = nullptr;
+    const measurement::RtestRun* rtest = nullptr;
     const LinearCircleRun* circle = nullptr;  ///< <circle>: its feed, overshoot and first direction drive the program
 };
 
 /// Every run of the plan in plan order: <run>, <absolute-run>, <dbb5>, <rtest>, <circle>. The plan must outlive the result.
 /// Throws ModelError for a run the machine cannot make (unknown axes, impossible geometry).
-std::vector<RunMotion> planMotions(const MachineModel& machine, const MeasurementPlan& plan);
+std::vector<RunMotion> planMotions(const MachineModel& machine, const measurement::MeasurementPlan& plan);
 
 /// Shape of a continuous sweep in the controller's coordinates: a circle in a principal plane (XY, ZX or YZ) run
 /// at a constant rate with every rotary axis linear in the same parameter, which is exactly what one G2/G3 block with
@@ -67,4 +67,4 @@ struct PathShape {
 /// Examines motion.at in the controller's coordinates over [from, to] (any order) every `step` and half-way between.
 PathShape analysePath(const MachineModel& machine, const RunMotion& motion, double from, double to, double step);
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

@@ -15,9 +15,11 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
-std::string programFileName(const std::string& run, int order, pp::Dialect d) {
+std::string programFileName(const std::string& run, int order, postproc::Dialect d) {
     std::string s = fmt::format("TP{:02d}_", order);
     for (char c : run) s.push_back(std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_');
     return s + programExtension(d);
@@ -206,13 +208,13 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
         syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no work offset; "
                                     "G43.1 Z{:g} gives the tool length: LinuxCNC adds it to every Z word, so Z is written as "
                                     "the machine coordinate minus {:g}",
-                                    pp::dialectName(o.dialect, pp::DialectUse::Write), r.toolLength, r.toolLength));
+                                    postproc::dialectName(o.dialect, postproc::DialectUse::Write), r.toolLength, r.toolLength));
         syntax->comment("cnccomp's LinuxCNC kinematics component (emit --controller linuxcnc) keeps the tool tip at that length exact "
                         "where the tool axis cannot follow");
     } else {
         syntax->comment(fmt::format("dialect {}: positions in the controller's machine coordinates (mm, deg), no tool length or "
                                     "work offset active",
-                                    pp::dialectName(o.dialect, pp::DialectUse::Write)));
+                                    postproc::dialectName(o.dialect, postproc::DialectUse::Write)));
     }
     // The mode the controller must run the program in, which verify also runs it in.
     syntax->comment(kKinematicsModeLine);
@@ -235,7 +237,7 @@ TestProgram makeTestProgram(const MachineModel& m, const RunMotion& r, int order
                                         : ""));
     syntax->comment("instrument: set it at the first stop, start the data capture at the second stop, stop it at the last "
                     "stop");
-    // `cnccomp correct` reads the length back from this line when no --tool-length is given (pp::toolLengthFromHeader).
+    // `cnccomp correct` reads the length back from this line when no --tool-length is given (postproc::toolLengthFromHeader).
     syntax->comment(fmt::format("to correct this program for the measured machine: cnccomp correct --tool-length {:g}", r.toolLength));
     for (const std::string& g : syntax->unconfirmed()) syntax->comment(g);
     syntax->init();
@@ -317,4 +319,4 @@ void writeTestPrograms(const TestProgramSet& set, const std::string& dir, const 
     out.commit();
 }
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

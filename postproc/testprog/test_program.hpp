@@ -19,7 +19,7 @@
 #include "postproc/testprog/program_syntax.hpp"
 #include "postproc/testprog/run_motion.hpp"
 
-namespace cnccomp::pp::testprog {
+namespace cnccomp::postproc::testprog {
 
 /// The header line every test program carries (all dialects): the kinematics mode the controller must run it in.
 /// The words are machine coordinates, so the controller's tool-tip transformation must be off; `cnccomp verify` runs
@@ -29,7 +29,7 @@ inline constexpr const char* kKinematicsModeLine =
     "Sinumerik TRAORI off, Heidenhain M128/FUNCTION TCPM off, Fanuc G43.4/G43.5 off)";
 
 struct TestProgramOptions {
-    pp::Dialect dialect = pp::Dialect::Rs274ngc;
+    postproc::Dialect dialect = postproc::Dialect::Rs274ngc;
     double feed = 1000.0;        ///< mm/min along the sweep and the overshoot arcs
     double approachFeed = 500.0; ///< mm/min onto the setup and start poses
     double overshootDeg = 10.0;  ///< feed-in / feed-out overshoot, in units of the sweep parameter (deg); reduced where
@@ -60,17 +60,17 @@ struct TestProgramSet {
 
 /// File name of the program of run number `order` (from 1): "TP01_<run>" with characters other than letters,
 /// digits and '_' replaced by '_', plus the dialect's extension.
-std::string programFileName(const std::string& run, int order, pp::Dialect d);
+std::string programFileName(const std::string& run, int order, postproc::Dialect d);
 
 /// The program of one run. Throws ModelError naming the run and the axis when a command the measurement needs (setup,
 /// approach, sweep) leaves an axis' travel; the overshoot is shortened instead.
 TestProgram makeTestProgram(const MachineModel& machine, const RunMotion& motion, int order, const TestProgramOptions& options);
 
 /// Programs for every run of the plan, plus the index. Nothing is written: errors come before any output.
-TestProgramSet makeTestPrograms(const MachineModel& machine, const MeasurementPlan& plan, const TestProgramOptions& options);
+TestProgramSet makeTestPrograms(const MachineModel& machine, const measurement::MeasurementPlan& plan, const TestProgramOptions& options);
 
 /// Writes every program and the index into `dir` (created if missing): all or none (each file is staged under a
 /// temporary name first, then renamed). Refuses to overwrite any of `inputs` or a file that is not a regular file.
 void writeTestPrograms(const TestProgramSet& set, const std::string& dir, const std::vector<std::string>& inputs);
 
-}  // namespace cnccomp::pp::testprog
+}  // namespace cnccomp::postproc::testprog

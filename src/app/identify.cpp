@@ -5,6 +5,9 @@
 #include "cnccomp/io/plan_measurements_io.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 IdentificationSummary identify(const MachineModel& machine, const MeasurementPlan* plan,
                                const IdentificationOptions& options) {

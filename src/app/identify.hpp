@@ -19,7 +19,7 @@
 namespace cnccomp::app {
 
 /// `plan` may be null only for the ball-bar formulas on an eccentricity table (options.eccentricities).
-IdentificationSummary identify(const MachineModel& machine, const MeasurementPlan* plan,
+IdentificationSummary identify(const MachineModel& machine, const measurement::MeasurementPlan* plan,
                                const IdentificationOptions& options);
 
 }  // namespace cnccomp::app

@@ -6,6 +6,8 @@
 #include "cnccomp/error.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 
 namespace {
 

@@ -33,6 +33,9 @@
 #include "app/identify_registry.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 /// The ball-bar traces of the plan's <run> elements, as read once.
@@ -467,7 +470,7 @@ IdentificationSummary sphereProbe(const MethodRequest& r) {
               cmds.runs[i].poses[static_cast<size_t>(w - rms.begin())].planPose);
     }
     const IdentifyOptions io = engineOptions(r, sphereDefaults(m, obs));
-    IdentificationResult res = cnccomp::identify(m, obs, io);
+    IdentificationResult res = cnccomp::identification::identify(m, obs, io);
     const auto identified = std::count_if(io.deviations.begin(), io.deviations.end(),
                                           [&](int i) { return res.deviations.present[static_cast<size_t>(i)] != 0; });
     IdentificationSummary out{res.deviations, res.report, {}, "", std::nullopt, std::nullopt};

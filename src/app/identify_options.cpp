@@ -7,6 +7,8 @@
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
 
 Approach parseApproach(std::string_view t) {
     if (t == "least-squares" || t == "lsq") return Approach::LeastSquares;

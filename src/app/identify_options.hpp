@@ -28,7 +28,7 @@ struct IdentificationOptions {
     int refine = -1;              ///< formulas: refinement passes 0..20 (-1 = the method's default)
     std::string params;           ///< least squares: deviations to identify ("" = the method's default; "all")
     Observe observe = Observe::Traces;
-    SolverChoice solver;          ///< least squares: Levenberg-Marquardt (default) or NLopt
+    identification::SolverChoice solver;          ///< least squares: Levenberg-Marquardt (default) or NLopt
     std::string bounds;           ///< NLopt: "NAME=LOWER:UPPER, …" in µm / arcsec
     std::string start;            ///< least squares: deviation CSV with starting values ("" = zero)
     int monteCarlo = 0;           ///< resampled solutions for sampled intervals (0 = none)
@@ -47,9 +47,9 @@ Approach parseApproach(std::string_view text);
 Observe parseObserve(std::string_view text);
 /// "lm" (or "levenberg-marquardt"), "nlopt:<ALGORITHM>" (e.g. nlopt:LD_SLSQP; the algorithm is checked by
 /// validateOptions). ModelError naming --solver and the accepted values.
-SolverChoice parseSolver(std::string_view text);
+identification::SolverChoice parseSolver(std::string_view text);
 /// The solver as parseSolver reads it: "lm" or "nlopt:<ALGORITHM>".
-std::string solverText(const SolverChoice& solver);
+std::string solverText(const identification::SolverChoice& solver);
 
 /// Checks every option that needs no file: the solver and its NLopt algorithm, the iteration limit, the rank
 /// tolerance, the Monte Carlo count, --refine, the bounds' syntax and, for least squares, bounds only with a bounded
@@ -59,6 +59,6 @@ void validateOptions(const IdentificationOptions& options);
 
 /// The bounds "NAME=LOWER:UPPER, …" (µm for lengths and nuisance parameters, arcsec for angles) in internal units,
 /// the names checked against the machine. ModelError naming --bounds.
-std::vector<ParameterBound> parseBounds(const MachineModel& machine, const std::string& text);
+std::vector<identification::ParameterBound> parseBounds(const MachineModel& machine, const std::string& text);
 
 }  // namespace cnccomp::app

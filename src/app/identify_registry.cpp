@@ -5,6 +5,7 @@
 #include "cnccomp/error.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
 
 const std::vector<IdentificationMethod>& identificationMethods() {
     static const std::vector<IdentificationMethod> all = [] {

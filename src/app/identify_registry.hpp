@@ -22,11 +22,11 @@ namespace cnccomp::app {
 /// What a method is given: the options, the machine, the plan and, once read, its captures.
 struct MethodRequest : IdentificationOptions {
     const MachineModel* machine = nullptr;
-    const MeasurementPlan* plan = nullptr;  ///< null only for ball-bar formulas from an eccentricity table
-    PlanMethod kind = PlanMethod::Ballbar;
+    const measurement::MeasurementPlan* plan = nullptr;  ///< null only for ball-bar formulas from an eccentricity table
+    identification::PlanMethod kind = identification::PlanMethod::Ballbar;
     bool formulas = false;                  ///< approach == Approach::Formulas
-    std::vector<ParameterBound> parsedBounds;  ///< `bounds` parsed against the machine
-    const PlanMeasurements* data = nullptr;    ///< set before run()
+    std::vector<identification::ParameterBound> parsedBounds;  ///< `bounds` parsed against the machine
+    const measurement::PlanMeasurements* data = nullptr;    ///< set before run()
     std::string* tables = nullptr;             ///< IdentificationSummary::methodTables, appended to by say()
     /// Appends to the method's tables (what it finds as it works, in order).
     template <class... Args>
@@ -37,10 +37,10 @@ struct MethodRequest : IdentificationOptions {
 
 struct IdentificationMethod {
     std::string name;                 ///< as planMethodName() of the kind it serves, e.g. "rtest-location"
-    std::vector<PlanMethod> serves;   ///< the kinds of plan it identifies
+    std::vector<identification::PlanMethod> serves;   ///< the kinds of plan it identifies
     std::string description;
     /// The kinds of runs it reads for this request (the façade reads them once, before run()).
-    MeasurementKinds (*reads)(const MethodRequest&) = nullptr;
+    measurement::MeasurementKinds (*reads)(const MethodRequest&) = nullptr;
     /// Checks the options against the machine and the plan (nothing read). ModelError naming the option.
     void (*check)(const MethodRequest&) = nullptr;
     /// Identifies from request.data. ModelError / InputError naming what does not fit.
@@ -52,7 +52,7 @@ const std::vector<IdentificationMethod>& identificationMethods();
 /// The method of that name; ModelError listing the registered names.
 const IdentificationMethod& identificationMethod(std::string_view name);
 /// The method serving that kind of plan; ModelError listing the registered methods and what they serve.
-const IdentificationMethod& identificationMethodFor(PlanMethod kind);
+const IdentificationMethod& identificationMethodFor(identification::PlanMethod kind);
 
 /// The built-in methods, listed by identificationMethods() (an explicit list, not objects registering themselves from
 /// their files: this is a static library linked without --whole-archive, and the linker drops an object file nobody

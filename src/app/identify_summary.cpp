@@ -7,6 +7,7 @@
 #include "app/text_out.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
 
 namespace {
 

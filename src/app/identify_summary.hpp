@@ -27,20 +27,20 @@ struct ExtraOutput {
 
 struct IdentificationSummary {
     DeviationSet deviations;
-    std::optional<IdentificationReport> report;  ///< least-squares solutions
+    std::optional<identification::IdentificationReport> report;  ///< least-squares solutions
     std::vector<ExtraOutput> extras;
     std::string summary;                         ///< one line: what was identified, how (briefReport())
     /// Least squares on measured ball-bar traces: the imported runs and the engine's result (for the ISO 230-4 table
     /// and the HTML report's polar plots).
-    std::optional<MeasuredRuns> measured;
-    std::optional<IdentificationResult> result;
+    std::optional<identification::MeasuredRuns> measured;
+    std::optional<identification::IdentificationResult> result;
     /// Circles of the linear axes (<circle> runs): their diagnostics and ISO 230-4 figures (the reports take them).
     std::optional<LinearCircleIdentification> circles{};
     /// The tables the method produced as it worked (ISO 230-4 figures of DBB5 runs, the fits of the formulas, the
     /// errors over angle of a head or a table, the sphere fits), in order; "" when none.
     std::string methodTables{};
     std::string method{};                        ///< the registered method that ran (identify_registry.hpp)
-    PlanMethod kind = PlanMethod::Ballbar;       ///< the kind of plan it served
+    identification::PlanMethod kind = identification::PlanMethod::Ballbar;       ///< the kind of plan it served
     bool formulas = false;                       ///< the paper's formulas, not least squares
 
     /// One line: what was identified, how.
@@ -52,7 +52,7 @@ struct IdentificationSummary {
 };
 
 /// A least-squares report: values under ISO names, intervals, combinations, residuals per run, adequacy, warnings.
-std::string formatReport(const IdentificationReport& report);
+std::string formatReport(const identification::IdentificationReport& report);
 
 /// The test conditions, the ISO 230-4 figures and the ranked diagnostics of every circle of the linear axes, and the
 /// deviations written.

@@ -18,10 +18,12 @@
 #include "postproc/testprog/test_program.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 
 namespace {
 
-class IdealCompensation final : public controllers::AppliedCompensation, public controllers::DirectionalCompensation {
+class IdealCompensation final : public controllers::AppliedCompensation, public controllers::common::DirectionalCompensation {
 public:
     IdealCompensation(const MachineModel& m, const DeviationSet& d) : nominal_(m), identified_(m, d), reversal_(d) {}
     AxisVector driveCommands(const AxisVector& q) const override { return driveCommandsForTool(q, 0.0); }
@@ -48,8 +50,8 @@ double span(const std::vector<double>& v) {
     return *hi - *lo;
 }
 
-std::string runType(const pp::testprog::RunMotion& r) {
-    if (r.ballbar) return std::string(testName(r.ballbar->test)) + (r.kind == pp::testprog::RunKind::AbsoluteBallbar ? " absolute" : "");
+std::string runType(const postproc::testprog::RunMotion& r) {
+    if (r.ballbar) return std::string(testName(r.ballbar->test)) + (r.kind == postproc::testprog::RunKind::AbsoluteBallbar ? " absolute" : "");
     if (r.dbb5)
         return r.dbb5->kind == Dbb5Run::Kind::LinearCircle ? fmt::format("DBB5 {} circle", r.dbb5->plane)
                                                            : fmt::format("DBB5 {} circle", r.dbb5->axis);
@@ -57,7 +59,7 @@ std::string runType(const pp::testprog::RunMotion& r) {
     return "R-test";
 }
 
-double barLength(const pp::testprog::RunMotion& r) {
+double barLength(const postproc::testprog::RunMotion& r) {
     return r.ballbar ? r.ballbar->LB : r.dbb5 ? r.dbb5->LB : r.circle ? r.circle->radius : 0.0;
 }
 
@@ -69,14 +71,14 @@ struct RunCommands {
     std::vector<std::vector<AxisVector>> q;
 };
 
-RunCommands samplesOf(const pp::testprog::RunMotion& r, const pp::testprog::ProgramCommands& p) {
+RunCommands samplesOf(const postproc::testprog::RunMotion& r, const postproc::testprog::ProgramCommands& p) {
     RunCommands c;
     c.setup = p.setup;
     for (const auto& pass : p.passes) {
         c.labels.push_back(pass.label);
         c.t.emplace_back();
         c.q.emplace_back();
-        pp::testprog::passSamples(r, pass, c.t.back(), c.q.back());
+        postproc::testprog::passSamples(r, pass, c.t.back(), c.q.back());
     }
     return c;
 }
@@ -108,7 +110,7 @@ struct TravelCheck {
 
 /// The instrument's readings along one pass on machine k: ΔL of a bar ([MultiTasking] eq. (14); absolute bar: Ball 2 at its
 /// nominal place, [FanWuLi]; DBB5, [IbarakiDBB5]), or the R-test displacement ([Moravek2019]).
-void simulatePass(const Kinematics& k, const Kinematics& nominal, const pp::testprog::RunMotion& r, const AxisVector& setup,
+void simulatePass(const Kinematics& k, const Kinematics& nominal, const postproc::testprog::RunMotion& r, const AxisVector& setup,
                   const AxisVector& nominalSetup, const std::vector<double>& t, const std::vector<AxisVector>& q,
                   BallbarTrace& trace, std::vector<Vec3>& displacement, TravelCheck& travel) {
     const MachineModel& m = k.machine();
@@ -131,7 +133,7 @@ void simulatePass(const Kinematics& k, const Kinematics& nominal, const pp::test
         const BallbarRun& b = *r.ballbar;
         tool = k.toolPoint(b.RB, b.toolBallOffset);
         LB = b.LB;
-        ref = r.kind == pp::testprog::RunKind::AbsoluteBallbar
+        ref = r.kind == postproc::testprog::RunKind::AbsoluteBallbar
                   ? nominal.toolPointInWorkpiece(nominalSetup, nominal.toolPoint(b.RB, b.toolBallOffset)) + b.workBallOffset
                   : k.toolPointInWorkpiece(setup, tool) + b.workBallOffset;  // eq. (11)–(13), (16)
     } else if (r.circle) {
@@ -162,7 +164,7 @@ double displacementSpan(const std::vector<Vec3>& d) {
 }
 
 /// ISO 230-4 figures and eccentricity of a ball-bar trace.
-void analyse(const MachineModel& m, const pp::testprog::RunMotion& r, const BallbarTrace& trace, CircularTestResult& iso,
+void analyse(const MachineModel& m, const postproc::testprog::RunMotion& r, const BallbarTrace& trace, CircularTestResult& iso,
              Vec3& eccentricity) {
     iso = evaluateCircularTest(trace, barLength(r));
     eccentricity = Vec3::Constant(NAN);
@@ -181,7 +183,7 @@ void analyse(const MachineModel& m, const pp::testprog::RunMotion& r, const Ball
 }
 
 /// The grid over the box of the plan's commands (as the test programs write them) at the runs' tool lengths.
-PlanWorkspace gridOver(const MachineModel& m, const std::vector<pp::testprog::RunMotion>& motions,
+PlanWorkspace gridOver(const MachineModel& m, const std::vector<postproc::testprog::RunMotion>& motions,
                        const std::vector<RunCommands>& programmed, int perAxis) {
     const int n = m.axisCount();
     AxisVector lo = AxisVector::Constant(n, HUGE_VAL), hi = AxisVector::Constant(n, -HUGE_VAL);
@@ -223,7 +225,7 @@ void volumetric(const MachineModel& m, const DeviationSet& simulated, const cont
     v.toolLengths = w.toolLengths;
     double sumBefore = 0, sumAfter = 0;
     for (double L : v.toolLengths) {
-        const auto f = controllers::evaluateCompensation(m, simulated, comp, w.poses, L);
+        const auto f = controllers::common::evaluateCompensation(m, simulated, comp, w.poses, L);
         v.maxBefore = std::max(v.maxBefore, f.maxBefore);
         v.maxAfter = std::max(v.maxAfter, f.maxAfter);
         v.tiltBefore = std::max(v.tiltBefore, f.maxAxisBefore);
@@ -242,9 +244,9 @@ void volumetric(const MachineModel& m, const DeviationSet& simulated, const cont
 
 /// The commands of every run as the plan's test programs write them (generated in memory, read back by the
 /// post-processor).
-RunCommands writtenCommands(const MachineModel& m, const pp::testprog::RunMotion& r, const pp::testprog::TestProgram& prog,
+RunCommands writtenCommands(const MachineModel& m, const postproc::testprog::RunMotion& r, const postproc::testprog::TestProgram& prog,
                             const VerifyOptions& options) {
-    return samplesOf(r, pp::testprog::readTestProgram(m, r, prog.text, options.dialect, prog.file));
+    return samplesOf(r, postproc::testprog::readTestProgram(m, r, prog.text, options.dialect, prog.file));
 }
 
 }  // namespace
@@ -255,10 +257,10 @@ std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const 
 }
 
 PlanWorkspace planWorkspace(const MachineModel& m, const MeasurementPlan& plan, const VerifyOptions& options) {
-    const std::vector<pp::testprog::RunMotion> motions = pp::testprog::planMotions(m, plan);
-    pp::testprog::TestProgramOptions po;
+    const std::vector<postproc::testprog::RunMotion> motions = postproc::testprog::planMotions(m, plan);
+    postproc::testprog::TestProgramOptions po;
     po.dialect = options.dialect;
-    const pp::testprog::TestProgramSet programs = pp::testprog::makeTestPrograms(m, plan, po);
+    const postproc::testprog::TestProgramSet programs = postproc::testprog::makeTestPrograms(m, plan, po);
     std::vector<RunCommands> programmed;
     for (size_t i = 0; i < motions.size(); ++i) programmed.push_back(writtenCommands(m, motions[i], programs.programs[i], options));
     return gridOver(m, motions, programmed, options.volumetricPerAxis);
@@ -297,14 +299,14 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
         }
         out.volumetric.note = "sphere plans: no volumetric figure (the probing poses are not sampled as a workspace)";
     } else {
-    const std::vector<pp::testprog::RunMotion> motions = pp::testprog::planMotions(m, plan);
-    pp::testprog::TestProgramOptions po;
+    const std::vector<postproc::testprog::RunMotion> motions = postproc::testprog::planMotions(m, plan);
+    postproc::testprog::TestProgramOptions po;
     po.dialect = options.dialect;
-    const pp::testprog::TestProgramSet programs = pp::testprog::makeTestPrograms(m, plan, po);
+    const postproc::testprog::TestProgramSet programs = postproc::testprog::makeTestPrograms(m, plan, po);
     std::vector<RunCommands> programmed;
     for (size_t i = 0; i < motions.size(); ++i) {
-        const pp::testprog::RunMotion& r = motions[i];
-        const pp::testprog::TestProgram& prog = programs.programs[i];
+        const postproc::testprog::RunMotion& r = motions[i];
+        const postproc::testprog::TestProgram& prog = programs.programs[i];
         // The commands as written: the program generated in memory, read back by the post-processor.
         const RunCommands before = writtenCommands(m, r, prog, options);
         RunCommands after;
@@ -312,12 +314,12 @@ VerifyResult verify(const MachineModel& m, const MeasurementPlan& plan, const De
             const auto it = std::find_if(comp.programs.begin(), comp.programs.end(), [&](const auto& p) { return p.first == r.name; });
             if (it == comp.programs.end()) throw InputError(comp.description, 0, fmt::format("no corrected program for run '{}'", r.name));
             const auto& [file, text] = it->second;
-            after = samplesOf(r, pp::testprog::readTestProgram(m, r, text, comp.programDialect, file));
+            after = samplesOf(r, postproc::testprog::readTestProgram(m, r, text, comp.programDialect, file));
         } else {
             // Each pose with the direction its axes' commands move in along the pass (lost_motion.hpp: a controller's
             // backlash or two-column table keys on it); the setup pose as reached from either side (0: the mean).
             after = before;
-            const auto* directional = dynamic_cast<const controllers::DirectionalCompensation*>(comp.model.get());
+            const auto* directional = dynamic_cast<const controllers::common::DirectionalCompensation*>(comp.model.get());
             const auto drive = [&](const AxisVector& q, const AxisVector& motion) {
                 return directional ? directional->driveCommandsMoving(q, r.toolLength, motion)
                                    : comp.model->driveCommandsForTool(q, r.toolLength);

@@ -36,7 +36,7 @@ struct VerifyCompensation {
     std::shared_ptr<const controllers::AppliedCompensation> model;
     /// CorrectedPrograms: run name → (file name, program text), read in `programDialect`.
     std::vector<std::pair<std::string, std::pair<std::string, std::string>>> programs;
-    pp::Dialect programDialect = pp::Dialect::Rs274ngc;
+    postproc::Dialect programDialect = postproc::Dialect::Rs274ngc;
     /// What the compensation leaves, and why (the backend's NOT-compensated list).
     std::vector<controllers::Coverage> notCompensated;
     /// What it takes, and how (the backend's compensated list from the files' header; empty when they carry none).
@@ -51,7 +51,7 @@ std::shared_ptr<const controllers::AppliedCompensation> idealCompensation(const 
                                                                           const DeviationSet& identified);
 
 struct VerifyOptions {
-    pp::Dialect dialect = pp::Dialect::Rs274ngc;  ///< the in-memory test programs
+    postproc::Dialect dialect = postproc::Dialect::Rs274ngc;  ///< the in-memory test programs
     int volumetricPerAxis = 5;  ///< grid over the plan's workspace: samples per axis
 };
 
@@ -62,7 +62,7 @@ struct PlanWorkspace {
     std::vector<double> toolLengths;  ///< mm, each once, in the order of the runs
     std::string note;                 ///< "5 per axis over the commands of the plan's runs (X=…), tool lengths 100 mm"
 };
-PlanWorkspace planWorkspace(const MachineModel& machine, const MeasurementPlan& plan, const VerifyOptions& options = {});
+PlanWorkspace planWorkspace(const MachineModel& machine, const measurement::MeasurementPlan& plan, const VerifyOptions& options = {});
 
 /// One pass (direction) of a run, before and after compensation.
 struct VerifyPass {
@@ -80,7 +80,7 @@ struct VerifyPass {
 
 struct VerifyRun {
     std::string name;
-    pp::testprog::RunKind kind = pp::testprog::RunKind::Ballbar;
+    postproc::testprog::RunKind kind = postproc::testprog::RunKind::Ballbar;
     std::string type;      ///< "B-X", "DBB5 XY circle", "R-test", …
     double LB = 0;         ///< bar length, mm (0 for R-test)
     std::string program;   ///< the test program's file name
@@ -154,7 +154,7 @@ std::string worseBanner(const VerifyResult& result);
 
 /// Runs the loop. `simulated` is the machine the commands reach (truth or identified); `simulatedName` says which.
 /// Throws ModelError / InputError (a corrected program missing or malformed, commands outside the travel …).
-VerifyResult verify(const MachineModel& machine, const MeasurementPlan& plan, const DeviationSet& simulated,
+VerifyResult verify(const MachineModel& machine, const measurement::MeasurementPlan& plan, const DeviationSet& simulated,
                     const std::string& simulatedName, const VerifyCompensation& compensation, const VerifyOptions& options = {});
 
 }  // namespace cnccomp::app

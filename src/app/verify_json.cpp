@@ -8,6 +8,7 @@
 
 
 namespace cnccomp::app {
+using namespace cnccomp::io;
 namespace {
 
 std::string str(std::string_view s) { return jsonString(s); }
@@ -77,7 +78,7 @@ std::string formatVerifyJson(const VerifyResult& r, std::optional<double> gateUm
         const VerifyRun& run = r.runs[i];
         o += fmt::format("    {{\"name\": {}, \"type\": {}, \"kind\": {}, \"program\": {}, \"LB_mm\": {}, \"span_before_um\": {}, "
                          "\"span_after_um\": {},\n     \"passes\": {}}}{}\n",
-                         str(run.name), str(run.type), str(pp::testprog::runKindName(run.kind)), str(run.program), jsonNumber(run.LB),
+                         str(run.name), str(run.type), str(postproc::testprog::runKindName(run.kind)), str(run.program), jsonNumber(run.LB),
                          um(run.spanBefore()), um(run.spanAfter()),
                          list(run.passes.size(), [&](size_t k) { return pass(run.passes[k]); }), i + 1 < r.runs.size() ? "," : "");
     }

@@ -13,6 +13,8 @@
 #include "postproc/testprog/test_program.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 std::vector<controllers::OutputFile> readFolder(const std::string& dir) {
     namespace fs = std::filesystem;
@@ -78,11 +80,11 @@ std::vector<controllers::Coverage> readCompensated(const std::vector<controllers
 
 namespace {
 
-std::optional<pp::Dialect> dialectOfExtension(std::string ext) {
+std::optional<postproc::Dialect> dialectOfExtension(std::string ext) {
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    for (auto d : {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
-                   pp::Dialect::Heidenhain})
-        if (ext == pp::testprog::programExtension(d)) return d;
+    for (auto d : {postproc::Dialect::Rs274ngc, postproc::Dialect::Fanuc, postproc::Dialect::Sinumerik,
+                   postproc::Dialect::Heidenhain})
+        if (ext == postproc::testprog::programExtension(d)) return d;
     return std::nullopt;
 }
 
@@ -119,11 +121,11 @@ LoadedCompensation loadCompensation(const MachineModel& m, const MeasurementPlan
         return out;
     }
     // Corrected test programs: TP<nn>_<run>.<ext>, one per run.
-    const std::vector<pp::testprog::RunMotion> motions = pp::testprog::planMotions(m, plan);
+    const std::vector<postproc::testprog::RunMotion> motions = postproc::testprog::planMotions(m, plan);
     std::vector<std::string> missing;
-    std::optional<pp::Dialect> dialect;
+    std::optional<postproc::Dialect> dialect;
     for (size_t i = 0; i < motions.size(); ++i) {
-        const std::string stem = pp::testprog::programFileName(motions[i].name, static_cast<int>(i) + 1, pp::Dialect::Rs274ngc);
+        const std::string stem = postproc::testprog::programFileName(motions[i].name, static_cast<int>(i) + 1, postproc::Dialect::Rs274ngc);
         const std::string base = stem.substr(0, stem.rfind('.'));
         const controllers::OutputFile* found = nullptr;
         for (const auto& f : files)

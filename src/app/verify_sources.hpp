@@ -20,7 +20,7 @@ struct LoadedCompensation {
 
 /// `controller`: a backend name to use instead of recognising one ("" = recognise). Throws InputError naming the path
 /// when it is neither a deviation CSV, a controller folder nor a folder with every run's corrected program.
-LoadedCompensation loadCompensation(const MachineModel& machine, const MeasurementPlan& plan, const std::string& path,
+LoadedCompensation loadCompensation(const MachineModel& machine, const measurement::MeasurementPlan& plan, const std::string& path,
                                     const std::string& controller = "");
 
 /// The NOT-compensated list of a header comment (controllers/common/header.hpp layout: a line "NOT compensated:" then

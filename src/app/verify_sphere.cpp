@@ -11,6 +11,8 @@
 #include "postproc/testprog/read_back.hpp"
 
 namespace cnccomp::app {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 namespace {
 
 /// Parameter t in [0, 1] where the stylus, driven to drive(t), is `radius` from `sphere`.
@@ -32,13 +34,13 @@ double componentSpan(const std::vector<Vec3>& d) {
 }  // namespace
 
 std::vector<VerifyRun> verifySphereRuns(const MachineModel& m, const MeasurementPlan& plan, const Kinematics& k,
-                                        const controllers::AppliedCompensation& model, pp::Dialect dialect) {
-    pp::testprog::ProbeProgramOptions po;
+                                        const controllers::AppliedCompensation& model, postproc::Dialect dialect) {
+    postproc::testprog::ProbeProgramOptions po;
     po.dialect = dialect;
-    const pp::testprog::ProbeProgram prog = pp::testprog::makeProbeProgram(m, plan, po);
+    const postproc::testprog::ProbeProgram prog = postproc::testprog::makeProbeProgram(m, plan, po);
     // The probing targets as written, read back by cnccomp's reader.
     const std::vector<AxisVector> targets =
-        pp::testprog::readProbeTargets(m, prog.files[0].text, dialect, prog.files[0].file);
+        postproc::testprog::readProbeTargets(m, prog.files[0].text, dialect, prog.files[0].file);
     if (targets.size() != prog.targets.size())
         throw ModelError(fmt::format("verify: the probing program reads back {} probing moves, the plan has {}", targets.size(),
                                      prog.targets.size()));
@@ -73,7 +75,7 @@ std::vector<VerifyRun> verifySphereRuns(const MachineModel& m, const Measurement
         }
         VerifyRun vr;
         vr.name = run.name;
-        vr.kind = pp::testprog::RunKind::Rtest;
+        vr.kind = postproc::testprog::RunKind::Rtest;
         vr.type = "sphere probing (centre spread)";
         vr.program = prog.files[0].file;
         VerifyPass p;

@@ -10,7 +10,7 @@ namespace cnccomp::app {
 /// One VerifyRun per sphere run: one pass "poses", displacement = each pose's centre minus the mean centre (table
 /// frame), span = largest span of a component (as the R-test's displacements). `model` null = no compensation after.
 /// Throws ModelError naming the pose and touch when a probing move misses the sphere.
-std::vector<VerifyRun> verifySphereRuns(const MachineModel& machine, const MeasurementPlan& plan, const Kinematics& simulated,
-                                        const controllers::AppliedCompensation& model, pp::Dialect dialect);
+std::vector<VerifyRun> verifySphereRuns(const MachineModel& machine, const measurement::MeasurementPlan& plan, const Kinematics& simulated,
+                                        const controllers::AppliedCompensation& model, postproc::Dialect dialect);
 
 }  // namespace cnccomp::app

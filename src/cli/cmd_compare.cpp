@@ -13,6 +13,7 @@
 #include "cnccomp/io/machine_xml.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
 namespace {
 
 struct Options {

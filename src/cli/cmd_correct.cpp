@@ -18,6 +18,7 @@
 #include "postproc/correct_program.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
 namespace {
 
 struct Options {
@@ -32,16 +33,16 @@ struct Options {
 
 int mCodeOption(const std::string& text, const char* option) {
     if (text.empty()) return -1;
-    const auto m = pp::parseMCode(text);
+    const auto m = postproc::parseMCode(text);
     if (!m) throw InputError(option, 0, fmt::format("expected an M code such as M428, got '{}'", text));
     return *m;
 }
 
 /// Builds the setup from --setup, --tool-table, --work-offset, --tool-length, --units.
-pp::Setup setupOf(const std::string& file, const std::string& toolTable, const std::vector<std::string>& offsets,
+postproc::Setup setupOf(const std::string& file, const std::string& toolTable, const std::vector<std::string>& offsets,
                   const std::vector<std::string>& lengths, const std::vector<std::string>& assume,
                   const std::string& units) {
-    pp::Setup s;
+    postproc::Setup s;
     if (!file.empty()) s.readFile(file);
     if (!toolTable.empty()) s.readToolTable(toolTable);
     for (const auto& a : assume) s.addAssumed(a);
@@ -53,13 +54,13 @@ pp::Setup setupOf(const std::string& file, const std::string& toolTable, const s
     return s;
 }
 
-std::optional<pp::Dialect> dialectOf(const std::string& name) {
+std::optional<postproc::Dialect> dialectOf(const std::string& name) {
     if (name == "auto") return std::nullopt;
     // HEIDENHAIN Klartext is also detected from BEGIN PGM.
-    const auto d = pp::parseDialect(name, pp::DialectUse::Correct);
+    const auto d = postproc::parseDialect(name, postproc::DialectUse::Correct);
     if (!d)
         throw InputError("--dialect", 0,
-                         fmt::format("unknown dialect '{}' (auto, {})", name, pp::dialectNames(pp::DialectUse::Correct)));
+                         fmt::format("unknown dialect '{}' (auto, {})", name, postproc::dialectNames(postproc::DialectUse::Correct)));
     return d;
 }
 
@@ -77,7 +78,7 @@ void run(const Options& o) {
         throw InputError("--tol-um", 0, "the tolerance must be a positive number of um");
     if (o.decimals < -1 || o.decimals > 12) throw InputError("--decimals", 0, "decimals must be 0..12");
     if (o.threads < 0 || o.threads > 256) throw InputError("--threads", 0, "threads must be 0 (the machine's cores) .. 256");
-    pp::CorrectOptions co;
+    postproc::CorrectOptions co;
     co.dialect = dialectOf(o.dialect);
     co.setup = setupOf(o.setup, o.toolTable, o.workOffsets, o.toolLengths, o.assume, o.units);
     co.tcpOnM = mCodeOption(o.tcpOn, "--tcp-on");
@@ -110,13 +111,13 @@ void run(const Options& o) {
         report->stream() << "line,kind,message\n";
         co.report = &report->stream();
     }
-    pp::CorrectSummary summary;
+    postproc::CorrectSummary summary;
     // A correction that does not converge (an end point the solver cannot reach, a move still over the tolerance at
     // the subdivision limit) is a failure: nothing is written unless --keep-partial asks for the partial program.
     bool failed = false;
     try {
         AtomicFile out(o.out);
-        summary = pp::correctProgram(m, d, in, out.stream(), co);
+        summary = postproc::correctProgram(m, d, in, out.stream(), co);
         failed = summary.unconverged + summary.limited > 0;
         if (!failed || o.keepPartial) {
             out.commit();
@@ -131,7 +132,7 @@ void run(const Options& o) {
     fmt::print("{} {} for '{}' ({} deviations{}) -> {}\n", written ? "corrected" : "NOT corrected", o.in, m.name,
                std::count(d.present.begin(), d.present.end(), 1), d.values.cwiseAbs().maxCoeff() == 0 ? ", all zero" : "",
                written ? o.out : std::string("nothing written"));
-    fmt::print("{}", pp::formatSummary(summary));
+    fmt::print("{}", postproc::formatSummary(summary));
     if (failed) {
         fmt::print(stderr, "cnccomp: the correction did not converge: {} end point(s) not converged, {} move(s) over the "
                            "tolerance at the subdivision limit; {}; exit status 3\n",

@@ -23,6 +23,8 @@
 #include "controllers/common/header.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Options {
@@ -35,12 +37,12 @@ struct Options {
 /// Where the values are fitted (controllers/common/fit.hpp): the plan's workspace (the grid `cnccomp verify` takes its
 /// volumetric figure over) and a grid over the machine's travel, at the tool lengths given (default 0 and 100 mm and
 /// the plan's own).
-controllers::FitWorkspace fitWorkspace(const MachineModel& m, const MeasurementPlan* plan, const Options& o) {
+controllers::common::FitWorkspace fitWorkspace(const MachineModel& m, const MeasurementPlan* plan, const Options& o) {
     if (o.fitGrid < 1 || o.fitGrid > 12) throw ModelError(fmt::format("--fit-grid {}: expected 1 to 12 samples per axis", o.fitGrid));
     for (double L : o.fitToolLengths)
         if (!std::isfinite(L) || L < 0 || L > 2000)
             throw ModelError(fmt::format("--fit-tool-lengths: {:g} is not a tool length (0 to 2000 mm)", L));
-    controllers::FitWorkspace w;
+    controllers::common::FitWorkspace w;
     std::vector<double> lengths = o.fitToolLengths.empty() ? std::vector<double>{0.0, 100.0} : o.fitToolLengths;
     std::string what;
     if (plan) {
@@ -54,7 +56,7 @@ controllers::FitWorkspace fitWorkspace(const MachineModel& m, const MeasurementP
         what = fmt::format("plan {}: {} per axis over the commands of its runs + ", std::filesystem::path(o.plan).filename().string(),
                            o.fitGrid);
     }
-    const std::vector<AxisVector> travel = controllers::workspaceSamples(m, o.fitGrid);
+    const std::vector<AxisVector> travel = controllers::common::workspaceSamples(m, o.fitGrid);
     w.poses.insert(w.poses.end(), travel.begin(), travel.end());
     w.toolLengths = lengths;
     w.description = fmt::format("{}{} per axis over the travel (linear axes within +-200 mm) = {} poses, tool lengths", what,
@@ -91,17 +93,17 @@ void warnIfWorse(bool spanWorse, bool volumetricWorse, bool rtest) {
 }
 
 bool beyondTolerance(double after, double before) {
-    return after > before + std::max(controllers::kFitTolerance.absolute, controllers::kFitTolerance.relative * before);
+    return after > before + std::max(controllers::common::kFitTolerance.absolute, controllers::common::kFitTolerance.relative * before);
 }
 
 /// The three candidates side by side, and the prediction for the files written.
-void predict(const controllers::Backend& b, const MachineModel& m, const DeviationSet& d, const controllers::FitWorkspace& w,
-             const controllers::FitOutcome& fit, bool fitted, const controllers::EmitResult& written, const MeasurementPlan* plan,
+void predict(const controllers::Backend& b, const MachineModel& m, const DeviationSet& d, const controllers::common::FitWorkspace& w,
+             const controllers::common::FitOutcome& fit, bool fitted, const controllers::EmitResult& written, const MeasurementPlan* plan,
              const Options& o) {
     try {
         struct Row {
             const char* name;
-            const controllers::FitFigures* f;
+            const controllers::common::FitFigures* f;
             const DeviationSet* values;
         };
         DeviationSet zero = d;
@@ -119,11 +121,11 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                 // The candidates' spans only (their volumetric figure is the fit's own, above): one volumetric point.
                 const app::VerifyResult v = verifyFiles(b, m, *plan, d, b.emit(req), rows[i].name, 1);
                 spans[static_cast<size_t>(i)] = v.residual;
-                for (const app::VerifyRun& run : v.runs) rtest = rtest || run.kind == pp::testprog::RunKind::Rtest;
+                for (const app::VerifyRun& run : v.runs) rtest = rtest || run.kind == postproc::testprog::RunKind::Rtest;
             }
         }
         const std::string spanName = rtest ? "largest R-test displacement (um)" : "largest span (um)";
-        fmt::print("predictions on the identified machine over the fit workspace ({}):\n", controllers::judgedWorkspace(m, w).description);
+        fmt::print("predictions on the identified machine over the fit workspace ({}):\n", controllers::common::judgedWorkspace(m, w).description);
         fmt::print("  {:<26} {:>28}{}\n", "candidate", "tool tip max / RMS (um)", plan ? fmt::format("  {:>34}", spanName) : "");
         for (int i = 0; i < 3; ++i) {
             if (i == 2 && (!fitted || sampled)) {
@@ -135,7 +137,7 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
             fmt::print("  {:<26} {:>28}{}\n", rows[i].name, tip, plan ? fmt::format("  {:>34.3f}", spans[static_cast<size_t>(i)] / kUm) : "");
         }
         const bool chosenFitted = fitted && fit.chosen == "fitted";
-        const controllers::FitFigures& chosen = !fitted ? fit.copied : fit.chosen == "none" ? fit.none : fit.chosen == "identified" ? fit.copied : fit.fitted;
+        const controllers::common::FitFigures& chosen = !fitted ? fit.copied : fit.chosen == "none" ? fit.none : fit.chosen == "identified" ? fit.copied : fit.fitted;
         fmt::print("written: {}\n", !fitted                       ? "the identified values copied (--copy-identified)"
                                      : chosenFitted                 ? (fit.heldValues < 0 ? "the fitted values (= the identified values: "
                                                                                             "the controller holds them all)"
@@ -150,14 +152,14 @@ void predict(const controllers::Backend& b, const MachineModel& m, const Deviati
                        "volumetric max {:.3f} -> {:.3f} um\n",
                        std::filesystem::path(o.plan).filename().string(), v.residual / kUm, v.residualBefore / kUm,
                        v.volumetric.maxBefore / kUm, v.volumetric.maxAfter / kUm);
-            warnIfWorse(beyondTolerance(v.residual, v.residualBefore), controllers::leavesMore(chosen, fit.none), rtest);
+            warnIfWorse(beyondTolerance(v.residual, v.residualBefore), controllers::common::leavesMore(chosen, fit.none), rtest);
             return;
         }
         fmt::print("predicted tool-tip error on the identified machine over the travel and fit workspace ({} poses x {} tool lengths; "
                    "give --plan for the ball-bar residual): max {:.3f} -> {:.3f} um, RMS {:.3f} -> {:.3f} um\n",
                    w.poses.size(), w.toolLengths.size(), fit.none.maxTip / kUm, chosen.maxTip / kUm, fit.none.rmsTip / kUm,
                    chosen.rmsTip / kUm);
-        warnIfWorse(false, controllers::leavesMore(chosen, fit.none), false);
+        warnIfWorse(false, controllers::common::leavesMore(chosen, fit.none), false);
     } catch (const std::exception& e) {
         fmt::print("predicted residual: not available ({})\n", e.what());
     }
@@ -177,17 +179,17 @@ void run(const Options& o) {
     const std::string date = o.date.empty() ? today() : o.date;
     std::optional<MeasurementPlan> plan;
     if (!o.plan.empty()) plan = readPlanXml(o.plan);
-    const controllers::FitWorkspace w = fitWorkspace(m, plan ? &*plan : nullptr, o);
+    const controllers::common::FitWorkspace w = fitWorkspace(m, plan ? &*plan : nullptr, o);
     // The values written: fitted to what this controller holds (controllers/common/fit.hpp), or with --copy-identified
     // the identified values as they are (the files of earlier versions, byte for byte).
-    controllers::FitOutcome fit{d, "identified", {}, {}, {}, {}, {}, -1};
+    controllers::common::FitOutcome fit{d, "identified", {}, {}, {}, {}, {}, -1};
     if (o.copyIdentified) {
         DeviationSet zero = d;
         zero.values.setZero();
-        fit.none = controllers::fitFigures(b, m, d, zero, w);
-        fit.copied = controllers::fitFigures(b, m, d, d, w);
+        fit.none = controllers::common::fitFigures(b, m, d, zero, w);
+        fit.copied = controllers::common::fitFigures(b, m, d, d, w);
     } else {
-        fit = controllers::fitControllerValues(b, m, d, w);
+        fit = controllers::common::fitControllerValues(b, m, d, w);
     }
     controllers::EmitRequest req{m, fit.written, std::filesystem::path(o.deviations).filename().string(), date};
     if (!o.copyIdentified) {
@@ -195,7 +197,7 @@ void run(const Options& o) {
         req.headerNotes = fit.notes;
     }
     controllers::EmitResult r = b.emit(req);
-    for (controllers::Coverage& c : controllers::reversalsNotHeld(req, r.compensated))
+    for (controllers::Coverage& c : controllers::common::reversalsNotHeld(req, r.compensated))
         if (std::none_of(r.notCompensated.begin(), r.notCompensated.end(),
                          [&](const controllers::Coverage& n) { return n.deviation == c.deviation; }))
             r.notCompensated.push_back(std::move(c));
@@ -207,7 +209,7 @@ void run(const Options& o) {
     fmt::print("{} compensation for '{}' from {} ({} files in {})\n", b.name(), m.name, o.deviations, r.files.size(), o.out);
     for (const controllers::OutputFile& f : r.files) fmt::print("  {}\n", f.name);
     for (const std::string& l : r.summary) fmt::print("{}\n", l);
-    fmt::print("{}", controllers::formatCoverage(r));
+    fmt::print("{}", controllers::common::formatCoverage(r));
     predict(b, m, d, w, fit, !o.copyIdentified, r, plan ? &*plan : nullptr, o);
 }
 

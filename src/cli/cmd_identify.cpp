@@ -24,6 +24,9 @@
 #include "app/report/linear_circle_report.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Options {

@@ -26,6 +26,7 @@
 #include "controllers/siemens/laser_eec.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
 namespace {
 
 struct Options {

@@ -14,6 +14,7 @@
 #include "cnccomp/volumetric_map.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
 namespace {
 
 struct Options {

@@ -12,6 +12,8 @@
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
 namespace {
 
 struct Options {

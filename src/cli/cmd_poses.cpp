@@ -12,6 +12,7 @@
 #include "postproc/poses.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
 namespace {
 
 struct Options {
@@ -22,17 +23,17 @@ struct Options {
 
 void run(const Options& o) {
     if (!o.out.empty()) checkOutputPath(o.out);  // a folder or a device as --out fails before any work
-    pp::PosesOptions po;
+    postproc::PosesOptions po;
     if (o.dialect != "auto") {
-        po.dialect = pp::parseDialect(o.dialect);
+        po.dialect = postproc::parseDialect(o.dialect);
         if (!po.dialect)
-            throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, {})", o.dialect, pp::dialectNames(pp::DialectUse::Read)));
+            throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' (auto, {})", o.dialect, postproc::dialectNames(postproc::DialectUse::Read)));
     }
     if (!o.setup.empty()) po.setup.readFile(o.setup);
     if (!o.toolTable.empty()) po.setup.readToolTable(o.toolTable);
     for (const auto& [text, name, target] : {std::tuple{&o.tcpOn, "--tcp-on", &po.tcpOnM}, std::tuple{&o.tcpOff, "--tcp-off", &po.tcpOffM}}) {
         if (text->empty()) continue;
-        const auto m = pp::parseMCode(*text);
+        const auto m = postproc::parseMCode(*text);
         if (!m) throw InputError(name, 0, fmt::format("expected an M code such as M428, got '{}'", *text));
         *target = *m;
     }
@@ -45,16 +46,16 @@ void run(const Options& o) {
     po.inputName = o.in;
     std::optional<MachineModel> m;
     if (!o.machine.empty()) m = readMachineXml(o.machine);
-    const pp::AxisLayout layout = m ? pp::AxisLayout::fromMachine(*m) : pp::AxisLayout::generic();
+    const postproc::AxisLayout layout = m ? postproc::AxisLayout::fromMachine(*m) : postproc::AxisLayout::generic();
     std::ifstream in(o.in, std::ios::binary);
     if (!in) throw InputError(o.in, 0, "cannot open the program");
     if (o.out.empty()) {
-        pp::writePoses(layout, in, std::cout, po);
+        postproc::writePoses(layout, in, std::cout, po);
         std::cout.flush();
         return;
     }
     refuseToOverwrite(o.out, {o.in, o.machine, o.setup});
-    writeFileAtomically(o.out, [&](std::ostream& out) { pp::writePoses(layout, in, out, po); });
+    writeFileAtomically(o.out, [&](std::ostream& out) { postproc::writePoses(layout, in, out, po); });
 }
 
 const RegisterCommand reg([](CLI::App& app) {

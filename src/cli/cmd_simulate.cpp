@@ -31,6 +31,9 @@
 #include "cnccomp/io/probe_log.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Options {

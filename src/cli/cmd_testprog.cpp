@@ -12,16 +12,18 @@
 #include "postproc/testprog/test_program.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Options {
     std::string machine, plan, dialect = "linuxcnc", out, probeLog = "cnccomp-probe.txt";
-    pp::testprog::TestProgramOptions program;
+    postproc::testprog::TestProgramOptions program;
 };
 
 void run(Options o) {
-    const auto d = pp::parseDialect(o.dialect, pp::DialectUse::Write);
-    if (!d) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' ({})", o.dialect, pp::dialectNames(pp::DialectUse::Write)));
+    const auto d = postproc::parseDialect(o.dialect, postproc::DialectUse::Write);
+    if (!d) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' ({})", o.dialect, postproc::dialectNames(postproc::DialectUse::Write)));
     o.program.dialect = *d;
     const MachineModel m = readMachineXml(o.machine);
     const MeasurementPlan plan = readPlanXml(o.plan);
@@ -30,31 +32,31 @@ void run(Options o) {
     if (!plan.sphereRuns.empty()) {
         if (plan.runCount() != plan.sphereRuns.size())
             throw ModelError("the plan has sphere runs and other runs: put the <sphere> runs in a plan of their own");
-        pp::testprog::ProbeProgramOptions po;
+        postproc::testprog::ProbeProgramOptions po;
         po.dialect = *d;
         po.log = o.probeLog;
         po.decimals = o.program.decimals;
         po.machineFile = o.program.machineFile;
         po.planFile = o.program.planFile;
-        const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(m, plan, po);
+        const postproc::testprog::ProbeProgram p = postproc::testprog::makeProbeProgram(m, plan, po);
         OutputSet staged({o.machine, o.plan});
         staged.makeFolder(o.out);
-        for (const pp::testprog::ProbeProgramFile& f : p.files) {
+        for (const postproc::testprog::ProbeProgramFile& f : p.files) {
             const std::string text = f.text;
             staged.add(OutputSet::fileIn(o.out, f.file, o.plan), [text](std::ostream& s) { s << text; });
         }
         staged.commit();
         fmt::print("probing program for '{}' ({}) in {}: {} poses, {} touches; it writes {}\n", m.name, o.dialect, o.out,
                    p.poses, p.touches, o.probeLog);
-        for (const pp::testprog::ProbeProgramFile& f : p.files) fmt::print("  {}\n", f.file);
+        for (const postproc::testprog::ProbeProgramFile& f : p.files) fmt::print("  {}\n", f.file);
         return;
     }
     if (o.probeLog != "cnccomp-probe.txt") throw ModelError("--probe-log applies to plans with sphere runs");
-    const pp::testprog::TestProgramSet set = pp::testprog::makeTestPrograms(m, plan, o.program);
-    pp::testprog::writeTestPrograms(set, o.out, {o.machine, o.plan});
+    const postproc::testprog::TestProgramSet set = postproc::testprog::makeTestPrograms(m, plan, o.program);
+    postproc::testprog::writeTestPrograms(set, o.out, {o.machine, o.plan});
     fmt::print("{} test programs for '{}' ({}) in {}:\n", set.programs.size(), m.name, o.dialect, o.out);
-    for (const pp::testprog::TestProgram& p : set.programs)
-        fmt::print("  {:<40} {:<18} {:<18} {:>6} samples, first {}, {}{}\n", p.file, p.run, pp::testprog::runKindName(p.kind),
+    for (const postproc::testprog::TestProgram& p : set.programs)
+        fmt::print("  {:<40} {:<18} {:<18} {:>6} samples, first {}, {}{}\n", p.file, p.run, postproc::testprog::runKindName(p.kind),
                    p.samples, p.firstPass, p.arcs ? "circular blocks" : "straight blocks",
                    p.overshootStart < o.program.overshootDeg || p.overshootEnd < o.program.overshootDeg
                        ? fmt::format(", overshoot {:g}/{:g} deg", p.overshootStart, p.overshootEnd)

@@ -25,6 +25,8 @@
 #include "app/verify_sources.hpp"
 
 namespace cnccomp::cli {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Options {
@@ -91,8 +93,8 @@ void run(const Options& o) {
     const MeasurementPlan plan = readPlanXml(o.plan);
     const std::string source = !o.compensation.empty() ? o.compensation : o.identified;
     if (source.empty()) throw InputError("--compensation", 0, "give the compensation to verify (deviation CSV or folder)");
-    const auto dialect = pp::parseDialect(o.dialect, pp::DialectUse::Write);
-    if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' ({})", o.dialect, pp::dialectNames(pp::DialectUse::Write)));
+    const auto dialect = postproc::parseDialect(o.dialect, postproc::DialectUse::Write);
+    if (!dialect) throw InputError("--dialect", 0, fmt::format("unknown dialect '{}' ({})", o.dialect, postproc::dialectNames(postproc::DialectUse::Write)));
     if (o.maxResidualUm && !(*o.maxResidualUm >= 0)) throw InputError("--max-residual-um", 0, "expected a number >= 0");
     if (o.maxVolumetricUm && !(*o.maxVolumetricUm >= 0)) throw InputError("--max-volumetric-um", 0, "expected a number >= 0");
     namespace fs = std::filesystem;

@@ -11,6 +11,7 @@
 #include "cnccomp/measurement/sweep.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::measurement;
 
 namespace {
 struct TestInfo {

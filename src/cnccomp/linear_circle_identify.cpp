@@ -14,6 +14,8 @@
 #include "cnccomp/kinematics.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_identify_detail {

@@ -48,7 +48,7 @@ struct LinearCircleRunResult {
     LinearCircleFit fit;
     CircularRunResult iso;                    ///< ISO 230-4 figures of the passes as measured
     std::vector<std::vector<double>> after;   ///< per pass: ΔL with the identified diagnostics removed, mm
-    TraceImportSummary summary;
+    io::TraceImportSummary summary;
 };
 
 /// A deviation of the set written from the circles.
@@ -89,7 +89,7 @@ LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& machine,
 /// The same on the runs' files already read (PlanMeasurements::circles, io/plan_measurements_io.hpp: each run validated
 /// and its commands checked against the machine before its file was read), one per run in order.
 LinearCircleIdentification identifyLinearCircleRuns(const MachineModel& machine, const std::vector<LinearCircleRun>& runs,
-                                                    const std::vector<LinearCircleTrace>& files,
+                                                    const std::vector<io::LinearCircleTrace>& files,
                                                     const LinearCircleSettings& settings = {});
 
 }  // namespace cnccomp

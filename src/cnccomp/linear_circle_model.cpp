@@ -14,6 +14,7 @@
 #include "cnccomp/identification/levenberg_marquardt.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
 
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_detail {

@@ -8,6 +8,7 @@
 #include "cnccomp/io/text_util.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 
 long MapGrid::size() const {
     long n = 1;

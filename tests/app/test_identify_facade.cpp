@@ -17,6 +17,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const std::string kPlan = test::sourcePath("samples/plans/multitasking-six-circles.xml");

@@ -25,6 +25,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 namespace fs = std::filesystem;
 using test::chromium, test::colourNear, test::countColour, test::near, test::readPng, test::rgb, test::screenshot;

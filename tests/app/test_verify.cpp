@@ -22,6 +22,9 @@
 #include "cnccomp/identification/dbb5_run.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Sample {

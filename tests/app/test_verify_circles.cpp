@@ -22,6 +22,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 using namespace app;  // verification (src/app)
 namespace {
 
@@ -82,7 +84,7 @@ TEST(VerifyCircles, TheIdealCompensationOfTheSquarenessLeavesTheCirclesOfTheMach
     EXPECT_FALSE(r.worse.any());
     EXPECT_LT(r.volumetric.maxAfter, r.volumetric.maxBefore);
     // The programs of the other dialects (G2/G3 of Fanuc and Sinumerik, Klartext CC / C) read back to the same circles.
-    for (const auto d : {pp::Dialect::Fanuc, pp::Dialect::Sinumerik, pp::Dialect::Heidenhain}) {
+    for (const auto d : {postproc::Dialect::Fanuc, postproc::Dialect::Sinumerik, postproc::Dialect::Heidenhain}) {
         app::VerifyOptions od = o;
         od.dialect = d;
         const app::VerifyResult rd = app::verify(m, plan, truth, "truth", comp, od);

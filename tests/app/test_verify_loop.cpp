@@ -25,6 +25,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Case {
@@ -187,7 +190,7 @@ double lever(const Loop& l, int axis) {
     if (l.machine.axisLink(axis).kind != AxisKind::Rotary) return 1.0;
     const Kinematics k(l.machine);
     double out = 0;
-    for (const pp::testprog::RunMotion& r : pp::testprog::planMotions(l.machine, l.plan))
+    for (const postproc::testprog::RunMotion& r : postproc::testprog::planMotions(l.machine, l.plan))
         for (size_t i = 0; i < r.sampleCount; ++i) {
             const AxisVector q = r.at(r.points[i]);
             const Vec3 tip = k.baseToTool(q) * k.toolPoint(r.toolLength);
@@ -309,36 +312,36 @@ TEST(VerifyLoop, CorrectedTestProgramsLeaveLessThanATenthOfAMicrometre) {
     for (const Case& c : kCases) {
         const Loop l = load(c);
         const DeviationSet identified = c.correctWithTruth ? *l.truth : simulateAndIdentify(l, 0.0);
-        for (const auto& [dialect, reader] : {std::pair{pp::Dialect::Rs274ngc, pp::Dialect::Rs274ngc},
-                                              std::pair{pp::Dialect::Heidenhain, pp::Dialect::Heidenhain}}) {
+        for (const auto& [dialect, reader] : {std::pair{postproc::Dialect::Rs274ngc, postproc::Dialect::Rs274ngc},
+                                              std::pair{postproc::Dialect::Heidenhain, postproc::Dialect::Heidenhain}}) {
             // testprog → cnccomp correct (with the run's tool length, as each program's header says) → verify.
-            const auto motions = pp::testprog::planMotions(l.machine, l.plan);
-            pp::testprog::TestProgramOptions to;
+            const auto motions = postproc::testprog::planMotions(l.machine, l.plan);
+            postproc::testprog::TestProgramOptions to;
             to.dialect = dialect;
-            const auto set = pp::testprog::makeTestPrograms(l.machine, l.plan, to);
+            const auto set = postproc::testprog::makeTestPrograms(l.machine, l.plan, to);
             app::VerifyCompensation comp;
             comp.kind = app::VerifyCompensation::Kind::CorrectedPrograms;
             comp.description = "corrected programs";
             comp.programDialect = reader;
             uint64_t split = 0;
             for (size_t i = 0; i < motions.size(); ++i) {
-                pp::CorrectOptions co;
+                postproc::CorrectOptions co;
                 co.dialect = reader;
                 co.setup.defaultToolLength = motions[i].toolLength;
                 std::istringstream in(set.programs[i].text);
                 std::ostringstream out;
-                const pp::CorrectSummary s = pp::correctProgram(l.machine, identified, in, out, co);
+                const postproc::CorrectSummary s = postproc::correctProgram(l.machine, identified, in, out, co);
                 EXPECT_EQ(s.unconverged, 0u) << c.machine << " " << motions[i].name;
                 EXPECT_GT(s.corrected, 0u);
                 split += s.split;
                 comp.programs.push_back({motions[i].name, {set.programs[i].file, out.str()}});
             }
             const app::VerifyResult r = app::verify(l.machine, l.plan, *l.truth, "truth", comp, fastOptions());
-            std::cout << "[ corrected ] " << c.machine << " " << pp::dialectName(reader)
+            std::cout << "[ corrected ] " << c.machine << " " << postproc::dialectName(reader)
                       << (c.machineZero.empty() ? "" : " (machine-zero)") << (c.correctWithTruth ? " (truth set)" : "")
                       << ": " << r.residual / kUm << " um (before " << r.residualBefore / kUm << " um), " << split
                       << " moves split\n";
-            EXPECT_LT(r.residual, 0.1 * kUm) << c.machine << " " << pp::dialectName(reader) << ": before "
+            EXPECT_LT(r.residual, 0.1 * kUm) << c.machine << " " << postproc::dialectName(reader) << ": before "
                                              << r.residualBefore / kUm << " um";
             EXPECT_GT(r.residualBefore, 1.0 * kUm) << c.machine;
             EXPECT_FALSE(r.volumetric.available);

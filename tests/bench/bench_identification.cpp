@@ -15,6 +15,9 @@
 #include "cnccomp/io/plan_xml.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct Fixture {

@@ -11,6 +11,9 @@
 #include "cnccomp/io/plan_xml.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 std::string sample(const std::string& rel) { return std::string(CNCCOMP_SOURCE_DIR) + "/samples/" + rel; }

@@ -23,6 +23,7 @@
 namespace {
 
 using namespace cnccomp;
+using namespace cnccomp::io;
 
 struct Fixture {
     MachineModel m = readMachineXml(std::string(CNCCOMP_SOURCE_DIR) + "/samples/machines/multitasking.xml");

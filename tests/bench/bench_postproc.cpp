@@ -25,6 +25,7 @@
 namespace {
 
 using namespace cnccomp;
+using namespace cnccomp::io;
 
 constexpr int kLines = 1'000'000;
 
@@ -78,14 +79,14 @@ protected:
 
 /// Corrects the program at `path` once per iteration into a counting sink; lines/s, bytes/s and what was done.
 void measure(benchmark::State& state, const MachineModel& m, const DeviationSet& d, const std::string& path,
-             const pp::CorrectOptions& o) {
+             const postproc::CorrectOptions& o) {
     const auto bytes = std::filesystem::file_size(path);
-    pp::CorrectSummary s;
+    postproc::CorrectSummary s;
     for (auto _ : state) {
         std::ifstream in(path, std::ios::binary);
         CountingBuf sink;
         std::ostream out(&sink);
-        s = pp::correctProgram(m, d, in, out, o);
+        s = postproc::correctProgram(m, d, in, out, o);
         benchmark::DoNotOptimize(sink.bytes);
     }
     state.counters["lines/s"] = benchmark::Counter(double(s.lines) * state.iterations(), benchmark::Counter::kIsRate);
@@ -101,8 +102,8 @@ void run(benchmark::State& state, bool identity) {
     static const DeviationSet truth =
         readDeviationCsv(std::string(CNCCOMP_SOURCE_DIR) + "/samples/deviations/multitasking-truth.csv", m);
     const DeviationSet zero(m);
-    pp::CorrectOptions o;
-    o.dialect = pp::Dialect::Rs274ngc;
+    postproc::CorrectOptions o;
+    o.dialect = postproc::Dialect::Rs274ngc;
     o.setup.addToolLength("100");
     measure(state, m, identity ? zero : truth, programPath(), o);
 }
@@ -173,8 +174,8 @@ void runImpeller(benchmark::State& state, bool identity) {
     static const MachineModel m = readMachineXml(im.machine);
     static const DeviationSet truth = readDeviationCsv(im.deviations, m);
     const DeviationSet zero(m);
-    pp::CorrectOptions o;
-    o.dialect = pp::Dialect::Rs274ngc;
+    postproc::CorrectOptions o;
+    o.dialect = postproc::Dialect::Rs274ngc;
     o.setup.addToolLength("30");
     o.tcpOnM = 428;
     o.tcpOffM = 429;

@@ -14,6 +14,8 @@
 #include "cnccomp/io/trace_import.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 struct TraceFile {

@@ -13,6 +13,8 @@
 namespace {
 
 using namespace cnccomp;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 void BM_VerifySixRunPlan(benchmark::State& state, const std::string& backendName) {
     const std::string dir = CNCCOMP_SOURCE_DIR;

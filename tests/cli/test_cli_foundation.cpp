@@ -7,6 +7,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");

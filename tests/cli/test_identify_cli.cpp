@@ -13,6 +13,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");

@@ -24,6 +24,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const std::string kMachine = test::sourcePath("samples/machines/mill-3axis.xml");

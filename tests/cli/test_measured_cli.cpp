@@ -22,6 +22,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 namespace fs = std::filesystem;
 

@@ -11,6 +11,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp::controllers {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 namespace {
 
 /// An ideal controller: solves the exact erroneous model for the nominal pose (what perfect compensation does).

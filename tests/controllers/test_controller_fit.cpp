@@ -23,6 +23,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 std::string src(const std::string& rel) { return test::sourcePath(rel); }
@@ -41,21 +43,21 @@ const std::map<std::string, std::string> kSampleSets = {
     {"tilting-head-b", "tilting-head-b-truth.csv"},
 };
 
-controllers::FitWorkspace smallWorkspace(const MachineModel& m, int perAxis = 3) {
-    controllers::FitWorkspace w;
-    w.poses = controllers::workspaceSamples(m, perAxis);
+controllers::common::FitWorkspace smallWorkspace(const MachineModel& m, int perAxis = 3) {
+    controllers::common::FitWorkspace w;
+    w.poses = controllers::common::workspaceSamples(m, perAxis);
     w.toolLengths = {0.0, 100.0};
     w.description = fmt::format("{} per axis over the travel, tools 0 100 mm", perAxis);
     return w;
 }
 
 /// No compensation (drives get the commands) over the workspace: the reference every chosen file set must not exceed.
-controllers::FitFigures noCompensation(const MachineModel& m, const DeviationSet& d, const controllers::FitWorkspace& w) {
-    controllers::FitFigures f;
+controllers::common::FitFigures noCompensation(const MachineModel& m, const DeviationSet& d, const controllers::common::FitWorkspace& w) {
+    controllers::common::FitFigures f;
     double sum = 0;
     long n = 0;
     for (double L : w.toolLengths) {
-        const auto c = controllers::evaluateCompensation(m, d, controllers::NoCompensation{}, w.poses, L);
+        const auto c = controllers::common::evaluateCompensation(m, d, controllers::common::NoCompensation{}, w.poses, L);
         f.maxTip = std::max(f.maxTip, c.maxBefore);
         sum += c.rmsBefore * c.rmsBefore * c.points;
         n += c.points;
@@ -77,9 +79,9 @@ TEST_P(ChosenFiles, NeverLeaveMoreThanNoneWithAnyBackend) {
         const MachineModel& m = test::sampleMachine(stem);
         const DeviationSet d = readDeviationCsv(src("samples/deviations/" + set), m);
         // The travel's ends (2 per axis): the emits of the fit's Jacobian cost more than the poses.
-        const controllers::FitWorkspace w = smallWorkspace(m, 2);
+        const controllers::common::FitWorkspace w = smallWorkspace(m, 2);
         // No compensation over the poses the candidates are judged on (the grid and each axis' sweep, fit.hpp).
-        const controllers::FitFigures none = noCompensation(m, d, controllers::judgedWorkspace(m, w));
+        const controllers::common::FitFigures none = noCompensation(m, d, controllers::common::judgedWorkspace(m, w));
         for (const controllers::Backend* b : controllers::backends()) {
             try {
                 (void)b->emit(controllers::EmitRequest{m, d, "x", "2000-01-01"});
@@ -89,14 +91,14 @@ TEST_P(ChosenFiles, NeverLeaveMoreThanNoneWithAnyBackend) {
             }
             SCOPED_TRACE(fmt::format("{} / {}", stem, b->name()));
             const auto t0 = std::chrono::steady_clock::now();
-            const controllers::FitOutcome o = controllers::fitControllerValues(*b, m, d, w);
+            const controllers::common::FitOutcome o = controllers::common::fitControllerValues(*b, m, d, w);
             const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            const controllers::FitFigures chosen = controllers::fitFigures(*b, m, d, o.written, w);
-            EXPECT_FALSE(controllers::leavesMore(chosen, none))
+            const controllers::common::FitFigures chosen = controllers::common::fitFigures(*b, m, d, o.written, w);
+            EXPECT_FALSE(controllers::common::leavesMore(chosen, none))
                 << fmt::format("chosen '{}' leaves max {:.4f} RMS {:.4f} um; none {:.4f} / {:.4f}", o.chosen, chosen.maxTip / kUm,
                                chosen.rmsTip / kUm, none.maxTip / kUm, none.rmsTip / kUm);
             // The figures the fit reports for its choice are those of the files it writes.
-            const controllers::FitFigures& reported = o.chosen == "none" ? o.none : o.chosen == "identified" ? o.copied : o.fitted;
+            const controllers::common::FitFigures& reported = o.chosen == "none" ? o.none : o.chosen == "identified" ? o.copied : o.fitted;
             EXPECT_NEAR(reported.maxTip, chosen.maxTip, 1e-9);
             EXPECT_NEAR(reported.rmsTip, chosen.rmsTip, 1e-9);
             // The fit never does worse (RMS) than the copy or none where it is chosen.
@@ -130,7 +132,7 @@ TEST(ControllerFit, TheGenericMapIsNotFittedItsCopyIsJudged) {
     const controllers::Backend& b = controllers::backend("generic");
     EXPECT_FALSE(b.fitsDeviationValues());
     EXPECT_TRUE(controllers::backend("fanuc-30i").fitsDeviationValues());
-    const controllers::FitOutcome o = controllers::fitControllerValues(b, m, d, smallWorkspace(m, 2));
+    const controllers::common::FitOutcome o = controllers::common::fitControllerValues(b, m, d, smallWorkspace(m, 2));
     EXPECT_EQ(o.heldValues, -1);
     EXPECT_EQ(o.chosen, "identified");
     EXPECT_TRUE(o.written.values == d.values);
@@ -146,12 +148,12 @@ TEST(ControllerFit, BackendsHoldingEveryDeviationWriteTheIdentifiedValues) {
     for (const std::string stem : {"multitasking", "table-table-ac", "tilting-head-b"}) {
         const MachineModel& m = test::sampleMachine(stem);
         const DeviationSet d = readDeviationCsv(src("samples/deviations/" + kSampleSets.at(stem)), m);
-        const controllers::FitWorkspace w = smallWorkspace(m);
+        const controllers::common::FitWorkspace w = smallWorkspace(m);
         for (const char* name : {"siemens-840d", "heidenhain-tnc", "isg", "generic"}) {
             SCOPED_TRACE(fmt::format("{} / {}", stem, name));
             const controllers::Backend& b = controllers::backend(name);
             if (!b.emit(controllers::EmitRequest{m, d, "x", "2000-01-01"}).notCompensated.empty()) continue;  // e.g. Siemens: EAB
-            const controllers::FitOutcome o = controllers::fitControllerValues(b, m, d, w);
+            const controllers::common::FitOutcome o = controllers::common::fitControllerValues(b, m, d, w);
             EXPECT_EQ(o.chosen, "fitted");
             ASSERT_EQ(o.written.values.size(), d.values.size());
             EXPECT_TRUE(o.written.values == d.values);
@@ -176,19 +178,19 @@ TEST(ControllerFit, FanucOnTheQuickstartMachineLeavesClearlyLessThanNone) {
     const DeviationSet d = readDeviationCsv(src("samples/deviations/multitasking-truth.csv"), m);
     const MeasurementPlan plan = readPlanXml(src("samples/plans/multitasking-six-circles-recorded.xml"));
     const app::PlanWorkspace p = app::planWorkspace(m, plan);
-    controllers::FitWorkspace w;
+    controllers::common::FitWorkspace w;
     w.poses = p.poses;
-    const auto travel = controllers::workspaceSamples(m, 5);
+    const auto travel = controllers::common::workspaceSamples(m, 5);
     w.poses.insert(w.poses.end(), travel.begin(), travel.end());
     w.toolLengths = {0.0, 100.0};
     for (double L : p.toolLengths)
         if (std::find(w.toolLengths.begin(), w.toolLengths.end(), L) == w.toolLengths.end()) w.toolLengths.push_back(L);
-    const controllers::FitOutcome o = controllers::fitControllerValues(controllers::backend("fanuc-30i"), m, d, w);
+    const controllers::common::FitOutcome o = controllers::common::fitControllerValues(controllers::backend("fanuc-30i"), m, d, w);
     std::printf("fanuc-30i on multitasking: none %.3f/%.3f  copied %.3f/%.3f  fitted %.3f/%.3f um (%d values)\n", o.none.maxTip / kUm,
                 o.none.rmsTip / kUm, o.copied.maxTip / kUm, o.copied.rmsTip / kUm, o.fitted.maxTip / kUm, o.fitted.rmsTip / kUm,
                 o.heldValues);
     EXPECT_EQ(o.chosen, "fitted");
-    EXPECT_TRUE(controllers::leavesMore(o.copied, o.none));  // the problem the issue reports
+    EXPECT_TRUE(controllers::common::leavesMore(o.copied, o.none));  // the problem the issue reports
     EXPECT_LT(o.fitted.maxTip, 0.85 * o.none.maxTip);
     EXPECT_LT(o.fitted.rmsTip, 0.75 * o.none.rmsTip);
     EXPECT_GT(o.heldValues, 0);
@@ -242,14 +244,14 @@ TEST(ControllerFit, EmitPrintsTheThreeCandidatesAndTheFitInEveryFileHeader) {
 
 TEST(ControllerFit, TheWarningHasATolerance) {
     // 1 % or 0.01 um, whichever is larger: equal figures (0.001 vs 0.001 um, 76.574 vs 76.574 um) and rounding never warn.
-    const auto fig = [](double maxUm, double rmsUm) { return controllers::FitFigures{maxUm * kUm, rmsUm * kUm, 0}; };
-    EXPECT_FALSE(controllers::leavesMore(fig(0.001, 0.001), fig(0.001, 0.001)));
-    EXPECT_FALSE(controllers::leavesMore(fig(76.574, 30), fig(76.574, 30)));
-    EXPECT_FALSE(controllers::leavesMore(fig(0.009, 0.009), fig(0.0, 0.0)));
-    EXPECT_TRUE(controllers::leavesMore(fig(0.011, 0.0), fig(0.0, 0.0)));
-    EXPECT_FALSE(controllers::leavesMore(fig(76.574 * 1.009, 30), fig(76.574, 30)));
-    EXPECT_TRUE(controllers::leavesMore(fig(76.574 * 1.011, 30), fig(76.574, 30)));
-    EXPECT_TRUE(controllers::leavesMore(fig(50, 30.4), fig(76.574, 30)));
+    const auto fig = [](double maxUm, double rmsUm) { return controllers::common::FitFigures{maxUm * kUm, rmsUm * kUm, 0}; };
+    EXPECT_FALSE(controllers::common::leavesMore(fig(0.001, 0.001), fig(0.001, 0.001)));
+    EXPECT_FALSE(controllers::common::leavesMore(fig(76.574, 30), fig(76.574, 30)));
+    EXPECT_FALSE(controllers::common::leavesMore(fig(0.009, 0.009), fig(0.0, 0.0)));
+    EXPECT_TRUE(controllers::common::leavesMore(fig(0.011, 0.0), fig(0.0, 0.0)));
+    EXPECT_FALSE(controllers::common::leavesMore(fig(76.574 * 1.009, 30), fig(76.574, 30)));
+    EXPECT_TRUE(controllers::common::leavesMore(fig(76.574 * 1.011, 30), fig(76.574, 30)));
+    EXPECT_TRUE(controllers::common::leavesMore(fig(50, 30.4), fig(76.574, 30)));
     // Through the CLI (the warning printed by emit, and none where the files hold everything):
     // Verify.EmitWarnsWhenItsFilesLeaveMoreThanNoCompensation.
 }

@@ -17,6 +17,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp::controllers {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 using test::sourcePath;

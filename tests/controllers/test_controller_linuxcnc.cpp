@@ -26,6 +26,8 @@
 #include "test_controller_common_support.hpp"
 
 namespace cnccomp::controllers {
+using namespace cnccomp::controllers::common;
+using namespace cnccomp::io;
 namespace {
 
 using namespace testing;

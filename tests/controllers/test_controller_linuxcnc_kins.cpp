@@ -29,6 +29,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 using controllers::linuxcnc::kinematicsComponent;
@@ -194,7 +195,7 @@ void checkMachine(const Sample& s, int poses, Figures& fig) {
     const Kinematics nominal(m), real(m, d);
     const KinematicsModel compiledNominal(m, nullptr);
     KinematicsData kd(compiledNominal);
-    const pp::TcpModel tcp(compiledNominal, kd);
+    const postproc::TcpModel tcp(compiledNominal, kd);
     const int n = m.axisCount();
     std::mt19937 rng(20261126);
     const IkOptions ik = referenceOptions(o);
@@ -396,7 +397,7 @@ TEST(LinuxcncKinsComponent, SingularPoseOfTheMultitaskingMachine) {
             } else {
                 const KinematicsModel compiledNominal(m, nullptr);
                 KinematicsData kd(compiledNominal);
-                const pp::TcpModel tcp(compiledNominal, kd);
+                const postproc::TcpModel tcp(compiledNominal, kd);
                 AxisVector cc(m.axisCount()), p;
                 for (int i = 0; i < m.axisCount(); ++i) cc[i] = cj[i] * unitOf(m, i);
                 tcp.toProgram(kd, cc, L, p);
@@ -431,7 +432,7 @@ TEST(LinuxcncKinsComponent, SolvesFromFarAwayJoints) {
         const Kinematics nominal(m), real(m, d);
         const KinematicsModel compiledNominal(m, nullptr);
         KinematicsData kd(compiledNominal);
-        const pp::TcpModel tcp(compiledNominal, kd);
+        const postproc::TcpModel tcp(compiledNominal, kd);
         const int n = m.axisCount();
         std::mt19937 rng(99);
         std::vector<double> joints(n, 0.0);
@@ -551,7 +552,7 @@ TEST(LinuxcncKinsComponent, InverseCostPerCall) {
             std::vector<CPose> words(calls);
             const KinematicsModel compiledNominal(m, nullptr);
             KinematicsData kd(compiledNominal);
-            const pp::TcpModel tcp(compiledNominal, kd);
+            const postproc::TcpModel tcp(compiledNominal, kd);
             for (int t = 0; t < calls; ++t) {
                 const AxisVector q = a + (b - a) * (double(t) / calls);
                 const std::vector<double> c = toJoints(m, q);

@@ -27,6 +27,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 const std::string kSample = test::sourcePath("samples/laser/x-axis-iso230-2.csv");
@@ -42,11 +43,11 @@ constexpr double kMeanReversal = (195.73 - 359.31) / 55;
 LaserPositioningResult sample() { return evaluateLaserPositioning(readLaserCsv(kSample).runs); }
 
 TEST(LaserControllers, OneTableControllersTakeTheReferenceDirectionAndTheMeanReversalAsBacklash) {
-    const auto c = controllers::laserAxisCompensation(sample(), true);
+    const auto c = controllers::common::laserAxisCompensation(sample(), true);
     EXPECT_NEAR(c.referenceUm.front(), kUp0, 1e-9);
     EXPECT_NEAR(c.referenceUm.back(), kUp500, 1e-9);
     EXPECT_NEAR(c.backlashUm, -kMeanReversal, 1e-9);  // lost motion: positive
-    const auto r = controllers::laserAxisCompensation(sample(), false);
+    const auto r = controllers::common::laserAxisCompensation(sample(), false);
     EXPECT_NEAR(r.referenceUm.back(), kDown500, 1e-9);
     // Moving + after a − approach the slide lags below the target by B̄: the motor goes −B̄ further in its direction of
     // motion, the same β (Fanuc 1851: compensation in the direction of movement).

@@ -20,6 +20,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 std::string fileOf(const controllers::EmitResult& e, const std::string& name) {
@@ -76,7 +77,7 @@ TEST(SetBacklash, EmitWritesValueSignAndUnitForEveryController) {
         plus << 1, 1, 1;
         minus << -1, -1, -1;
         const AxisVector still = a->driveCommandsForTool(q, 0.0);
-        const auto* dir = dynamic_cast<const controllers::DirectionalCompensation*>(a.get());
+        const auto* dir = dynamic_cast<const controllers::common::DirectionalCompensation*>(a.get());
         ASSERT_NE(dir, nullptr) << c.controller;
         const AxisVector up = dir->driveCommandsMoving(q, 0.0, plus), down = dir->driveCommandsMoving(q, 0.0, minus);
         EXPECT_NEAR(up[0] - still[0], 0.0, 1e-12) << c.controller;

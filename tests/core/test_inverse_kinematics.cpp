@@ -8,6 +8,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 AxisVector somePose(const MachineModel& m, int seed) {

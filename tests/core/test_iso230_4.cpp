@@ -15,6 +15,7 @@
 #include "app/report/html_report.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 constexpr double LB = 100.0;

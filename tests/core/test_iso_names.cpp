@@ -18,6 +18,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

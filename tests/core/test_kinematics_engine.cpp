@@ -17,6 +17,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 /// A head whose B axis is inclined 45° in the Y-Z plane (as on a nutating head), with location errors on it.

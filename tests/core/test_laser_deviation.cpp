@@ -23,6 +23,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 const std::string kLaser = test::sourcePath("samples/laser/mill-3axis-x.csv");

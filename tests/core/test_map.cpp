@@ -13,6 +13,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 MapRequest req(const MachineModel& m, const DeviationSet& d, const char* grid, double toolLength,

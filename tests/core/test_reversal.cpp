@@ -24,6 +24,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 std::string readText(const std::string& path) {

@@ -24,7 +24,7 @@ TEST(SingularPose, ToolAxisParallelToCIsHandledAlikeByTheThreeConfigurations) {
     d.set("aBT", 6.5 * kArcsec);
     d.set("dxBT", 0.012);
     const Kinematics nominal(m), actual(m, d);
-    pp::Corrector corrector(m, d);
+    postproc::Corrector corrector(m, d);
     ASSERT_TRUE((m.fromController(AxisVector::Zero(m.axisCount())).array() == 0.0).all());  // commands = model's
     const int B = m.requireAxis("B"), C = m.requireAxis("C");
     const double L = 100.0;
@@ -41,7 +41,7 @@ TEST(SingularPose, ToolAxisParallelToCIsHandledAlikeByTheThreeConfigurations) {
         const IkResult kins = solveToolPose(actual, target, tip, q, controllers::linuxcnc::kinsSolverOptions());
         EXPECT_TRUE(kins.converged);
         AxisVector corrected;
-        const pp::SolveResult s = corrector.solve(q, L, q, corrected);
+        const postproc::SolveResult s = corrector.solve(q, L, q, corrected);
         EXPECT_TRUE(core.converged);
         EXPECT_TRUE(s.converged);
         for (const AxisVector* sol : std::initializer_list<const AxisVector*>{&core.q, &kins.q, &corrected}) {

@@ -3,6 +3,7 @@
 #include "cnccomp/io/deviation_csv.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "fuzz_reader.hpp"
+using namespace cnccomp::io;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace cnccomp;

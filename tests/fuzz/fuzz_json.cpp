@@ -2,6 +2,7 @@
 // InputError naming the line; never a crash, a hang or a stack overflow (nesting is limited). Seeds: tests/fuzz/seeds/json.
 #include "cnccomp/io/json.hpp"
 #include "fuzz_reader.hpp"
+using namespace cnccomp::io;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace cnccomp;

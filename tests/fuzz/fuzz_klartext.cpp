@@ -8,12 +8,12 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace cnccomp;
-    static const pp::AxisLayout layout = pp::AxisLayout::generic();
+    static const postproc::AxisLayout layout = postproc::AxisLayout::generic();
     std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
     std::ostringstream csv;
-    pp::PosesOptions o;
+    postproc::PosesOptions o;
     o.inputName = "fuzz.h";
     o.bufferSize = 256;  // overlong lines are exercised too
-    fuzz::expectOnlyInputErrors([&] { (void)pp::writeKlartextPoses(layout, in, csv, o); });
+    fuzz::expectOnlyInputErrors([&] { (void)postproc::writeKlartextPoses(layout, in, csv, o); });
     return 0;
 }

@@ -15,7 +15,8 @@
 #include "cnccomp/io/number_format.hpp"
 
 using namespace cnccomp;
-using namespace cnccomp::pp;
+using namespace cnccomp::postproc;
+using namespace cnccomp::io;
 
 namespace {
 void check(bool ok) {

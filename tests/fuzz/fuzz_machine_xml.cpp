@@ -5,6 +5,6 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::string path = cnccomp::fuzz::writeInput(data, size, ".xml");
-    cnccomp::fuzz::expectOnlyInputErrors([&] { (void)cnccomp::readMachineXml(path); });
+    cnccomp::fuzz::expectOnlyInputErrors([&] { (void)cnccomp::io::readMachineXml(path); });
     return 0;
 }

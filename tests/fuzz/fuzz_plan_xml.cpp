@@ -3,6 +3,8 @@
 // takes, with the same runs.
 #include "cnccomp/io/plan_xml.hpp"
 #include "fuzz_reader.hpp"
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace cnccomp;

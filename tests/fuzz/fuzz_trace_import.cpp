@@ -6,6 +6,7 @@
 // mark. Their ΔL values are made up (sines of a few um): the fuzz target checks the reader, not the numbers.
 #include "cnccomp/io/trace_import.hpp"
 #include "fuzz_reader.hpp"
+using namespace cnccomp::io;
 
 namespace {
 cnccomp::BallbarRun cRadial(bool timeSampled) {

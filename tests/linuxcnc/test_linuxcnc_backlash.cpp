@@ -54,6 +54,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp::test {
+using namespace cnccomp::io;
 namespace {
 
 namespace fs = std::filesystem;
@@ -206,7 +207,7 @@ TEST(LinuxcncBacklash, TheEmittedBacklashActsAsControlCSaysNegativeIncludedAndTa
 
     // cnccomp's apply models of the files: the component route's (what verify takes for this folder) and the pins route's.
     const std::unique_ptr<controllers::AppliedCompensation> applied = controllers::backend("linuxcnc").apply(m, files);
-    const auto* componentModel = dynamic_cast<const controllers::DirectionalCompensation*>(applied.get());
+    const auto* componentModel = dynamic_cast<const controllers::common::DirectionalCompensation*>(applied.get());
     ASSERT_NE(componentModel, nullptr);
     const controllers::linuxcnc::LinuxcncModel pinsModel(m, files);
 

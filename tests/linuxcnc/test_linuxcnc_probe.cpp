@@ -45,6 +45,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp::test {
+using namespace cnccomp::io;
 namespace {
 
 namespace fs = std::filesystem;

@@ -17,7 +17,8 @@
 #include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 struct PathMove {
@@ -303,4 +304,4 @@ TEST(PostprocAccuracy, CorrectedArcsStayArcsWhenTheyCan) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -11,7 +11,8 @@
 #include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");
@@ -159,4 +160,4 @@ TEST(PostprocCli, TipOnlyLeavesRotaryWordsAlone) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

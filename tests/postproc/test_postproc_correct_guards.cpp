@@ -15,7 +15,7 @@
 #include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 namespace {
 
 namespace fs = std::filesystem;
@@ -212,4 +212,4 @@ TEST(PostprocCorrectGuards, ExponentWordDoesNotMakeAMillingProgramPrinterCode) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

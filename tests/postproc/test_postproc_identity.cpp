@@ -12,7 +12,8 @@
 #include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 namespace fs = std::filesystem;
@@ -98,4 +99,4 @@ TEST(PostprocIdentity, CommandLineWritesAnIdenticalFile) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -31,7 +31,8 @@
 #include "test_postproc_xyzac.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 namespace xyzac = cnccomp::test::xyzac;
@@ -323,9 +324,9 @@ TEST(PostprocKlartextCorrect, ZeroDeviationsKeepEveryByte) {
     // testprog's Klartext programs of two sample plans (circles as CC / C blocks, chords, cycles 7 and 9, STOP).
     for (const auto& [machine, plan] : {std::pair{"table-table-ac", "dbb5-table-table-ac"}, std::pair{"multitasking", "multitasking-six-circles"}}) {
         const MachineModel& m = test::sampleMachine(machine);
-        pp::testprog::TestProgramOptions o;
-        o.dialect = pp::Dialect::Heidenhain;
-        for (const auto& p : pp::testprog::makeTestPrograms(m, readPlanXml(test::sourcePath(fmt::format("samples/plans/{}.xml", plan))), o).programs) {
+        postproc::testprog::TestProgramOptions o;
+        o.dialect = postproc::Dialect::Heidenhain;
+        for (const auto& p : postproc::testprog::makeTestPrograms(m, readPlanXml(test::sourcePath(fmt::format("samples/plans/{}.xml", plan))), o).programs) {
             CorrectOptions co;
             co.setup.defaultToolLength = 100;
             std::istringstream in(p.text);
@@ -694,4 +695,4 @@ TEST(PostprocKlartextCorrect, CliStrictExitsThreeAndAMalformedBlockWritesNothing
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -14,7 +14,8 @@
 #include "postproc/line_reader.hpp"
 #include "cnccomp/io/number_format.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 std::string_view text(std::string_view line, const Word& w) { return line.substr(w.valueBegin, w.end - w.valueBegin); }
@@ -262,7 +263,7 @@ TEST(PostprocDialect, DetectsUnambiguousProgramsOnly) {
 }
 
 // One name table for reading, correcting and writing test programs. Oracle: the names each command accepted before the
-// two tables (pp::parseDialect, pp::testprog::parseProgramDialect) were made one, transcribed from those two functions and
+// two tables (postproc::parseDialect, postproc::testprog::parseProgramDialect) were made one, transcribed from those two functions and
 // the CLI (`correct` added heidenhain and klartext to the reader's names).
 TEST(PostprocDialect, OneNameTableServesEveryUse) {
     using U = DialectUse;
@@ -293,4 +294,4 @@ TEST(PostprocDialect, OneNameTableServesEveryUse) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

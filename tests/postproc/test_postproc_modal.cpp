@@ -11,7 +11,7 @@
 #include "postproc/poses.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
 namespace {
 
 struct ProgramRun {
@@ -19,7 +19,7 @@ struct ProgramRun {
     std::vector<std::string> lines;
 };
 
-ProgramRun interpretProgram(const std::string& program, Dialect d = Dialect::Rs274ngc, pp::Setup setup = {},
+ProgramRun interpretProgram(const std::string& program, Dialect d = Dialect::Rs274ngc, postproc::Setup setup = {},
                      AxisLayout layout = AxisLayout::generic(), bool shortest = false) {
     Interpreter interp(layout, InterpreterOptions{d, setup, shortest});
     ProgramRun run;
@@ -39,7 +39,7 @@ ProgramRun interpretProgram(const std::string& program, Dialect d = Dialect::Rs2
 constexpr int X = 0, Y = 1, Z = 2, A = 3, B = 4, C = 5;
 
 TEST(PostprocModal, AbsoluteIncrementalUnitsAndOffsets) {
-    pp::Setup s;
+    postproc::Setup s;
     s.addWorkOffset("G54=100,-50,10");
     s.addWorkOffset("G55=0,0,0,0,0,90");
     const ProgramRun r = interpretProgram(
@@ -68,7 +68,7 @@ TEST(PostprocModal, AbsoluteIncrementalUnitsAndOffsets) {
 }
 
 TEST(PostprocModal, ToolLengthOffsetShiftsZAndSetsTheToolPoint) {
-    pp::Setup s;
+    postproc::Setup s;
     s.addToolLength("H3=120.5");
     s.addToolLength("40");
     const ProgramRun r = interpretProgram("G21 G90\nG0 X0 Y0 Z10\nG43 H3 Z10\nG49 Z10\nG43 H9 Z10\n", Dialect::Rs274ngc, s);
@@ -156,7 +156,7 @@ TEST(PostprocModal, RotaryShortestPathOnModuloAxes) {
 }
 
 TEST(PostprocModal, OffsetsFromTheProgram) {
-    pp::Setup s;
+    postproc::Setup s;
     s.addWorkOffset("G54=10,0,0");
     const ProgramRun r = interpretProgram(
         "G90 G54 G0 X0 Y0 Z0\n"
@@ -239,7 +239,7 @@ TEST(PostprocModal, SinumerikKeywordsAndTcp) {
 }
 
 TEST(PostprocPoses, CsvOfMachinePositionsFollowsTheModalState) {
-    pp::Setup s;
+    postproc::Setup s;
     s.addWorkOffset("G54=100,0,-50");
     PosesOptions o;
     o.setup = s;
@@ -258,4 +258,4 @@ TEST(PostprocPoses, CsvOfMachinePositionsFollowsTheModalState) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

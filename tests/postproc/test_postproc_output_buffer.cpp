@@ -28,7 +28,7 @@ TEST(PostprocOutputBuffer, StreamGetsEveryPieceInOrderAndHoldsAtMostTheCapacity)
         std::ostringstream out;
         std::string expected;
         {
-            pp::OutputBuffer b(out, capacity);
+            postproc::OutputBuffer b(out, capacity);
             for (int i = 0; i < 4000; ++i) {
                 // Mostly block-sized pieces, now and then one larger than the small capacities, some empty.
                 const size_t n = i % 97 == 0 ? 3000 + rng() % 9000 : i % 31 == 0 ? 0 : rng() % 120;
@@ -46,7 +46,7 @@ TEST(PostprocOutputBuffer, StreamGetsEveryPieceInOrderAndHoldsAtMostTheCapacity)
 
 TEST(PostprocOutputBuffer, NothingReachesTheStreamBeforeTheCapacityIsExceededOrFlush) {
     std::ostringstream out;
-    pp::OutputBuffer b(out, 10000);
+    postproc::OutputBuffer b(out, 10000);
     std::string expected;
     for (int i = 0; i < 99; ++i) {  // 9 900 bytes: held (crossing the 4 KiB and 8 KiB storage steps)
         const std::string s(100, static_cast<char>('0' + i % 10));

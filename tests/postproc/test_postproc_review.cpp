@@ -14,7 +14,8 @@
 #include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 const DeviationSet& multitaskingTruth() {
@@ -188,4 +189,4 @@ TEST(PostprocReview, AppendedWordsFollowTheBlocksSpacing) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -14,7 +14,8 @@
 #include "postproc/correct_program.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 const DeviationSet& truth() {
@@ -280,4 +281,4 @@ TEST(PostprocRobustness, HeidenhainKlartextProgramGoesToTheKlartextCorrector) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

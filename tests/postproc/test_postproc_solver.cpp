@@ -10,7 +10,8 @@
 #include "postproc/correction.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 DeviationSet randomDeviations(const MachineModel& m, int seed) {
@@ -210,4 +211,4 @@ TEST(PostprocSplit, RotaryMovesAreSplitUntilMidpointsMeetTheTolerance) {
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -25,7 +25,8 @@
 #include "test_postproc_xyzac.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 using namespace cnccomp::test::xyzac;  // the independent controller and machine models
@@ -442,4 +443,4 @@ TEST(PostprocTcp, FanucG435VectorProgram) { expectVectorProgramAccurate(false); 
 TEST(PostprocTcp, SinumerikTraoriVectorProgram) { expectVectorProgramAccurate(true); }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

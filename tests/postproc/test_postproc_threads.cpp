@@ -14,7 +14,8 @@
 #include "test_postproc_xyzac.hpp"
 #include "test_support.hpp"
 
-namespace cnccomp::pp {
+namespace cnccomp::postproc {
+using namespace cnccomp::io;
 namespace {
 
 struct Run {
@@ -82,4 +83,4 @@ TEST(PostprocThreads, JointModeProgramWithEveryKindOfBlockIsTheSameOnOneAndTwoTh
 }
 
 }  // namespace
-}  // namespace cnccomp::pp
+}  // namespace cnccomp::postproc

@@ -56,7 +56,7 @@ VolumetricMap uncompensatedMap(const MachineModel& m, const DeviationSet& deviat
 std::vector<AxisVector> regularWorkspaceSamples(const MachineModel& m, int perAxis) {
     std::vector<AxisVector> samples;
     const Kinematics nominal(m);
-    for (const AxisVector& q : controllers::workspaceSamples(m, perAxis))
+    for (const AxisVector& q : controllers::common::workspaceSamples(m, perAxis))
         if (!singularPose(nominal, q)) samples.push_back(q);
     return samples;
 }

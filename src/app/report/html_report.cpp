@@ -13,6 +13,7 @@
 #include "app/report/report_format.hpp"
 
 namespace cnccomp::app::report {
+using namespace cnccomp::io;
 namespace fs = std::filesystem;
 
 namespace {

@@ -28,7 +28,7 @@ ReportFiles reportFiles(const std::string& htmlPath, const ReportData& data);
 
 /// Stages the page, the SVGs and the summary in `out`; nothing is written before out.commit(), so a command that
 /// fails later leaves none of them. Throws ModelError for maps without data.machineModel.
-ReportFiles stageHtmlReport(OutputSet& out, const std::string& htmlPath, const ReportData& data);
+ReportFiles stageHtmlReport(io::OutputSet& out, const std::string& htmlPath, const ReportData& data);
 
 /// The three kinds of text, for tests.
 std::string formatReportSummaryJson(const ReportData& data, const ReportFiles& files);

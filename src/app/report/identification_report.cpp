@@ -13,6 +13,9 @@
 #include "controllers/common/evaluate.hpp"
 
 namespace cnccomp::app::report {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -121,8 +124,8 @@ void addCompensationSections(ReportData& data, const MachineModel& m, const Devi
         const controllers::Backend& b = controllers::backend(name);
         const controllers::EmitResult emitted = b.emit({m, identified, "identified deviations", "2000-01-01"});
         const auto comp = b.apply(m, emitted.files);
-        const controllers::CompensationFigures f =
-            controllers::evaluateCompensation(m, identified, *comp, samples, o.toolLength);
+        const controllers::common::CompensationFigures f =
+            controllers::common::evaluateCompensation(m, identified, *comp, samples, o.toolLength);
         ControllerSection c;
         c.name = name;
         for (const auto& x : emitted.compensated) c.compensated.push_back({x.deviation, x.note, kUnknown, ""});

@@ -20,11 +20,11 @@ namespace cnccomp::app::report {
 
 /// Ball-bar runs of a measured plan: before / after traces per pass, ISO 230-4 figures, fit RMS.
 /// `measured.observations` must be those the identification used (plan.runs first).
-std::vector<RunSection> measuredRunSections(const MachineModel& machine, const MeasurementPlan& plan,
-                                            const MeasuredRuns& measured, const IdentificationResult& result);
+std::vector<RunSection> measuredRunSections(const MachineModel& machine, const measurement::MeasurementPlan& plan,
+                                            const identification::MeasuredRuns& measured, const identification::IdentificationResult& result);
 
 /// The deviations of a report: every requested one, identified or not (display units um / arcsec).
-std::vector<DeviationRow> deviationRows(const IdentificationReport& report);
+std::vector<DeviationRow> deviationRows(const identification::IdentificationReport& report);
 
 /// Map of the identified machine ("before") and, per controller backend name, the coverage and the residual of that
 /// controller compensating the identified deviations (figures over workspaceSamples(machine, 5) less the poses whose

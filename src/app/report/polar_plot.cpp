@@ -10,6 +10,7 @@
 #include "app/report/report_format.hpp"
 
 namespace cnccomp::app::report {
+using namespace cnccomp::io;
 
 PolarScale polarScale(const RunSection& run) {
     double m = 0;

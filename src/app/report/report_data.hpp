@@ -72,7 +72,7 @@ struct DeviationRow {
 struct MapPicture {
     std::string title;  ///< "before compensation", "after compensation (linuxcnc)", …
     VolumetricMap map;
-    MapPlane plane;
+    io::MapPlane plane;
 };
 
 /// What the instrument reads on one pass of a run before and after compensation (verify): the span (max − min) of ΔL

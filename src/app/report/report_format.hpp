@@ -11,6 +11,6 @@ namespace cnccomp::app::report {
 double niceNumber(double x);
 /// `v` with `decimals` decimals; "–" when not finite.
 std::string fixed(double v, int decimals);
-using cnccomp::jsonString;  // io/markup.hpp
+using cnccomp::io::jsonString;  // io/markup.hpp
 
 }  // namespace cnccomp::app::report

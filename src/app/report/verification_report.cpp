@@ -10,6 +10,7 @@
 #include "cnccomp/map_grid.hpp"
 
 namespace cnccomp::app::report {
+using namespace cnccomp::io;
 
 namespace {
 

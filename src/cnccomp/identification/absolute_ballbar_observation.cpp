@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 AbsoluteBallbarObservation::AbsoluteBallbarObservation(const MachineModel& machine, BallbarRun run,
                                                        const BallbarTrace& trace)
@@ -83,4 +83,4 @@ Observations absoluteBallbarObservations(const MachineModel& machine, const std:
     return obs;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

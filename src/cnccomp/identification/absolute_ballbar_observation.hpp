@@ -3,7 +3,7 @@
 // Ball 1 at the setup pose, ΔL = |p_T(q) − p_W| − LB with p_W fixed (see simulateAbsoluteRun).
 #include "cnccomp/identification/observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 class AbsoluteBallbarObservation final : public ObservationModel {
 public:
@@ -35,4 +35,4 @@ private:
 Observations absoluteBallbarObservations(const MachineModel& machine, const std::vector<BallbarRun>& runs,
                                          const std::vector<BallbarTrace>& traces);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

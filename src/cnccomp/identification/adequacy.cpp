@@ -12,7 +12,7 @@
 #include "cnccomp/identification/identifiability.hpp"
 #include "cnccomp/units.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 namespace {
 
 constexpr double kInfiniteDof = 1e7;
@@ -230,4 +230,4 @@ void testAdequacy(const LsqProblem& p, const Eigen::VectorXd& x, const IdentifyO
     rep.warnings.insert(rep.warnings.begin(), a.message);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -21,7 +21,7 @@
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/problem.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Fills report.adequacy from the residual at scaled point x; when the model does not fit, puts the warning first in
 /// report.warnings and widens stddev / intervals / covariance of the parameters and combinations.
@@ -31,4 +31,4 @@ void testAdequacy(const LsqProblem& problem, const Eigen::VectorXd& x, const Ide
 /// Quantile of the F(d1, d2) distribution (Paulson's approximation; d2 ≥ 1e6 taken as ∞: χ²(d1)/d1 by Wilson–Hilferty).
 double fQuantile(double p, double d1, double d2);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

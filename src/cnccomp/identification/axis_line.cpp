@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 void setAxisLine(const MachineModel& m, DeviationSet& set, int axis, const AxisVector& q, const Vec3& pointBed,
                  const Vec3& dirBed, const std::vector<int>& only) {
@@ -43,4 +43,4 @@ void setAxisLine(const MachineModel& m, DeviationSet& set, int axis, const AxisV
     }
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

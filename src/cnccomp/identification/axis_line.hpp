@@ -5,7 +5,7 @@
 
 #include "cnccomp/deviations.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Sets the location deviations of rotary axis `axis` listed in `only` (indices into machine.deviations) so that
 /// the axis line passes through `pointBed` along `dirBed`, both in the bed frame with the links before the axis at
@@ -16,4 +16,4 @@ namespace cnccomp {
 void setAxisLine(const MachineModel& m, DeviationSet& set, int axis, const AxisVector& q, const Vec3& pointBed,
                  const Vec3& dirBed, const std::vector<int>& only);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

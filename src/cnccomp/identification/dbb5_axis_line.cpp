@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 namespace {
 
@@ -96,4 +96,4 @@ Dbb5PaperTilt paperXycTilt(double dx, double dy, double R) {
     return {dx / R, -dy / R};
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

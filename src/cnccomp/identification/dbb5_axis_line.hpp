@@ -29,7 +29,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Centre shifts of an axis along one machine axis at two positions along the rotary axis.
 struct Dbb5ShiftPair {
@@ -86,4 +86,4 @@ struct Dbb5PaperTilt {
 };
 Dbb5PaperTilt paperXycTilt(double dx, double dy, double R);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -9,7 +9,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -183,4 +184,4 @@ DeviationSet dbb5ComponentTables(const MachineModel& m, const Dbb5ComponentProfi
     return set;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

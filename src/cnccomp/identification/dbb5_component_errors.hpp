@@ -24,7 +24,7 @@
 #include "cnccomp/deviations.hpp"
 #include "cnccomp/identification/dbb5_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct Dbb5ComponentProfile {
     std::string axis;
@@ -44,7 +44,7 @@ struct Dbb5ComponentProfile {
 /// axis (within 0.01 mm) and the bar along a machine axis; `location` is the identified location set (its simulated
 /// runs are subtracted). Throws ModelError naming what is missing (a run with the bar along each machine axis ⟂ the
 /// axis) or runs whose sample angles differ.
-Dbb5ComponentProfile dbb5ComponentProfile(const MachineModel& m, const std::vector<Dbb5Run>& runs,
+Dbb5ComponentProfile dbb5ComponentProfile(const MachineModel& m, const std::vector<measurement::Dbb5Run>& runs,
                                           const std::vector<BallbarTrace>& traces, const DeviationSet& location,
                                           const std::string& axis);
 
@@ -54,4 +54,4 @@ Dbb5ComponentProfile dbb5ComponentProfile(const MachineModel& m, const std::vect
 /// Throws ModelError for a component error of the axis that is not a table, or a node outside the measured angles.
 DeviationSet dbb5ComponentTables(const MachineModel& m, const Dbb5ComponentProfile& profile, const DeviationSet& base);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -8,7 +8,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/dbb5_observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -132,4 +133,4 @@ Dbb5ConeEvaluation evaluateDbb5ConeRun(const MachineModel& m, const Dbb5Run& run
     return e;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

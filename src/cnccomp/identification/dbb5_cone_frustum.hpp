@@ -24,11 +24,11 @@
 #include "cnccomp/identification/dbb5_circular.hpp"
 #include "cnccomp/identification/dbb5_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Tool axis t(φ) (tip → spindle) and bar direction u(φ) (table ball → spindle ball), workpiece frame, unit.
-Vec3 dbb5ConeToolAxis(const Dbb5Run& run, double phiDeg);
-Vec3 dbb5ConeBarDirection(const Dbb5Run& run, double phiDeg);
+Vec3 dbb5ConeToolAxis(const measurement::Dbb5Run& run, double phiDeg);
+Vec3 dbb5ConeBarDirection(const measurement::Dbb5Run& run, double phiDeg);
 
 /// Commands of the two table rotary axes (the rest of `q` untouched) that put the machine's tool direction along
 /// `toolAxisW` (tip → spindle, workpiece frame) on the nominal machine; `branch` +1 / −1 picks the solution.
@@ -36,7 +36,7 @@ Vec3 dbb5ConeBarDirection(const Dbb5Run& run, double phiDeg);
 AxisVector dbb5TableOrientation(const MachineModel& m, const Vec3& toolAxisW, int branch, AxisVector q);
 
 /// The branch dbb5TableOrientation takes for a cone-frustum run: the smaller outer tilt at the setup angle.
-int dbb5ConeBranch(const MachineModel& m, const Dbb5Run& run);
+int dbb5ConeBranch(const MachineModel& m, const measurement::Dbb5Run& run);
 
 struct Dbb5ConeEvaluation {
     std::string run;
@@ -47,7 +47,7 @@ struct Dbb5ConeEvaluation {
 
 /// ISO 230-4 figures of a cone-frustum run; with `deviations`, also the profile they predict and the difference —
 /// the check of identified errors against a five-axis test the identification did not use (the paper's use).
-Dbb5ConeEvaluation evaluateDbb5ConeRun(const MachineModel& m, const Dbb5Run& run, const BallbarTrace& trace,
+Dbb5ConeEvaluation evaluateDbb5ConeRun(const MachineModel& m, const measurement::Dbb5Run& run, const BallbarTrace& trace,
                                        const DeviationSet* deviations = nullptr);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

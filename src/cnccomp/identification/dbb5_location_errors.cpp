@@ -10,7 +10,8 @@
 #include "cnccomp/identification/reading_refinement.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -315,4 +316,4 @@ Dbb5LocationResult dbb5LocationErrors(const MachineModel& m, const std::vector<D
     return res;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -26,7 +26,7 @@
 #include "cnccomp/identification/dbb5_circular.hpp"
 #include "cnccomp/identification/dbb5_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct Dbb5LocationOptions {
     /// Tilting (outer) and rotary table (inner) axes; empty = the two rotary axes of the workpiece chain, the one
@@ -68,7 +68,7 @@ struct Dbb5LocationResult {
 
 /// Throws ModelError naming the missing runs (a linear circle per plane; per rotary axis two runs with the bar along
 /// each machine axis ⟂ it at two positions, the other rotary axis at 0) or deviations the machine lacks.
-Dbb5LocationResult dbb5LocationErrors(const MachineModel& m, const std::vector<Dbb5Run>& runs,
+Dbb5LocationResult dbb5LocationErrors(const MachineModel& m, const std::vector<measurement::Dbb5Run>& runs,
                                       const std::vector<BallbarTrace>& traces, const Dbb5LocationOptions& options = {});
 
 /// The outer and inner rotary axes (names) of a tilting rotary table: `options` if given, else the two rotary axes of
@@ -83,4 +83,4 @@ std::vector<int> dbb5LocationDeviations(const MachineModel& m, const Dbb5Locatio
 /// all rotary axes 0, bed frame) and the angles between the relative X, Y, Z motions. Order as `formulas`.
 Eigen::VectorXd dbb5GeometricReadings(const Kinematics& k, const std::string& outerAxis, const std::string& innerAxis);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -7,7 +7,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/plan_method.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 Dbb5Observation::Dbb5Observation(const MachineModel& machine, Dbb5Run run, const BallbarTrace& trace)
     : run_(std::move(run)) {
@@ -73,4 +74,4 @@ Observations dbb5Observations(const MachineModel& machine, const std::vector<Dbb
     return obs;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

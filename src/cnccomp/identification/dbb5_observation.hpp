@@ -5,12 +5,12 @@
 #include "cnccomp/identification/dbb5_run.hpp"
 #include "cnccomp/identification/observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 class Dbb5Observation final : public ObservationModel {
 public:
     /// `trace` angles may be any subset of the sweep; throws ModelError on size mismatch or non-finite data.
-    Dbb5Observation(const MachineModel& machine, Dbb5Run run, const BallbarTrace& trace);
+    Dbb5Observation(const MachineModel& machine, measurement::Dbb5Run run, const BallbarTrace& trace);
 
     std::string runName() const override { return run_.name; }
     std::string kind() const override { return "dbb5"; }
@@ -24,12 +24,12 @@ public:
     std::vector<double> sweepAnglesDeg() const override { return anglesDeg_; }
     /// The turning axis of a rotary circle; every rotary axis the machine moves in a cone frustum; none for linear circles.
     std::vector<std::string> turningAxes() const override { return turning_; }
-    bool movesOnlyLinearAxes() const override { return run_.kind == Dbb5Run::Kind::LinearCircle; }
+    bool movesOnlyLinearAxes() const override { return run_.kind == measurement::Dbb5Run::Kind::LinearCircle; }
 
-    const Dbb5Run& run() const { return run_; }
+    const measurement::Dbb5Run& run() const { return run_; }
 
 private:
-    Dbb5Run run_;
+    measurement::Dbb5Run run_;
     Eigen::VectorXd measured_;
     std::vector<double> anglesDeg_;
     std::vector<std::string> turning_;
@@ -38,7 +38,7 @@ private:
 };
 
 /// One observation per run (same order as the traces).
-Observations dbb5Observations(const MachineModel& machine, const std::vector<Dbb5Run>& runs,
+Observations dbb5Observations(const MachineModel& machine, const std::vector<measurement::Dbb5Run>& runs,
                               const std::vector<BallbarTrace>& traces);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

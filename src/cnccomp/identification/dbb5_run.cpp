@@ -8,7 +8,8 @@
 #include "cnccomp/identification/dbb5_cone_frustum.hpp"
 #include "cnccomp/identification/rtest_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -107,4 +108,4 @@ std::pair<Vec3, Vec3> rotaryAxisLine(const Kinematics& k, int axis, const AxisVe
     throw ModelError(fmt::format("machine '{}': axis number {} has no joint frame", k.machine().name, axis));
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

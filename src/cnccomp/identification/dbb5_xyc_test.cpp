@@ -6,7 +6,8 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -64,4 +65,4 @@ Dbb5XycResult evaluateDbb5XycTest(const MachineModel& m, const Dbb5Run& run, con
     return r;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

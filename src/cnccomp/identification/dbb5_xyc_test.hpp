@@ -15,7 +15,7 @@
 #include "cnccomp/identification/dbb5_circular.hpp"
 #include "cnccomp/identification/dbb5_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct Dbb5XycResult {
     std::string run, axis;
@@ -28,9 +28,9 @@ struct Dbb5XycResult {
 };
 
 /// True for a rotary run whose bar is along its turning axis and whose ball is off the axis by more than 1 mm.
-bool isDbb5XycTest(const MachineModel& m, const Dbb5Run& run);
+bool isDbb5XycTest(const MachineModel& m, const measurement::Dbb5Run& run);
 
 /// Throws ModelError for a run that is not an XYC test (see isDbb5XycTest) or a trace that does not match it.
-Dbb5XycResult evaluateDbb5XycTest(const MachineModel& m, const Dbb5Run& run, const BallbarTrace& trace);
+Dbb5XycResult evaluateDbb5XycTest(const MachineModel& m, const measurement::Dbb5Run& run, const BallbarTrace& trace);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

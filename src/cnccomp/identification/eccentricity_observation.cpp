@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 EccentricityObservation::EccentricityObservation(const MachineModel& machine, BallbarRun run, const BallbarTrace& trace)
     : run_(std::move(run)), anglesDeg_(trace.angleDeg), measured_(2) {
@@ -51,4 +51,4 @@ Observations eccentricityObservations(const MachineModel& machine, const std::ve
     return obs;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -8,7 +8,7 @@
 // residuals are in units of ΔL noise like those of BallbarObservation. No analytic Jacobian (finite differences).
 #include "cnccomp/identification/observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 class EccentricityObservation final : public ObservationModel {
 public:
@@ -34,4 +34,4 @@ private:
 Observations eccentricityObservations(const MachineModel& machine, const std::vector<BallbarRun>& runs,
                                       const std::vector<BallbarTrace>& traces);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -8,7 +8,7 @@
 
 #include "cnccomp/identification/levenberg_marquardt.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 double ParameterEstimate::displayScale() const { return angle ? kArcsec : kUm; }
 
@@ -266,4 +266,4 @@ void analyzeSolution(const LsqProblem& p, const ObservableSubspace& sub, const E
     }
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

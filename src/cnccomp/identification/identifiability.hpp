@@ -13,7 +13,7 @@
 #include "cnccomp/identification/problem.hpp"
 #include "cnccomp/identification/report.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Fills rank, singular values, condition number, parameters (values, identified flags, intervals), combinations,
 /// covariance, σ̂, dof and the per-run residuals of `report` at scaled point x (start x0 for "before").
@@ -36,4 +36,4 @@ double normalQuantile(double p);
 /// "EX0C + 360·EB0B" from names and coefficients (first coefficient 1).
 std::string formatCombination(const std::vector<std::string>& names, const std::vector<double>& coefficients);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

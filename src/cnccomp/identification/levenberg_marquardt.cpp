@@ -6,7 +6,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 JacobianSvd decomposeJacobian(const Eigen::MatrixXd& J, double rankTolerance, const Eigen::VectorXd* r) {
     const Eigen::Index m = J.rows(), n = J.cols();
@@ -137,4 +137,4 @@ SolverOutcome levenbergMarquardt(const LsqProblem& p, const Eigen::VectorXd& x0,
     return o;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -8,7 +8,7 @@
 
 #include "cnccomp/identification/problem.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct SolverSettings {
     int maxIterations = 50;
@@ -51,4 +51,4 @@ struct ObservableSubspace {
 };
 ObservableSubspace observableSubspace(const LsqProblem& problem, double rankTolerance);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -15,7 +15,7 @@
 #include "cnccomp/identification/nlopt_solver.hpp"
 #include "cnccomp/identification/problem.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 namespace {
 
@@ -171,4 +171,4 @@ IdentificationResult identify(const MachineModel& machine, const Observations& o
     return res;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

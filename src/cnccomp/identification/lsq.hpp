@@ -13,7 +13,7 @@
 #include "cnccomp/identification/observation.hpp"
 #include "cnccomp/identification/report.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Bounds of one unknown for bounded solvers, internal units.
 struct ParameterBound {
@@ -64,4 +64,4 @@ void validateIdentifyOptions(const IdentifyOptions& options);
 IdentificationResult identify(const MachineModel& machine, const Observations& observations,
                               const IdentifyOptions& options = {});
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

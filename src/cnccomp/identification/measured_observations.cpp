@@ -3,7 +3,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/plan_observations.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 LengthOffsetObservation::LengthOffsetObservation(std::unique_ptr<ObservationModel> inner) : inner_(std::move(inner)) {}
 
@@ -54,4 +55,4 @@ MeasuredRuns measuredObservations(const MachineModel& machine, const Measurement
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -11,7 +11,7 @@
 #include "cnccomp/measurement/plan_measurements.hpp"
 #include "cnccomp/io/trace_import.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// A ball-bar run recorded by an instrument that does not know its absolute length (a relative transducer zeroed
 /// anywhere): measured ΔL = ΔL_model + dL0. Wraps the run's observation and adds the offset dL0 as one more
@@ -41,13 +41,13 @@ private:
 };
 
 struct MeasuredRuns {
-    std::vector<MeasuredTrace> ballbar;  ///< one per plan.runs entry, same order (passes, import summary)
+    std::vector<io::MeasuredTrace> ballbar;  ///< one per plan.runs entry, same order (passes, import summary)
     Observations observations;           ///< plan.runs first (same order), then the other kinds as planObservations
 };
 
 /// The observations of the plan's captures read once (io/plan_measurements_io.hpp, MeasurementKinds::observed(): the
 /// ball-bar files imported with their capture settings, `# machine:` lines checked against machine.name): wraps the
 /// runs whose instrument is relative, and adds the plan's other runs (planObservations).
-MeasuredRuns measuredObservations(const MachineModel& machine, const MeasurementPlan& plan, const PlanMeasurements& data);
+MeasuredRuns measuredObservations(const MachineModel& machine, const measurement::MeasurementPlan& plan, const measurement::PlanMeasurements& data);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 namespace {
 struct Context {
@@ -93,4 +93,4 @@ SolverOutcome solveNlopt(const LsqProblem& problem, const Eigen::VectorXd& x0, c
     return o;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -5,7 +5,7 @@
 
 #include "cnccomp/identification/levenberg_marquardt.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Whether NLopt knows the algorithm name (without prefix), e.g. "LD_SLSQP".
 bool nloptAlgorithmKnown(const std::string& algorithm);
@@ -15,4 +15,4 @@ bool nloptAlgorithmKnown(const std::string& algorithm);
 SolverOutcome solveNlopt(const LsqProblem& problem, const Eigen::VectorXd& x0, const std::string& algorithm,
                          const Eigen::VectorXd& lower, const Eigen::VectorXd& upper, int maxEvaluations);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

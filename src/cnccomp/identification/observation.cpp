@@ -8,7 +8,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 namespace {
 
@@ -282,4 +282,4 @@ Observations ballbarObservations(const MachineModel& machine, const std::vector<
     return obs;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

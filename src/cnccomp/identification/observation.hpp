@@ -29,7 +29,7 @@
 #include "cnccomp/deviations.hpp"
 #include "cnccomp/kinematics.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// The machine at one deviation vector: its exact kinematics plus exact first derivatives of chain points
 /// with respect to the flat deviation vector (location and component errors, rotation parts through the
@@ -160,4 +160,4 @@ private:
 Observations ballbarObservations(const MachineModel& machine, const std::vector<BallbarRun>& runs,
                                  const std::vector<BallbarTrace>& traces);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 double coefficientScale(const MachineModel& machine, const DeviationDef& d, int k) {
     const double unit = d.isAngle() ? kArcsec : kUm;
@@ -141,4 +141,4 @@ std::vector<int> parseDeviationList(const MachineModel& machine, std::string_vie
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -12,7 +12,7 @@
 
 #include "cnccomp/identification/observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct UnknownInfo {
     std::string name;        ///< "EX0C", "EXC[2]" (component coefficient), "B-X.xT" (nuisance)
@@ -73,4 +73,4 @@ std::vector<int> parseDeviationList(const MachineModel& machine, std::string_vie
 /// Typical size of a coefficient of a component error (internal units per solver unit), see file comment.
 double coefficientScale(const MachineModel& machine, const DeviationDef& d, int k);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -9,7 +9,8 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 const char* planMethodName(PlanMethod m) {
     switch (m) {
@@ -152,4 +153,4 @@ std::pair<std::string, std::string> tableRotaryAxes(const MachineModel& m) {
     return {rot[0], rot[1]};
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

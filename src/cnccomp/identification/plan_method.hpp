@@ -7,7 +7,7 @@
 
 #include "cnccomp/io/plan_xml.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 enum class PlanMethod {
     Ballbar,        ///< ball-bar circles around B and C (<run>): every deviation the runs see; formulas: eccentricities
@@ -29,14 +29,14 @@ const char* planMethodFormulas(PlanMethod m);
 
 /// The method the plan's runs fit. R-test plans: RtestTables when some rotary axis is swept alone (the others held)
 /// with the ball at three or more places, else RtestLocation. Throws ModelError for an empty plan.
-PlanMethod classifyPlan(const MeasurementPlan& plan);
+PlanMethod classifyPlan(const measurement::MeasurementPlan& plan);
 
 /// Parses a method name (as planMethodName) given on the command line to override the classification; checks that
 /// the plan has the runs it needs and says which method the plan fits when it does not. Throws ModelError.
-PlanMethod choosePlanMethod(const MeasurementPlan& plan, const std::string& name);
+PlanMethod choosePlanMethod(const measurement::MeasurementPlan& plan, const std::string& name);
 
 /// The two rotary axes of the workpiece side in chain order (outer = tilting, inner = table), e.g. ("A", "C");
 /// empty strings when the machine has fewer.
 std::pair<std::string, std::string> tableRotaryAxes(const MachineModel& machine);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -7,7 +7,9 @@
 #include "cnccomp/identification/rtest_observation.hpp"
 #include "cnccomp/identification/absolute_ballbar_observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 
 Observations planObservations(const MachineModel& m, const MeasurementPlan& plan, const PlanMeasurements& data) {
     if (plan.runCount() == 0) throw ModelError("the plan has no runs");
@@ -40,4 +42,4 @@ Observations planObservations(const MachineModel& m, const MeasurementPlan& plan
     return all;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

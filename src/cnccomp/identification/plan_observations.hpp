@@ -9,10 +9,10 @@
 #include "cnccomp/measurement/plan.hpp"
 #include "cnccomp/measurement/plan_measurements.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// `data` holds the captures of every kind of run the plan has (MeasurementKinds::observed()). ModelError for an empty
 /// plan.
-Observations planObservations(const MachineModel& machine, const MeasurementPlan& plan, const PlanMeasurements& data);
+Observations planObservations(const MachineModel& machine, const measurement::MeasurementPlan& plan, const measurement::PlanMeasurements& data);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -14,7 +14,7 @@
 #include "cnccomp/identification/parameters.hpp"
 #include "cnccomp/identification/problem.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 namespace {
 
@@ -392,4 +392,4 @@ PlanProposal proposePlan(const MachineModel& m, const PlannerOptions& o) {
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

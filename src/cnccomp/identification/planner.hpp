@@ -14,7 +14,7 @@
 
 #include "cnccomp/io/plan_xml.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct PlannerOptions {
     std::vector<int> identify;          ///< deviation indices (required)
@@ -58,7 +58,7 @@ struct ExtraAdvice {
 };
 
 struct PlanProposal {
-    MeasurementPlan plan;
+    measurement::MeasurementPlan plan;
     bool complete = false;             ///< every requested deviation is identifiable
     int rank = 0, unknowns = 0;
     double conditionNumber = 0;
@@ -75,4 +75,4 @@ PlanProposal proposePlan(const MachineModel& machine, const PlannerOptions& opti
 /// Candidate run name: the test name plus the geometry, e.g. "C-radial_RB410_ZC340" (file-name safe).
 std::string candidateName(const BallbarRun& r);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

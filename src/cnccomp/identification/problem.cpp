@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 LsqProblem::LsqProblem(const MachineModel& machine, const Observations& observations, const UnknownLayout& layout,
                        const DeviationSet& fixed)
@@ -133,4 +133,4 @@ void LsqProblem::setMeasured(const Eigen::VectorXd& measured) {
     measured_ = measured;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

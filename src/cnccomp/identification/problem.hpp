@@ -4,7 +4,7 @@
 // values of the `fixed` set.
 #include "cnccomp/identification/parameters.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 class LsqProblem {
 public:
@@ -52,4 +52,4 @@ private:
     Eigen::VectorXd start_, measured_, weights_;
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -5,7 +5,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 DeviationSet refineReadings(const MachineModel& m, const std::vector<int>& devs,
                             const std::function<Eigen::VectorXd(const DeviationSet&)>& readings,
@@ -44,4 +44,4 @@ DeviationSet refineReadings(const MachineModel& m, const std::vector<int>& devs,
     return set;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -11,7 +11,7 @@
 
 #include "cnccomp/deviations.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// `readings(set)`: the formulas applied to the data simulated with `set` (size = devs.size(), internal units).
 /// Returns θ after `steps` Gauss–Newton steps from θ = measured readings (steps = 0: the plain formulas).
@@ -20,4 +20,4 @@ DeviationSet refineReadings(const MachineModel& m, const std::vector<int>& devs,
                             const std::function<Eigen::VectorXd(const DeviationSet&)>& readings,
                             const Eigen::VectorXd& measured, int steps);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

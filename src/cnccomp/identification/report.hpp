@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -103,4 +103,4 @@ struct IdentificationReport {
     int find(const std::string& nameOrAlias) const;
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

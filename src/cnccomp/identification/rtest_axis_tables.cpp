@@ -14,7 +14,8 @@
 #include "cnccomp/identification/problem.hpp"
 #include "cnccomp/identification/rtest_observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -287,4 +288,4 @@ CradleLsq cradleLeastSquares(const MachineModel& m, const std::string& outerAxis
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

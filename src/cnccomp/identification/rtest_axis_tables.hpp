@@ -22,7 +22,7 @@
 #include "cnccomp/identification/lsq.hpp"
 #include "cnccomp/identification/rtest_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct AxisErrorSample {
     double angleDeg = 0;
@@ -40,7 +40,7 @@ struct AxisErrors {
 /// Per-angle six errors of the rotary axis `axis` (workpiece side) from the R-test runs that turn only that axis.
 /// Assumes the tool side and the other axes are free of errors at the held positions. Throws ModelError when fewer
 /// than three non-collinear balls see an angle, or no run turns the axis.
-AxisErrors cradleAxisErrors(const MachineModel& m, const std::string& axis, const std::vector<RtestRun>& runs,
+AxisErrors cradleAxisErrors(const MachineModel& m, const std::string& axis, const std::vector<measurement::RtestRun>& runs,
                             const std::vector<RtestTrace>& traces);
 
 /// Component-error tables E[X|Y|Z|A|B|C]<axis> from per-angle results, node values interpolated linearly between
@@ -51,7 +51,7 @@ DeviationSet cradleDeviations(const MachineModel& m, const std::vector<AxisError
 /// the inner errors at zero), then the inner axis after removing from its runs the displacement the identified outer
 /// tables cause at the held outer position (exact model). `perAngle` receives the two per-angle results.
 DeviationSet cradleTablesPerAngle(const MachineModel& m, const std::string& outerAxis, const std::string& innerAxis,
-                             const std::vector<RtestRun>& runs, const std::vector<RtestTrace>& traces,
+                             const std::vector<measurement::RtestRun>& runs, const std::vector<RtestTrace>& traces,
                              std::vector<AxisErrors>* perAngle = nullptr);
 
 /// Six errors of one axis at one angle, for the small-angle model.
@@ -71,7 +71,7 @@ struct CradleLsq {
     DeviationSet deviations;  ///< after the gauge (the twelve tables present)
 };
 CradleLsq cradleLeastSquares(const MachineModel& m, const std::string& outerAxis, const std::string& innerAxis,
-                             const std::vector<RtestRun>& runs, const std::vector<RtestTrace>& traces,
+                             const std::vector<measurement::RtestRun>& runs, const std::vector<RtestTrace>& traces,
                              const IdentifyOptions& options = {});
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

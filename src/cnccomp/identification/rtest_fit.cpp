@@ -9,7 +9,7 @@
 #include "cnccomp/circle_fit.hpp"
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 using Vec2 = Eigen::Vector2d;
 
@@ -261,4 +261,4 @@ double ellipseDistance(const EllipseFit& e, const Vec2& p, double* phase) {
     return (Vec2(e.a * std::cos(phi), e.b * std::sin(phi)) - q).norm();
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -10,7 +10,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct PlaneFit {
     Vec3 centroid = Vec3::Zero();
@@ -54,4 +54,4 @@ double ellipseDiameter(const EllipseFit& e, double angle);
 /// Distance from a point to an ellipse and the phase of the closest point (Newton on the phase).
 double ellipseDistance(const EllipseFit& e, const Eigen::Vector2d& p, double* phase = nullptr);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

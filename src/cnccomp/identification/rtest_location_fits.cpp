@@ -9,7 +9,8 @@
 #include "cnccomp/identification/axis_line.hpp"
 #include "cnccomp/identification/reading_refinement.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -196,4 +197,4 @@ VolumetricAlongRun volumetricErrorAlongRun(const MachineModel& m, const Deviatio
     return v;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

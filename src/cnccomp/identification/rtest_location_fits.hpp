@@ -34,7 +34,7 @@
 #include "cnccomp/identification/rtest_fit.hpp"
 #include "cnccomp/identification/rtest_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct RtestLocationOptions {
     std::string outerAxis = "A", innerAxis = "C";
@@ -54,7 +54,7 @@ struct RtestLocationResult {
 /// Finds the runs by what moves: the inner axis alone with the outer at 0 (XYC), at ±φ (tilted XYC), the outer
 /// alone (YZA); runs where both turn are ignored (XYZAC, for volumetricErrorAlongRun). Throws ModelError naming what is
 /// missing, or when the machine lacks one of the 11 deviations.
-RtestLocationResult rtestLocationFits(const MachineModel& m, const std::vector<RtestRun>& runs,
+RtestLocationResult rtestLocationFits(const MachineModel& m, const std::vector<measurement::RtestRun>& runs,
                               const std::vector<RtestTrace>& traces, const RtestLocationOptions& options = {});
 
 /// Section 3.2: along a (typically XYZAC) run, the measured displacement ("ErrMTCH"), the displacement the
@@ -64,7 +64,7 @@ struct VolumetricAlongRun {
     double rmsResidual = 0, maxResidual = 0;  ///< of |measured − predicted|, mm
     double rmsMeasured = 0;                   ///< of |measured|, mm
 };
-VolumetricAlongRun volumetricErrorAlongRun(const MachineModel& m, const DeviationSet& identified, const RtestRun& run,
+VolumetricAlongRun volumetricErrorAlongRun(const MachineModel& m, const DeviationSet& identified, const measurement::RtestRun& run,
                                      const RtestTrace& trace);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -4,7 +4,8 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 RtestObservation::RtestObservation(const MachineModel& machine, RtestRun run, const RtestTrace& trace)
     : run_(std::move(run)), commands_(trace.commands) {
@@ -80,4 +81,4 @@ Observations rtestObservations(const MachineModel& machine, const std::vector<Rt
     return obs;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -5,12 +5,12 @@
 #include "cnccomp/identification/observation.hpp"
 #include "cnccomp/identification/rtest_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 class RtestObservation final : public ObservationModel {
 public:
     /// `trace.commands` are the poses (rtestCommands); throws ModelError on size mismatch or non-finite data.
-    RtestObservation(const MachineModel& machine, RtestRun run, const RtestTrace& trace);
+    RtestObservation(const MachineModel& machine, measurement::RtestRun run, const RtestTrace& trace);
 
     std::string runName() const override { return run_.name; }
     std::string kind() const override { return "rtest"; }
@@ -24,18 +24,18 @@ public:
     bool jacobian(const DifferentiableMachine& m, const double* nuisance, const std::vector<int>& flat,
                   Eigen::Ref<Eigen::MatrixXd> J) const override;
 
-    const RtestRun& run() const { return run_; }
+    const measurement::RtestRun& run() const { return run_; }
 
 private:
     Vec3 ball(const double* nuisance) const;
 
-    RtestRun run_;
+    measurement::RtestRun run_;
     Eigen::VectorXd measured_;
     std::vector<AxisVector> commands_;
 };
 
 /// One observation per run (same order as the traces).
-Observations rtestObservations(const MachineModel& machine, const std::vector<RtestRun>& runs,
+Observations rtestObservations(const MachineModel& machine, const std::vector<measurement::RtestRun>& runs,
                                const std::vector<RtestTrace>& traces);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -8,7 +8,8 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 
 AxisVector followPoint(const Kinematics& k, AxisVector q, const Vec3& toolPoint, const Vec3& target) {
     const MachineModel& m = k.machine();
@@ -89,4 +90,4 @@ RtestTrace simulateRtest(const Kinematics& k, const RtestRun& run) {
     return simulateRtest(k, run, rtestCommands(k.machine(), run));
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -5,7 +5,7 @@
 #include "cnccomp/kinematics.hpp"
 #include "cnccomp/measurement/rtest_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// Axis values at which the tool point `toolPoint` (tool frame) of machine `k` sits on `target` (workpiece frame):
 /// the linear axes are solved by Newton's method, the other axes keep their values from `q`.
@@ -15,7 +15,7 @@ AxisVector followPoint(const Kinematics& k, AxisVector q, const Vec3& toolPoint,
 /// Axis commands of every pose: the rotary axes on their sweeps, the linear axes from followPoint on the
 /// nominal machine so that the nest centre sits on the nominal ball centre. Throws ModelError (naming the run)
 /// for an unknown or non-rotary axis and for commands outside the travel.
-std::vector<AxisVector> rtestCommands(const MachineModel& m, const RtestRun& run);
+std::vector<AxisVector> rtestCommands(const MachineModel& m, const measurement::RtestRun& run);
 
 /// Displacement of the ball centre from the nest centre in the tool (sensor) frame: d = tMw·ball − nest.
 /// Zero on the nominal machine at the commands of rtestCommands().
@@ -27,8 +27,8 @@ struct RtestTrace {
 };
 
 /// Simulates a run on machine `k`, the ball at ball + ballOffset.
-RtestTrace simulateRtest(const Kinematics& k, const RtestRun& run);
+RtestTrace simulateRtest(const Kinematics& k, const measurement::RtestRun& run);
 /// Same, for precomputed commands (rtestCommands).
-RtestTrace simulateRtest(const Kinematics& k, const RtestRun& run, const std::vector<AxisVector>& commands);
+RtestTrace simulateRtest(const Kinematics& k, const measurement::RtestRun& run, const std::vector<AxisVector>& commands);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -11,7 +11,8 @@
 #include "cnccomp/identification/rtest_run.hpp"
 #include "cnccomp/measurement/sphere_fit.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
+using namespace cnccomp::measurement;
 namespace {
 
 std::string poseText(const SpherePose& p) {
@@ -378,4 +379,4 @@ std::optional<double> bracketedRoot(const std::function<double(double)>& f, doub
     return 0.5 * (a + b);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -26,7 +26,7 @@
 #include "cnccomp/measurement/probe_log.hpp"
 #include "cnccomp/measurement/sphere_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 struct SphereTouchCommand {
     Vec3 normal = Vec3::UnitZ();  ///< outward surface normal at the nominal touch, workpiece frame
@@ -35,13 +35,13 @@ struct SphereTouchCommand {
 
 struct SpherePoseCommand {
     int planPose = 0;             ///< pose number in the plan (from 0, over every sphere run)
-    SpherePose angles;            ///< as planned (deg)
+    measurement::SpherePose angles;            ///< as planned (deg)
     AxisVector safe;              ///< stylus at the safe point above the pole
     std::vector<SphereTouchCommand> touches;  ///< pole first, then the ring
 };
 
 struct SphereRunCommands {
-    SphereRun run;
+    measurement::SphereRun run;
     std::vector<SpherePoseCommand> poses;
 };
 
@@ -59,10 +59,10 @@ std::optional<double> bracketedRoot(const std::function<double(double)>& f, doub
 
 /// Commands of every sphere run of a plan (pose numbers continue from run to run). Throws ModelError naming the run,
 /// pose and touch for a command outside the travel or a move between poses that would come near a sphere.
-SpherePlanCommands sphereCommands(const MachineModel& machine, const std::vector<SphereRun>& runs);
+SpherePlanCommands sphereCommands(const MachineModel& machine, const std::vector<measurement::SphereRun>& runs);
 
 /// Tool point of the stylus ball centre (tool frame).
-Vec3 stylusPoint(const MachineModel& machine, const SphereRun& run);
+Vec3 stylusPoint(const MachineModel& machine, const measurement::SphereRun& run);
 
 /// Where the probing move from `from` to `to` (straight in the axes) triggers on machine `k`: the first point at which
 /// the stylus ball centre is `radius` from `sphere` (workpiece frame). Parameter along the move in [lo, hi] (0 = from,
@@ -74,7 +74,7 @@ std::optional<AxisVector> probeTrigger(const Kinematics& k, const Vec3& stylus, 
 /// probe triggering at trigger offset triggerOffset + triggerError; `noise` (mm, one standard deviation) moves each
 /// trigger along its probing move with normal noise from `seed` (0 = none). Missed touches are recorded with
 /// triggered = 0 at the target, as G38.3 leaves them.
-ProbeLog simulateSphereProbing(const Kinematics& k, const SpherePlanCommands& commands, double noise = 0.0,
+measurement::ProbeLog simulateSphereProbing(const Kinematics& k, const SpherePlanCommands& commands, double noise = 0.0,
                                unsigned long seed = 1);
 
 /// The touches of each pose of each run from a log, checked: every (pose, touch) of the plan once, triggered, its
@@ -82,7 +82,7 @@ ProbeLog simulateSphereProbing(const Kinematics& k, const SpherePlanCommands& co
 /// surface. Throws InputError (log file, line) naming the pose and touch otherwise, or (line 0) a touch that is not in
 /// the file. Result: [run][pose][touch] axis positions, description frame.
 std::vector<std::vector<std::vector<AxisVector>>> checkedTouches(const MachineModel& machine,
-                                                                 const SpherePlanCommands& commands, const ProbeLog& log);
+                                                                 const SpherePlanCommands& commands, const measurement::ProbeLog& log);
 
 /// Observation of one sphere run: per pose the fitted sphere centre (fitSphereKnownRadius on the stylus ball centres
 /// the nominal machine computes from the touch positions) minus the nominal centre, workpiece frame, 3 values a pose.
@@ -118,6 +118,6 @@ private:
 };
 
 /// One observation per sphere run.
-Observations sphereObservations(const MachineModel& machine, const SpherePlanCommands& commands, const ProbeLog& log);
+Observations sphereObservations(const MachineModel& machine, const SpherePlanCommands& commands, const measurement::ProbeLog& log);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

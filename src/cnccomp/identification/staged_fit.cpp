@@ -9,7 +9,7 @@
 
 #include "cnccomp/identification/parameters.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 namespace {
 
@@ -181,4 +181,4 @@ IdentificationResult identifyStaged(const MachineModel& machine, const Observati
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

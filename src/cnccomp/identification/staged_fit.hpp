@@ -25,10 +25,10 @@
 // requested deviations or all of them, or when `options.staged` is false (`identify --one-stage`).
 #include "cnccomp/identification/lsq.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// identify() in two stages as above; the report's `stages` says which deviations came from which runs.
 IdentificationResult identifyStaged(const MachineModel& machine, const Observations& observations,
                                     const IdentifyOptions& options = {});
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

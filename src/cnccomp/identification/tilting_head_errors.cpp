@@ -10,7 +10,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/identification/absolute_ballbar_observation.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 BallbarTrace simulateAbsoluteRun(const Kinematics& k, const BallbarRun& run) {
     const MachineModel& m = k.machine();
@@ -272,4 +272,4 @@ TiltingHeadLsq tiltingHeadLeastSquares(const MachineModel& m, const std::vector<
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

@@ -22,7 +22,7 @@
 #include "cnccomp/deviations.hpp"
 #include "cnccomp/identification/lsq.hpp"
 
-namespace cnccomp {
+namespace cnccomp::identification {
 
 /// ΔL of a ball-bar run with Ball 2 at its nominal position (where the nominal machine puts the T-side ball at the
 /// setup commands) plus the run's work-ball offset: an absolutely calibrated bar on a located socket.
@@ -63,4 +63,4 @@ struct TiltingHeadLsq {
 TiltingHeadLsq tiltingHeadLeastSquares(const MachineModel& machine, const std::vector<BallbarRun>& runs,
                                        const std::vector<BallbarTrace>& traces, const IdentifyOptions& options = {});
 
-}  // namespace cnccomp
+}  // namespace cnccomp::identification

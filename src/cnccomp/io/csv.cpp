@@ -13,7 +13,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/machine.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 void requireRegularFile(const std::string& path) {
     struct stat st {};
@@ -243,4 +243,4 @@ std::string axisColumn(const MachineModel& m, int axis) {
     return m.axisNames[static_cast<size_t>(axis)] + (m.axisLink(axis).kind == AxisKind::Rotary ? "_deg" : "_mm");
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

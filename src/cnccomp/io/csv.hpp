@@ -20,9 +20,9 @@
 #include <string_view>
 #include <vector>
 
-namespace cnccomp {
+#include "cnccomp/machine.hpp"
 
-struct MachineModel;
+namespace cnccomp::io {
 
 /// Throws InputError unless `path` names a regular file (or a link to one): a folder is "a folder, not a file", a
 /// FIFO / socket / device is named as such and never opened (opening a FIFO blocks until a writer comes). Every
@@ -115,4 +115,4 @@ std::optional<double> parseCsvNumber(std::string_view cell, bool decimalComma);
 /// Column of machine axis `axis` in cnccomp's CSV files: its name and unit, e.g. "X_mm", "C_deg".
 std::string axisColumn(const MachineModel& m, int axis);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -19,7 +19,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/units.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 namespace {
 
 // "EXC[3]" → ("EXC", 3); plain names give index -1.
@@ -311,4 +311,4 @@ void writeDeviationCsv(const std::string& path, const DeviationSet& set, bool al
     writeFileAtomically(path, [&](std::ostream& o) { o << text; });
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -15,7 +15,7 @@
 
 #include "cnccomp/deviations.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 DeviationSet readDeviationCsv(const std::string& path, const MachineModel& machine);
 /// Writes the present deviations (all of them when `all`), atomically.
@@ -23,4 +23,4 @@ void writeDeviationCsv(const std::string& path, const DeviationSet& set, bool al
 /// Same text as a string (for printing and tests).
 std::string formatDeviationCsv(const DeviationSet& set, bool all = false);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -4,7 +4,7 @@
 
 #include "cnccomp/machine.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// The largest deviation a machine tool can have, checked at reading (a value beyond it is a unit or typing mistake:
 /// 1e200 mm made `simulate` crash in the circle fit). A length (location error or component-error coefficient):
@@ -19,4 +19,4 @@ inline constexpr double kMaxDeviationAngle = kDeg;     ///< rad (1°)
 /// finite), or an empty string.
 std::string deviationRangeProblem(const DeviationDef& d, double value);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

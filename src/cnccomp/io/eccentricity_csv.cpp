@@ -9,7 +9,7 @@
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 std::vector<EccentricityRow> readEccentricityCsv(const std::string& path) {
     const CsvTable t = readCsv(path);
@@ -51,4 +51,4 @@ void writeEccentricityCsv(const std::string& path, const std::vector<Eccentricit
     writeFileAtomically(path, [&](std::ostream& o) { writeEccentricityCsv(o, rows); });
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

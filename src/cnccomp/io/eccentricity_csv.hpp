@@ -6,11 +6,11 @@
 
 #include "cnccomp/eccentricity.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 std::vector<EccentricityRow> readEccentricityCsv(const std::string& path);
 void writeEccentricityCsv(const std::string& path, const std::vector<EccentricityRow>& rows);
 /// The same CSV written to a stream (for outputs staged together, io/output_set.hpp).
 void writeEccentricityCsv(std::ostream& out, const std::vector<EccentricityRow>& rows);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -11,7 +11,7 @@
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 const char* jsonTypeName(Json::Type t) {
     switch (t) {
@@ -222,4 +222,4 @@ Json readJsonFile(const std::string& path) {
     return parseJson(ss.str(), path);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

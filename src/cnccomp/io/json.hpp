@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 struct JsonMember;
 
@@ -55,4 +55,4 @@ Json parseJson(std::string_view text, const std::string& source = "");
 /// Reads and parses a file (a regular file; InputError naming it otherwise).
 Json readJsonFile(const std::string& path);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -12,7 +12,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/csv.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace laser_csv_detail {
@@ -156,4 +156,4 @@ LaserCsvFile parseLaserCsv(std::string_view text, const std::string& name, const
     return readFrom(reader, options);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

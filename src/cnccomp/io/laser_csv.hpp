@@ -24,7 +24,7 @@
 
 #include "cnccomp/laser_positioning.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 struct LaserCsvOptions {
     std::string targetColumn = "target_mm";
@@ -47,4 +47,4 @@ LaserCsvFile readLaserCsv(const std::string& path, const LaserCsvOptions& option
 /// The same from text in memory (`name` for messages).
 LaserCsvFile parseLaserCsv(std::string_view text, const std::string& name, const LaserCsvOptions& options = {});
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -6,7 +6,7 @@
 
 #include "cnccomp/io/markup.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 namespace laser_report_detail {
 
@@ -71,4 +71,4 @@ std::string formatLaserJson(const LaserPositioningResult& r, bool environmentSta
         lrNum(r.RReverse), lrNum(r.M), warnings, targets);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -6,7 +6,7 @@
 
 #include "cnccomp/laser_positioning.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// Per target P_i, x̄_i↑, x̄_i↓, x̄_i, B_i, R_i↑, R_i↓, R_i; then E, E↑, E↓, A, A↑, A↓, B, B̄, R, R↑, R↓, M; the run count and
 /// whether environment compensation was done (`environmentStated` false: "not stated in the file").
@@ -14,4 +14,4 @@ std::string formatLaserTable(const LaserPositioningResult& r, bool environmentSt
 /// The same fields as JSON; `file` names the laser file.
 std::string formatLaserJson(const LaserPositioningResult& r, bool environmentStated, const std::string& file);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

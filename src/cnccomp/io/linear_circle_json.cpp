@@ -7,7 +7,7 @@
 #include "cnccomp/geometry.hpp"
 #include "cnccomp/io/markup.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_json_detail {
@@ -112,4 +112,4 @@ std::string formatLinearCircleJson(const std::string& machine, const LinearCircl
     return o;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

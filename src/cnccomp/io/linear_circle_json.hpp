@@ -10,8 +10,8 @@
 
 #include "cnccomp/linear_circle_identify.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 std::string formatLinearCircleJson(const std::string& machine, const LinearCircleIdentification& id);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

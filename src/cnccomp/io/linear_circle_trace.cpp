@@ -10,7 +10,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_export.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 // Internals in a named namespace (not anonymous): the core may be compiled as unity units.
 namespace linear_circle_trace_detail {
@@ -105,4 +105,4 @@ std::string formatLinearCircleTrace(const LinearCircleRun& run, const std::vecto
     return o;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

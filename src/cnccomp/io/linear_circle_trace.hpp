@@ -10,7 +10,7 @@
 #include "cnccomp/io/trace_import.hpp"
 #include "cnccomp/linear_circle_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 struct LinearCircleTrace {
     MeasuredTrace measured;                      ///< the passes, angles in θ of the circle (deg)
@@ -32,4 +32,4 @@ LinearCircleTrace importLinearCircleTrace(const std::string& path, const LinearC
 std::string formatLinearCircleTrace(const LinearCircleRun& run, const std::vector<DirectedTrace>& passes, bool timeSampled,
                                     const std::string& machine);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

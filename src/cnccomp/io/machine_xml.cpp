@@ -10,7 +10,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/xml_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 namespace {
 
 using tinyxml2::XMLElement;
@@ -191,4 +191,4 @@ MachineModel readMachineXml(const std::string& path) {
     return m;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

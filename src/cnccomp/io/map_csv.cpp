@@ -15,7 +15,7 @@
 #include "cnccomp/io/number_format.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 namespace {
 
 constexpr const char* kErrorColumns[] = {"x_mm", "y_mm", "z_mm", "dx_um", "dy_um", "dz_um", "e_um",
@@ -277,4 +277,4 @@ MapCsvTable readMapCsv(const std::string& path) {
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

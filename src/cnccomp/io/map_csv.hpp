@@ -8,7 +8,7 @@
 
 #include "cnccomp/volumetric_map.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 struct MapCsvInfo {
     std::string machine;         ///< machine name
@@ -44,4 +44,4 @@ MapCsvTable readMapCsv(const std::string& path);
 /// Statistics lines shared by the CSV header and the `cnccomp map` output (no comment prefix).
 std::vector<std::string> formatMapStatistics(const VolumetricMap& map, const MachineModel& machine);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -6,7 +6,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 std::string escapeXml(std::string_view text, std::string_view what) {
     std::string o;
@@ -56,4 +56,4 @@ std::string jsonString(std::string_view s) {
     return o + "\"";
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

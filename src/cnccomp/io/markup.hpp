@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// & < > " ' as entities; tab, line feed and carriage return as character references (so that attribute values
 /// keep them: XML parsers normalise raw ones to spaces). Other control characters cannot appear in XML 1.0:
@@ -20,4 +20,4 @@ std::string jsonString(std::string_view s);
 /// infinities, which JSON cannot hold, as null (a writer that must refuse them checks before: the generic backend).
 std::string jsonNumber(double v, int significant = 0);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

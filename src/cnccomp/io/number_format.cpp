@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <cstring>
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 namespace {
 int clampDecimals(const NumberStyle& s) { return s.point ? (s.decimals < 0 ? 0 : (s.decimals > 15 ? 15 : s.decimals)) : 0; }
@@ -119,4 +119,4 @@ double tenTo(int e) {
     return e <= 0 && e >= -15 ? kNeg[-e] : std::pow(10.0, e);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

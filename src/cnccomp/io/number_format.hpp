@@ -6,7 +6,7 @@
 //    faster than either for the numbers a machine produces.
 #include <cstddef>
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 struct NumberStyle {
     int decimals = 4;           ///< digits after the point
@@ -38,4 +38,4 @@ size_t formatNumber(double value, const NumberStyle& style, char* out);
 /// `value` rounded to the style's resolution (what a controller reads back from formatNumber's text).
 double roundToStyle(double value, const NumberStyle& style);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

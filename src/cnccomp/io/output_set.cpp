@@ -9,7 +9,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 namespace fs = std::filesystem;
 
 namespace {
@@ -137,4 +137,4 @@ void OutputSet::rollback() noexcept {
     createdDirs_.clear();
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

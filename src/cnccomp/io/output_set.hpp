@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 class AtomicFile;
 
@@ -62,4 +62,4 @@ private:
     std::vector<std::string> createdDirs_;  ///< outermost first
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -7,7 +7,8 @@
 #include "cnccomp/io/rtest_csv.hpp"
 #include "cnccomp/io/trace_csv.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
+using namespace cnccomp::measurement;
 
 PlanMeasurements loadPlanMeasurements(const MachineModel& m, const MeasurementPlan& plan, const std::string& dir,
                                       const MeasurementKinds& kinds, const std::string& probeLog) {
@@ -31,4 +32,4 @@ PlanMeasurements loadPlanMeasurements(const MachineModel& m, const MeasurementPl
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -8,14 +8,14 @@
 #include "cnccomp/measurement/plan.hpp"
 #include "cnccomp/measurement/plan_measurements.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// Reads, in this order, the ball-bar runs (importRunTraces: checked against their runs and `# machine:` lines against
 /// machine.name, unit checks over the set), the absolute ball-bar runs, the R-test runs (checked against their poses),
 /// the DBB5 runs, the circles of the linear axes (each run validated and its commands checked against the machine
 /// first) and the probe result file DIR/<probeLog>. InputError naming the file and line for a file that is missing or
 /// does not fit its run.
-PlanMeasurements loadPlanMeasurements(const MachineModel& machine, const MeasurementPlan& plan, const std::string& dir,
-                                      const MeasurementKinds& kinds, const std::string& probeLog = "cnccomp-probe.txt");
+measurement::PlanMeasurements loadPlanMeasurements(const MachineModel& machine, const measurement::MeasurementPlan& plan, const std::string& dir,
+                                      const measurement::MeasurementKinds& kinds, const std::string& probeLog = "cnccomp-probe.txt");
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

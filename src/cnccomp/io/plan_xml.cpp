@@ -13,7 +13,8 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/xml_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -640,4 +641,4 @@ void writePlanXml(const std::string& path, const MeasurementPlan& plan) {
     writeFileAtomically(path, [&](std::ostream& o) { o << text; });
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -10,7 +10,7 @@
 
 #include "cnccomp/measurement/plan.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// Attributes of <run> and <absolute-run>: name (a plain file name: DIR/<name>.csv), test (B-X … B-axial), LB RB RC ZC (mm), start end step (deg),
 /// tool-ball-offset / work-ball-offset ("x y z" mm), estimate-mounting (none|tool|work|both: mounting offsets as
@@ -29,10 +29,10 @@ namespace cnccomp {
 /// feed=1000 overshoot=0 directions="cw ccw" date instrument operator, the instrument attributes]> with children
 /// <hold axis deg/> (rotary axes): a ball-bar circle of the linear axes (linear_circle_run.hpp), centre in axis
 /// commands, arc in (0, 360]°.
-MeasurementPlan readPlanXml(const std::string& path);
+measurement::MeasurementPlan readPlanXml(const std::string& path);
 /// Throws InputError naming the plan file and the line of <plan> when the plan names another machine than `machine`.
-void checkPlanMachine(const MeasurementPlan& plan, const std::string& planPath, const std::string& machine);
-void writePlanXml(const std::string& path, const MeasurementPlan& plan);
-std::string formatPlanXml(const MeasurementPlan& plan);
+void checkPlanMachine(const measurement::MeasurementPlan& plan, const std::string& planPath, const std::string& machine);
+void writePlanXml(const std::string& path, const measurement::MeasurementPlan& plan);
+std::string formatPlanXml(const measurement::MeasurementPlan& plan);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -10,7 +10,8 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
+using namespace cnccomp::measurement;
 namespace {
 
 constexpr const char* kAxes[] = {"X", "Y", "Z", "A", "B", "C"};
@@ -108,4 +109,4 @@ void writeProbeLog(const std::string& path, const ProbeLog& log, const MachineMo
     writeFileAtomically(path, [&](std::ostream& o) { o << text; });
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

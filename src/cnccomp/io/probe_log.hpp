@@ -14,16 +14,16 @@
 #include "cnccomp/machine.hpp"
 #include "cnccomp/measurement/probe_log.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// Reads the file; axis values go to the machine's axes of the same names (others stay NaN). Throws InputError
 /// (file:line) for a malformed TOUCH line, a file that cannot be read or one without any TOUCH line.
-ProbeLog readProbeLog(const std::string& path, const MachineModel& machine);
+measurement::ProbeLog readProbeLog(const std::string& path, const MachineModel& machine);
 /// Parses text already read (`source` names it in messages).
-ProbeLog parseProbeLog(const std::string& text, const std::string& source, const MachineModel& machine);
+measurement::ProbeLog parseProbeLog(const std::string& text, const std::string& source, const MachineModel& machine);
 /// The text LinuxCNC's (LOG,...) lines of the probing program give, with `decimals` digits (LinuxCNC: 6).
-std::string formatProbeLog(const ProbeLog& log, const MachineModel& machine, int decimals = 6);
+std::string formatProbeLog(const measurement::ProbeLog& log, const MachineModel& machine, int decimals = 6);
 /// formatProbeLog into `path`, atomically.
-void writeProbeLog(const std::string& path, const ProbeLog& log, const MachineModel& machine, int decimals = 6);
+void writeProbeLog(const std::string& path, const measurement::ProbeLog& log, const MachineModel& machine, int decimals = 6);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -14,7 +14,8 @@
 #include "cnccomp/geometry.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
+using namespace cnccomp::identification;
 
 namespace {
 
@@ -227,4 +228,4 @@ void writeReportJson(const std::string& path, const IdentificationReport& report
     writeFileAtomically(path, [&](std::ostream& o) { o << text; });
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

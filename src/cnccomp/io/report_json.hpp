@@ -7,10 +7,10 @@
 
 #include "cnccomp/identification/report.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
-std::string formatReportJson(const IdentificationReport& report);
+std::string formatReportJson(const identification::IdentificationReport& report);
 /// Writes atomically (never a half file).
-void writeReportJson(const std::string& path, const IdentificationReport& report);
+void writeReportJson(const std::string& path, const identification::IdentificationReport& report);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -9,7 +9,9 @@
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 
 namespace {
 
@@ -78,4 +80,4 @@ std::vector<RtestTrace> readRtestTraces(const std::string& dir, const MachineMod
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -10,7 +10,7 @@
 #include "cnccomp/io/markup.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 namespace {
 
 const char* kSource = "--plane";
@@ -329,4 +329,4 @@ std::string renderMapSvg(const VolumetricMap& map, const std::vector<MapPoint>& 
     return render(map, &planePoints, m, plane, info);
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

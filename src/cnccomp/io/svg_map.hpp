@@ -10,7 +10,7 @@
 
 #include "cnccomp/volumetric_map.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// "XY@Z=0" or "XZ@Y=100,B=30": two grid axes spanning the picture (horizontal, vertical) and the values at which
 /// the other grid axes are cut (grid axes not named are cut at their value nearest 0).
@@ -45,4 +45,4 @@ std::vector<long> planePointIndices(const VolumetricMap& map, const MapPlane& pl
 std::string renderMapSvg(const VolumetricMap& map, const std::vector<MapPoint>& planePoints, const MachineModel& machine,
                          const MapPlane& plane, const SvgInfo& info);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -18,7 +18,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 std::string_view trim(std::string_view s) {
     while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r' || s.front() == '\n')) s.remove_prefix(1);
@@ -228,4 +228,4 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
     file.commit();
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// Whole-string number ("1.5", "-2e-3", "inf", "-inf"); no trailing junk. NaN text is rejected.
 std::optional<double> parseNumber(std::string_view s);
@@ -61,4 +61,4 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
 /// Throws InputError if `output` names the same file as one of the inputs.
 void refuseToOverwrite(const std::string& output, std::initializer_list<std::string> inputs);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

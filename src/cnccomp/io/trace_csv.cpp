@@ -7,7 +7,7 @@
 #include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/trace_import.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 namespace {
 /// Metadata values stay on their line.
@@ -45,12 +45,12 @@ void writeTraceCsv(const std::string& path, const BallbarTrace& trace, const Bal
     writeFileAtomically(path, [&](std::ostream& o) { o << text; });
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io
 
-namespace cnccomp {
+namespace cnccomp::io {
 std::vector<BallbarTrace> readRunTraces(const std::string& dir, const std::vector<BallbarRun>& runs) {
     std::vector<BallbarTrace> out;
     for (MeasuredTrace& m : importRunTraces(dir, runs)) out.push_back(std::move(m.trace));
     return out;
 }
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -6,7 +6,7 @@
 
 #include "cnccomp/ballbar.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// A trace in cnccomp's layout without a run to check against (at least three samples).
 BallbarTrace readTraceCsv(const std::string& path);
@@ -16,10 +16,10 @@ void writeTraceCsv(const std::string& path, const BallbarTrace& trace);
 void writeTraceCsv(const std::string& path, const BallbarTrace& trace, const BallbarRun& run, const std::string& machine);
 std::string formatTraceCsv(const BallbarTrace& trace, const BallbarRun* run = nullptr, const std::string& machine = "");
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io
 
-namespace cnccomp {
+namespace cnccomp::io {
 /// Reads DIR/<run name>.csv for every run, in order, with the run's capture settings, checked against the run
 /// (importRunTraces); a missing file is an InputError naming it. Passes are concatenated.
 std::vector<BallbarTrace> readRunTraces(const std::string& dir, const std::vector<BallbarRun>& runs);
-}  // namespace cnccomp
+}  // namespace cnccomp::io

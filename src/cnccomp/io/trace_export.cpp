@@ -9,7 +9,7 @@
 #include "cnccomp/io/trace_csv.hpp"
 #include "cnccomp/io/trace_import.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 std::vector<DirectedTrace> simulateCapturedPasses(const Kinematics& k, const BallbarRun& run) {
     const std::vector<int> directions = run.capture.passes.empty() ? std::vector<int>{run.stepDeg < 0 ? -1 : +1}
@@ -82,4 +82,4 @@ std::string formatCapturedTrace(const BallbarRun& run, const std::vector<Directe
     return o;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

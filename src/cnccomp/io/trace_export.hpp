@@ -7,7 +7,7 @@
 #include "cnccomp/ballbar.hpp"
 #include "cnccomp/circular_test.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// The passes an instrument records for `run` on `machine`, from run.capture: one pass per direction (default: the
 /// step's), each over the sweep extended by the overshoot at both ends, at the plan's step. ModelError when the
@@ -26,4 +26,4 @@ std::string formatCapturedTrace(const BallbarRun& run, const std::vector<Directe
 void appendCapturedPasses(std::string& o, const RunCapture& capture, const std::vector<DirectedTrace>& passes,
                           bool timeSampled, double omegaDeg);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

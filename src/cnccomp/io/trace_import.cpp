@@ -14,7 +14,7 @@
 #include "cnccomp/io/output_set.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 namespace {
 
 /// One sample (24 bytes: a 1 kHz file has millions of them).
@@ -571,4 +571,4 @@ std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::ve
 
 MeasuredTrace importTrace(const std::string& path) { return importImpl(path, nullptr, RunCapture{}, ""); }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

@@ -22,7 +22,7 @@
 #include "cnccomp/ballbar.hpp"
 #include "cnccomp/circular_test.hpp"
 
-namespace cnccomp {
+namespace cnccomp::io {
 
 /// What the import did with a file, for messages and the report.
 struct TraceImportSummary {
@@ -60,4 +60,4 @@ std::vector<MeasuredTrace> importRunTraces(const std::string& dir, const std::ve
 /// A file in cnccomp's own layout without a run to check against (the DBB5 runs): one pass, at least three samples.
 MeasuredTrace importTrace(const std::string& path);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::io

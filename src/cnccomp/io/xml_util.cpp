@@ -14,7 +14,7 @@
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/text_util.hpp"
 
-namespace cnccomp::xml {
+namespace cnccomp::io::xml {
 
 void load(tinyxml2::XMLDocument& doc, const std::string& path) {
     requireRegularFile(path);  // a folder or a FIFO is named, never opened
@@ -138,4 +138,4 @@ bool boolean(const tinyxml2::XMLElement& e, const std::string& path, const char*
     fail(e, path, fmt::format("attribute '{}' = '{}' is not true/false", attr, s));
 }
 
-}  // namespace cnccomp::xml
+}  // namespace cnccomp::io::xml

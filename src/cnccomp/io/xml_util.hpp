@@ -9,7 +9,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp::xml {
+namespace cnccomp::io::xml {
 
 /// Loads and parses a file; throws InputError with the parser's line on malformed XML or a missing file.
 void load(tinyxml2::XMLDocument& doc, const std::string& path);
@@ -35,4 +35,4 @@ void allowAttributes(const tinyxml2::XMLElement& e, const std::string& path, std
 /// Throws InputError at this element's line.
 [[noreturn]] void fail(const tinyxml2::XMLElement& e, const std::string& path, const std::string& message);
 
-}  // namespace cnccomp::xml
+}  // namespace cnccomp::io::xml

@@ -7,7 +7,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/measurement/sweep.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 void Dbb5Run::validate() const {
     const auto bad = [&](const std::string& what) { throw ModelError(fmt::format("DBB5 run '{}': {}", name, what)); };
@@ -43,4 +43,4 @@ std::pair<Vec3, Vec3> Dbb5Run::planeAxes() const {
     return {unit(plane[0]), unit(plane[1])};
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

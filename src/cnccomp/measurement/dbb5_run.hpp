@@ -20,7 +20,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 struct Dbb5Run {
     enum class Kind { LinearCircle, RotaryCircle, ConeFrustum };
@@ -47,4 +47,4 @@ struct Dbb5Run {
     std::pair<Vec3, Vec3> planeAxes() const;
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

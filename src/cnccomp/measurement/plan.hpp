@@ -11,7 +11,7 @@
 #include "cnccomp/measurement/rtest_run.hpp"
 #include "cnccomp/measurement/sphere_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 struct MeasurementPlan {
     std::string machine;      ///< machine name the plan was made for (may be empty)
@@ -33,4 +33,4 @@ struct MeasurementPlan {
     }
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

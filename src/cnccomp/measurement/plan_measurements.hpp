@@ -18,7 +18,7 @@
 #include "cnccomp/io/trace_import.hpp"
 #include "cnccomp/measurement/probe_log.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 /// Which kinds of runs of a plan to read (a method reads only the runs it uses).
 struct MeasurementKinds {
@@ -35,12 +35,12 @@ struct MeasurementKinds {
 struct PlanMeasurements {
     std::string folder;                       ///< where they were read from
     MeasurementKinds loaded;                  ///< which kinds were read
-    std::vector<MeasuredTrace> ballbar;       ///< one per plan.runs entry, same order
+    std::vector<io::MeasuredTrace> ballbar;       ///< one per plan.runs entry, same order
     std::vector<BallbarTrace> absolute;       ///< one per plan.absoluteRuns entry
-    std::vector<RtestTrace> rtest;            ///< one per plan.rtestRuns entry
+    std::vector<identification::RtestTrace> rtest;            ///< one per plan.rtestRuns entry
     std::vector<BallbarTrace> dbb5;           ///< one per plan.dbb5Runs entry
-    std::vector<LinearCircleTrace> circles;   ///< one per plan.circleRuns entry
+    std::vector<io::LinearCircleTrace> circles;   ///< one per plan.circleRuns entry
     std::optional<ProbeLog> probes;           ///< the <sphere> runs' probe result file
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

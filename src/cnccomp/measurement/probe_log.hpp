@@ -7,7 +7,7 @@
 
 #include "cnccomp/machine.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 struct ProbeTouch {
     int pose = 0, touch = 0;  ///< from 0, plan order (pose numbers run on over the plan's sphere runs)
@@ -22,4 +22,4 @@ struct ProbeLog {
     std::vector<ProbeTouch> touches;
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 void RtestRun::validate() const {
     const auto bad = [&](const std::string& what) { throw ModelError(fmt::format("R-test run '{}': {}", name, what)); };
@@ -39,4 +39,4 @@ double RtestRun::angleDeg(int s, int i) const {
     return w.startDeg + (w.endDeg - w.startDeg) * i / steps;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

@@ -8,7 +8,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 /// One rotary axis during a run: linear in the sample index from start to end (degrees); start == end holds it.
 struct RotarySweep {
@@ -33,4 +33,4 @@ struct RtestRun {
     double angleDeg(int s, int i) const;
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 SphereFit fitSphereKnownRadius(const std::vector<Vec3>& points, double radius, const Vec3& start) {
     if (points.size() < 4) throw ModelError(fmt::format("a sphere fit needs four or more touches, got {}", points.size()));
@@ -43,4 +43,4 @@ SphereFit fitSphereKnownRadius(const std::vector<Vec3>& points, double radius, c
     return f;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

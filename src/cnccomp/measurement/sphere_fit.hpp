@@ -13,7 +13,7 @@
 
 #include "cnccomp/geometry.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 struct SphereFit {
     Vec3 centre = Vec3::Zero();
@@ -27,4 +27,4 @@ struct SphereFit {
 /// fewer than four points, a point at the centre or a pattern that does not fix the centre (all points on one line).
 SphereFit fitSphereKnownRadius(const std::vector<Vec3>& points, double radius, const Vec3& start);
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

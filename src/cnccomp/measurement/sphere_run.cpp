@@ -7,7 +7,7 @@
 
 #include "cnccomp/error.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 void SphereRun::validate() const {
     const auto bad = [&](const std::string& what) { throw ModelError(fmt::format("sphere run '{}': {}", name, what)); };
@@ -69,4 +69,4 @@ std::vector<SpherePose> SphereRun::poses() const {
     return out;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

@@ -13,7 +13,7 @@
 #include "cnccomp/geometry.hpp"
 #include "cnccomp/measurement/rtest_run.hpp"
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 /// Rotary-axis positions of some poses: the axes in `sweeps` linear in the pose index from start to end over `steps`
 /// intervals (a whole turn does not repeat its first pose); `steps` = 0: one pose, every axis held (start == end).
@@ -61,4 +61,4 @@ struct SphereRun {
     double touchWindow() const { return window == window ? window : 0.5 * approach; }
 };
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

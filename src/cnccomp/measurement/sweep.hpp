@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-namespace cnccomp {
+namespace cnccomp::measurement {
 
 /// start, start + step, … up to `end` (degrees; the step's sign gives the direction, validated by the run). A sweep of
 /// whole turns ends where it began: its last sample (the first again) is left out.
@@ -17,4 +17,4 @@ inline std::vector<double> sweepAnglesDeg(double startDeg, double endDeg, double
     return a;
 }
 
-}  // namespace cnccomp
+}  // namespace cnccomp::measurement

@@ -20,6 +20,9 @@
 #include "test_dbb5_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const MachineModel& bc() { return test::tableTableBc(); }

@@ -14,6 +14,8 @@
 #include "test_dbb5_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 namespace {
 
 const MachineModel& bc() { return test::tableTableBc(); }

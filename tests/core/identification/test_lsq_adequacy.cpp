@@ -20,6 +20,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const std::string kComponentsTruth = "samples/deviations/dbb5-table-table-bc-components-truth.csv";

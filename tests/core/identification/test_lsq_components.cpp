@@ -10,6 +10,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
 namespace {
 
 const char* kMachine = R"(<?xml version="1.0"?>

@@ -8,6 +8,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
 namespace {
 
 /// Multitasking machine plus component errors of every basis type (polynomial on X and Z, Fourier on C and B,

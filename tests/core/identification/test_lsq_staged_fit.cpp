@@ -19,6 +19,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 using test::simulateBc;

@@ -14,6 +14,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const char* kTwelve = "dxBT dzBT aBT aXB bXB gXB aYZ bYZ dxCZ dyCZ aCZ bCZ";

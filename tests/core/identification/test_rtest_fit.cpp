@@ -9,6 +9,7 @@
 #include "cnccomp/identification/rtest_fit.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
 namespace {
 
 using Vec2 = Eigen::Vector2d;

@@ -15,6 +15,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::measurement;
 namespace {
 
 const MachineModel& tableTable() { return test::sampleMachine("table-table-ac"); }

@@ -14,6 +14,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 const std::string kFormat = "# cnccomp-deviations/2: location errors under ISO 230-1 names are ISO values (iso_names.hpp)\n";

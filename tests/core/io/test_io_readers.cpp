@@ -9,6 +9,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 // Runs `f`, expects an InputError whose message contains every piece of `parts`.

@@ -16,6 +16,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 namespace fs = std::filesystem;

@@ -15,6 +15,7 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 const std::string kSample = test::sourcePath("samples/laser/x-axis-iso230-2.csv");

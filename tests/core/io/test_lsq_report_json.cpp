@@ -11,6 +11,8 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
 namespace {
 
 IdentificationReport handMade() {

@@ -15,6 +15,7 @@
 #include "cnccomp/io/number_format.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::io;
 namespace {
 
 std::string exact(double v, int decimals) {

@@ -15,6 +15,9 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 const MachineModel& tableTable() { return test::sampleMachine("table-table-ac"); }
@@ -25,29 +28,29 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
     // for the ISO dialects) and every rapid (readPoses, the post-processor's modal reader) against the commands.
     const MachineModel& m = tableTable();
     const MeasurementPlan plan = samplePlan();
-    for (auto d : {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
-                   pp::Dialect::Heidenhain}) {
-        pp::testprog::ProbeProgramOptions o;
+    for (auto d : {postproc::Dialect::Rs274ngc, postproc::Dialect::Fanuc, postproc::Dialect::Sinumerik,
+                   postproc::Dialect::Heidenhain}) {
+        postproc::testprog::ProbeProgramOptions o;
         o.dialect = d;
-        const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(m, plan, o);
+        const postproc::testprog::ProbeProgram p = postproc::testprog::makeProbeProgram(m, plan, o);
         ASSERT_EQ(p.touches, 115);
         ASSERT_EQ(p.targets.size(), 115u);
         const std::string& text = p.files[0].text;
-        const auto targets = pp::testprog::readProbeTargets(m, text, d, p.files[0].file);
-        ASSERT_EQ(targets.size(), p.targets.size()) << pp::dialectName(d, pp::DialectUse::Write);
+        const auto targets = postproc::testprog::readProbeTargets(m, text, d, p.files[0].file);
+        ASSERT_EQ(targets.size(), p.targets.size()) << postproc::dialectName(d, postproc::DialectUse::Write);
         for (size_t i = 0; i < targets.size(); ++i)
             EXPECT_LT((targets[i] - p.targets[i].target).cwiseAbs().maxCoeff(), 1e-6)
-                << pp::dialectName(d, pp::DialectUse::Write) << " touch " << i;
+                << postproc::dialectName(d, postproc::DialectUse::Write) << " touch " << i;
         // Lines < 255 characters (LinuxCNC's LINELEN), the header says the kinematics mode.
         std::istringstream in(text);
         for (std::string l; std::getline(in, l);) EXPECT_LT(l.size(), 255u) << l;
-        if (d == pp::Dialect::Heidenhain) {
+        if (d == postproc::Dialect::Heidenhain) {
             ASSERT_EQ(p.files.size(), 2u);  // the FN 16 format file
             EXPECT_NE(p.files[1].text.find("TOUCH %1.0LF"), std::string::npos);
             continue;
         }
         // Every approach point is a rapid the modal reader finds, in order.
-        const auto rows = pp::testprog::readPoses(m, text, d, p.files[0].file);
+        const auto rows = postproc::testprog::readPoses(m, text, d, p.files[0].file);
         size_t next = 0;
         for (const auto& r : rows) {
             if (next == p.targets.size()) break;
@@ -59,14 +62,14 @@ TEST(ProbeProgram, EveryDialectReadsBackTheCommandedTouchTargets) {
             }
             if (same) ++next;
         }
-        EXPECT_EQ(next, p.targets.size()) << pp::dialectName(d, pp::DialectUse::Write);
+        EXPECT_EQ(next, p.targets.size()) << postproc::dialectName(d, postproc::DialectUse::Write);
     }
 }
 
 TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
-    pp::testprog::ProbeProgramOptions o;
+    postproc::testprog::ProbeProgramOptions o;
     o.log = "run1.txt";
-    const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(tableTable(), samplePlan(), o);
+    const postproc::testprog::ProbeProgram p = postproc::testprog::makeProbeProgram(tableTable(), samplePlan(), o);
     const std::string& t = p.files[0].text;
     EXPECT_EQ(p.files[0].file, "probe.ngc");
     EXPECT_NE(t.find("(LOGOPEN,run1.txt)\n"), std::string::npos);
@@ -82,7 +85,7 @@ TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
     EXPECT_NE(t.find("G49\n(LOGCLOSE)\nM2\n"), std::string::npos);
     EXPECT_LT(t.find("(LOGOPEN"), t.find("G38.3"));
     o.log = "a,b";
-    EXPECT_THROW(pp::testprog::makeProbeProgram(tableTable(), samplePlan(), o), ModelError);
+    EXPECT_THROW(postproc::testprog::makeProbeProgram(tableTable(), samplePlan(), o), ModelError);
 }
 
 TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheReaderReads) {
@@ -93,7 +96,7 @@ TEST(ProbeProgram, LinuxCncInterpreterReadsItProbesTheTargetsAndLogsLinesTheRead
     if (rs274.empty()) GTEST_SKIP() << "rs274 not found: LinuxCNC's interpreter comes with the Debian package linuxcnc-uspace";
     const MachineModel& m = tableTable();
     const MeasurementPlan plan = samplePlan();
-    const pp::testprog::ProbeProgram p = pp::testprog::makeProbeProgram(m, plan, {});
+    const postproc::testprog::ProbeProgram p = postproc::testprog::makeProbeProgram(m, plan, {});
     test::ScratchDir dir("probe-rs274");
     const std::string ngc = dir.file("probe.ngc"), out = dir.file("canon.txt"), log = dir.file("rs.log"),
                       tbl = dir.file("tool.tbl");

@@ -24,11 +24,14 @@
 #include "test_support.hpp"
 
 namespace cnccomp {
+using namespace cnccomp::identification;
+using namespace cnccomp::io;
+using namespace cnccomp::measurement;
 namespace {
 
 
-constexpr pp::Dialect kDialects[] = {pp::Dialect::Rs274ngc, pp::Dialect::Fanuc, pp::Dialect::Sinumerik,
-                                        pp::Dialect::Heidenhain};
+constexpr postproc::Dialect kDialects[] = {postproc::Dialect::Rs274ngc, postproc::Dialect::Fanuc, postproc::Dialect::Sinumerik,
+                                        postproc::Dialect::Heidenhain};
 
 struct SamplePlan {
     std::string file;
@@ -62,7 +65,7 @@ void expectSamePose(const MachineModel& m, const AxisVector& got, const AxisVect
 }
 
 /// The commands the simulation uses, straight from the simulation's own functions (not from RunMotion).
-AxisVector simulationCommands(const MachineModel& m, const pp::testprog::RunMotion& r, double t) {
+AxisVector simulationCommands(const MachineModel& m, const postproc::testprog::RunMotion& r, double t) {
     if (r.ballbar) return runCommands(m, *r.ballbar, t * kDeg);
     if (r.circle) return linearCircleCommands(m, *r.circle, t);
     if (r.dbb5) return dbb5Commands(m, *r.dbb5, t);
@@ -71,13 +74,13 @@ AxisVector simulationCommands(const MachineModel& m, const pp::testprog::RunMoti
     if (it == cache.end()) it = cache.emplace(r.rtest, rtestCommands(m, *r.rtest)).first;
     return it->second[static_cast<size_t>(t)];
 }
-AxisVector simulationSetup(const MachineModel& m, const pp::testprog::RunMotion& r) {
+AxisVector simulationSetup(const MachineModel& m, const postproc::testprog::RunMotion& r) {
     if (r.ballbar) return setupCommands(m, *r.ballbar);
     if (r.dbb5) return dbb5SetupCommands(m, *r.dbb5);
     if (r.circle) return linearCircleCentreCommands(m, *r.circle);
     return rtestCommands(m, *r.rtest).front();
 }
-std::vector<double> simulationSamples(const pp::testprog::RunMotion& r) {
+std::vector<double> simulationSamples(const postproc::testprog::RunMotion& r) {
     if (r.ballbar) return r.ballbar->anglesDeg();
     if (r.dbb5) return r.dbb5->anglesDeg();
     if (r.circle) return r.circle->dataAnglesDeg();
@@ -91,23 +94,23 @@ TEST(TestPrograms, EveryDialectReadsBackToTheSimulationsPosesForEverySamplePlan)
     // → commands, against the commands simulate / simulate-runs evaluate ([MultiTasking] Table 2, [IbarakiDBB5], [Moravek2019] / [RotaryTableModel]).
     ASSERT_GE(samplePlans().size(), 8u);
     for (const SamplePlan& sp : samplePlans()) {
-        const auto motions = pp::testprog::planMotions(sp.machine, sp.plan);
-        for (pp::Dialect d : kDialects) {
-            pp::testprog::TestProgramOptions o;
+        const auto motions = postproc::testprog::planMotions(sp.machine, sp.plan);
+        for (postproc::Dialect d : kDialects) {
+            postproc::testprog::TestProgramOptions o;
             o.dialect = d;
-            const auto set = pp::testprog::makeTestPrograms(sp.machine, sp.plan, o);
+            const auto set = postproc::testprog::makeTestPrograms(sp.machine, sp.plan, o);
             ASSERT_EQ(set.programs.size(), motions.size());
             for (size_t i = 0; i < motions.size(); ++i) {
                 const auto& r = motions[i];
-                const std::string where = sp.file + " " + pp::dialectName(d, pp::DialectUse::Write) + " run " + r.name;
-                const auto back = pp::testprog::readTestProgram(sp.machine, r, set.programs[i].text, d, where);
+                const std::string where = sp.file + " " + postproc::dialectName(d, postproc::DialectUse::Write) + " run " + r.name;
+                const auto back = postproc::testprog::readTestProgram(sp.machine, r, set.programs[i].text, d, where);
                 expectSamePose(sp.machine, back.setup, simulationSetup(sp.machine, r), where + " setup");
                 const std::vector<double> samples = simulationSamples(r);
                 ASSERT_EQ(back.passes.size(), 2u) << where;
                 for (const auto& pass : back.passes) {
                     std::vector<double> t;
                     std::vector<AxisVector> q;
-                    pp::testprog::passSamples(r, pass, t, q);
+                    postproc::testprog::passSamples(r, pass, t, q);
                     ASSERT_EQ(t.size(), samples.size()) << where << " pass " << pass.label;
                     // Every sample of the simulation once per pass, in one direction.
                     std::vector<double> sorted = t;
@@ -132,7 +135,7 @@ TEST(TestPrograms, BallBarSweepsAreCircularBlocksCwFirstWithOvershootInsideTheTr
     for (const auto& sp : samplePlans())
         if (sp.file == "multitasking-six-circles.xml") six = &sp;
     ASSERT_TRUE(six);
-    const auto set = pp::testprog::makeTestPrograms(six->machine, six->plan, {});
+    const auto set = postproc::testprog::makeTestPrograms(six->machine, six->plan, {});
     for (const auto& p : set.programs) {
         EXPECT_TRUE(p.arcs) << p.run;
         EXPECT_EQ(p.firstPass, "CW") << p.run;
@@ -149,7 +152,7 @@ TEST(TestPrograms, BallBarSweepsAreCircularBlocksCwFirstWithOvershootInsideTheTr
     // The tilting head's absolute runs use the whole B travel: no overshoot is possible.
     for (const auto& sp : samplePlans())
         if (sp.file == "tilting-head-b-patterns.xml")
-            for (const auto& p : pp::testprog::makeTestPrograms(sp.machine, sp.plan, {}).programs) {
+            for (const auto& p : postproc::testprog::makeTestPrograms(sp.machine, sp.plan, {}).programs) {
                 EXPECT_EQ(p.overshootStart, 0.0) << p.run;
                 EXPECT_EQ(p.overshootEnd, 0.0) << p.run;
             }
@@ -228,7 +231,7 @@ TEST(TestPrograms, LinuxCncInterpreterReadsEveryProgramAndMakesTheSameMoves) {
     for (const SamplePlan& sp : samplePlans()) {
         // These two repeat run types of multitasking-six-circles (B-X, B-Y, C-axial, C-radial) with other geometry.
         if (sp.file == "lsq-multitasking-b-runs.xml" || sp.file == "lsq-multitasking-mounting.xml") continue;
-        const auto set = pp::testprog::makeTestPrograms(sp.machine, sp.plan, {});
+        const auto set = postproc::testprog::makeTestPrograms(sp.machine, sp.plan, {});
         for (const auto& p : set.programs) {
             const std::string ngc = dir.file(p.file), out = dir.file(p.file + ".canon"), log = dir.file(p.file + ".log");
             test::writeText(ngc, p.text);
@@ -236,7 +239,7 @@ TEST(TestPrograms, LinuxCncInterpreterReadsEveryProgramAndMakesTheSameMoves) {
             const int status = std::system(cmd.c_str());
             ASSERT_EQ(status, 0) << sp.file << " " << p.file << ": rs274 failed:\n" << test::readText(log);
             const std::vector<CanonMove> canon = parseCanon(test::readText(out));
-            const auto rows = pp::testprog::readPoses(sp.machine, p.text, pp::Dialect::Rs274ngc, p.file);
+            const auto rows = postproc::testprog::readPoses(sp.machine, p.text, postproc::Dialect::Rs274ngc, p.file);
             ASSERT_EQ(canon.size(), rows.size()) << sp.file << " " << p.file;
             for (size_t i = 0; i < rows.size(); ++i) {
                 const auto& r = rows[i];
@@ -271,7 +274,7 @@ TEST(TestPrograms, ARunOutsideTheTravelNamesRunAndAxisAndWritesNothing) {
     m.finalize();
     const MeasurementPlan plan = readPlanXml(test::sourcePath("samples/plans/multitasking-six-circles.xml"));
     try {
-        pp::testprog::makeTestPrograms(m, plan, {});
+        postproc::testprog::makeTestPrograms(m, plan, {});
         FAIL() << "expected a travel error";
     } catch (const ModelError& e) {
         const std::string what = e.what();
@@ -323,32 +326,32 @@ TEST(TestPrograms, ProgramsStartAndEndInTheirDialectsFrame) {
     for (const auto& sp : samplePlans())
         if (sp.file == "multitasking-six-circles.xml") six = &sp;
     ASSERT_TRUE(six);
-    const auto motions = pp::testprog::planMotions(six->machine, six->plan);
-    const auto text = [&](pp::Dialect d) {
-        pp::testprog::TestProgramOptions o;
+    const auto motions = postproc::testprog::planMotions(six->machine, six->plan);
+    const auto text = [&](postproc::Dialect d) {
+        postproc::testprog::TestProgramOptions o;
         o.dialect = d;
-        return pp::testprog::makeTestProgram(six->machine, motions[3], 4, o).text;
+        return postproc::testprog::makeTestProgram(six->machine, motions[3], 4, o).text;
     };
-    const std::string fanuc = text(pp::Dialect::Fanuc);
+    const std::string fanuc = text(postproc::Dialect::Fanuc);
     EXPECT_EQ(fanuc.rfind("%\nO1004 (TP04_C_RADIAL)\n", 0), 0u) << fanuc.substr(0, 40);
     EXPECT_NE(fanuc.find("G10 L2 P1 X0.000000 Y0.000000 Z0.000000 B0.000000 C0.000000"), std::string::npos);
     EXPECT_EQ(fanuc.substr(fanuc.size() - 2), "%\n");
-    const std::string siemens = text(pp::Dialect::Sinumerik);
+    const std::string siemens = text(postproc::Dialect::Sinumerik);
     EXPECT_NE(siemens.find("G500"), std::string::npos);
     EXPECT_NE(siemens.find("; CNCCOMP PASS 1 CW BEGIN"), std::string::npos);
-    const std::string ngc = text(pp::Dialect::Rs274ngc);
+    const std::string ngc = text(postproc::Dialect::Rs274ngc);
     EXPECT_NE(ngc.find("(MSG, MOUNT THE BAR"), std::string::npos);
     EXPECT_NE(ngc.find(" G2 X"), std::string::npos) << "C-radial circles: XY plane, CW first";
     EXPECT_EQ(ngc.find("G18"), std::string::npos);
-    const std::string h = text(pp::Dialect::Heidenhain);
+    const std::string h = text(postproc::Dialect::Heidenhain);
     EXPECT_EQ(h.find(" CC X"), std::string::npos) << "C turns with the circle: straight blocks on a TNC [G]";
     EXPECT_NE(h.find(" L X+"), std::string::npos);
     // A DBB5 linear circle has no rotary axis in it: CC and C blocks, clockwise first.
     for (const auto& sp : samplePlans())
         if (sp.file == "dbb5-table-table-ac.xml") {
-            pp::testprog::TestProgramOptions o;
-            o.dialect = pp::Dialect::Heidenhain;
-            const auto p = pp::testprog::makeTestProgram(sp.machine, pp::testprog::planMotions(sp.machine, sp.plan)[0], 1, o);
+            postproc::testprog::TestProgramOptions o;
+            o.dialect = postproc::Dialect::Heidenhain;
+            const auto p = postproc::testprog::makeTestProgram(sp.machine, postproc::testprog::planMotions(sp.machine, sp.plan)[0], 1, o);
             EXPECT_TRUE(p.arcs);
             EXPECT_NE(p.text.find(" CC X+0.000000 Y+0.000000"), std::string::npos);
             EXPECT_NE(p.text.find(" DR- R0"), std::string::npos);
@@ -375,27 +378,27 @@ TEST(TestPrograms, LinearCircleEveryDialectReadsBackThePlansCircleFeedAndDirecti
     test::ScratchDir dir("testprog-circle");
     test::writeText(dir.file("p.xml"), circle_programs::kCirclePlan);
     const MeasurementPlan plan = readPlanXml(dir.file("p.xml"));
-    const auto motions = pp::testprog::planMotions(m, plan);
+    const auto motions = postproc::testprog::planMotions(m, plan);
     ASSERT_EQ(motions.size(), 2u);
-    for (pp::Dialect d : kDialects) {
-        pp::testprog::TestProgramOptions o;
+    for (postproc::Dialect d : kDialects) {
+        postproc::testprog::TestProgramOptions o;
         o.dialect = d;
         o.feed = 333;          // the plan's feed wins for circles
         o.overshootDeg = 20;   // and its overshoot
-        const auto set = pp::testprog::makeTestPrograms(m, plan, o);
+        const auto set = postproc::testprog::makeTestPrograms(m, plan, o);
         ASSERT_EQ(set.programs.size(), 2u);
         for (size_t i = 0; i < 2; ++i) {
-            const pp::testprog::TestProgram& p = set.programs[i];
+            const postproc::testprog::TestProgram& p = set.programs[i];
             const LinearCircleRun& c = plan.circleRuns[i];
-            const std::string where = std::string(pp::dialectName(d, pp::DialectUse::Write)) + " " + c.name;
+            const std::string where = std::string(postproc::dialectName(d, postproc::DialectUse::Write)) + " " + c.name;
             EXPECT_TRUE(p.arcs) << where;
-            EXPECT_EQ(p.kind, pp::testprog::RunKind::LinearCircle);
+            EXPECT_EQ(p.kind, postproc::testprog::RunKind::LinearCircle);
             EXPECT_EQ(p.firstPass, i == 0 ? "CCW" : "CW") << where;
             EXPECT_DOUBLE_EQ(p.overshootStart, c.capture.overshootDeg) << where;
             EXPECT_EQ(p.samples, c.dataAnglesDeg().size());
             EXPECT_NE(p.text.find(fmt::format("F{:g}", c.capture.feed)), std::string::npos) << where;
             EXPECT_EQ(p.text.find("F333"), std::string::npos) << where;
-            const auto back = pp::testprog::readTestProgram(m, motions[i], p.text, d, where);
+            const auto back = postproc::testprog::readTestProgram(m, motions[i], p.text, d, where);
             expectSamePose(m, back.setup, linearCircleCentreCommands(m, c), where + " setup");
             ASSERT_EQ(back.passes.size(), 2u);
             EXPECT_EQ(back.passes[0].label, i == 0 ? "CCW" : "CW") << where;
@@ -418,7 +421,7 @@ TEST(TestPrograms, LinearCircleLinuxCncInterpreterMakesTheCircle) {
     test::ScratchDir dir("testprog-circle-rs274");
     test::writeText(dir.file("p.xml"), circle_programs::kCirclePlan);
     const MeasurementPlan plan = readPlanXml(dir.file("p.xml"));
-    const auto set = pp::testprog::makeTestPrograms(m, plan, {});
+    const auto set = postproc::testprog::makeTestPrograms(m, plan, {});
     const std::string tbl = dir.file("tool.tbl");
     test::writeText(tbl, "");
     for (size_t i = 0; i < set.programs.size(); ++i) {

@@ -19,14 +19,14 @@ struct Row {
     std::string cells[6];
 };
 
-std::vector<Row> poses(const std::string& program, pp::Setup setup = {}) {
-    pp::PosesOptions o;
-    o.dialect = pp::Dialect::Heidenhain;
+std::vector<Row> poses(const std::string& program, postproc::Setup setup = {}) {
+    postproc::PosesOptions o;
+    o.dialect = postproc::Dialect::Heidenhain;
     o.setup = std::move(setup);
     o.inputName = "test.h";
     std::istringstream in(program);
     std::ostringstream csv;
-    pp::writePoses(pp::AxisLayout::generic(), in, csv, o);
+    postproc::writePoses(postproc::AxisLayout::generic(), in, csv, o);
     std::vector<Row> rows;
     std::istringstream lines(csv.str());
     std::string l;
@@ -59,8 +59,8 @@ void expectError(const std::string& program, int line, const std::string& words)
 }
 
 TEST(Klartext, DetectedFromBeginPgmAndDispatchedByPoses) {
-    EXPECT_EQ(pp::detectDialect("0 BEGIN PGM ABC MM\n1 L X+0 R0 FMAX\n").dialect, pp::Dialect::Heidenhain);
-    EXPECT_EQ(pp::detectDialect("(BEGIN PGM in a comment)\nG0 X1\n").dialect, pp::Dialect::Rs274ngc);
+    EXPECT_EQ(postproc::detectDialect("0 BEGIN PGM ABC MM\n1 L X+0 R0 FMAX\n").dialect, postproc::Dialect::Heidenhain);
+    EXPECT_EQ(postproc::detectDialect("(BEGIN PGM in a comment)\nG0 X1\n").dialect, postproc::Dialect::Rs274ngc);
     test::ScratchDir dir("klartext-cli");
     test::writeText(dir.file("p.h"), "0 BEGIN PGM P MM\n1 L X+10 Y-5 Z+100 R0 FMAX\n2 END PGM P MM\n");
     const auto r = test::runCli("poses --in " + dir.file("p.h"));
@@ -152,7 +152,7 @@ TEST(Klartext, RadiusTangentialAndPolarBlocks) {
 }
 
 TEST(Klartext, ToolLengthDatumShiftMachineCoordinatesAndInch) {
-    pp::Setup setup;
+    postproc::Setup setup;
     setup.toolLengths.emplace_back(3, 120.0);
     const auto rows = poses(
         "0 BEGIN PGM D MM\n"
