@@ -8,7 +8,9 @@
 // unless RTAPI_UID names another user and RTAPI_FIFO_PATH a fifo that user can create; `[EMC] VERSION = 1.1` keeps
 // the INI updater (a GUI) away; the INI folder must be writable; one LinuxCNC per machine (/tmp/linuxcnc.lock, fixed
 // shared-memory keys), so the tests that start it share a ctest RESOURCE_LOCK; a comp value is ramped in by a
-// filter whose residual is bounded by 0.5·MAX_ACCELERATION·SERVO_PERIOD², hence a 50 µs servo period here; on a
+// filter whose residual is bounded by 0.5·a·SERVO_PERIOD², a being the joint's acceleration limit, which control.c caps
+// at [TRAJ] DEFAULT_LINEAR_ACCELERATION after homing (free mode; measured: tests/linuxcnc/test_linuxcnc_backlash.cpp),
+// hence a 50 µs servo period here; on a
 // loaded machine (ctest -j, POSIX non-realtime threads) motion answers task late: [EMCMOT] COMM_TIMEOUT = 30 s, since
 // a timed-out command is sent again and the comp-table loader then refuses the repeated line ("compensation values
 // must increase"); a move is over when the commanded position has reached the block's words (driver.py).
