@@ -14,8 +14,7 @@ namespace cnccomp::postproc::iso {
 class FrontEnd {
 public:
     FrontEnd(const MachineModel& m, const DeviationSet& d, const CorrectOptions& o, Dialect dialect, LineReader& reader)
-        : machine_(m),
-          options_(o),
+        : options_(o),
           dialect_(dialect),
           layout_(AxisLayout::fromMachine(m)),
           interp_(layout_, InterpreterOptions{dialect, o.setup, o.rotaryShortest, o.tcpOnM, o.tcpOffM}),
@@ -35,7 +34,6 @@ private:
     void move(Record& rec);
     void refuse(Record& rec, const char* reason);
 
-    const MachineModel& machine_;
     const CorrectOptions& options_;
     Dialect dialect_;
     AxisLayout layout_;

@@ -25,8 +25,7 @@ class KlartextCorrector {
 public:
     KlartextCorrector(const MachineModel& m, const DeviationSet& d, const CorrectOptions& o, CorrectSummary& s,
                       OutputBuffer& out)
-        : machine_(m),
-          options_(o),
+        : options_(o),
           layout_(AxisLayout::fromMachine(m)),
           corrector_(m, d, o.corrector),
           interp_(layout_, o.setup, o.inputName),
@@ -83,7 +82,6 @@ private:
     }
     void dropToken(int i);
 
-    const MachineModel& machine_;
     const CorrectOptions& options_;
     AxisLayout layout_;
     Corrector corrector_;
