@@ -136,9 +136,7 @@ double ProgramCorrector::toleranceFor(const MoveSpace& space, uint64_t no) {
 
 void ProgramCorrector::switchMode() {
     // The same machine position read in the new mode (the front end did the same for the nominal program).
-    AxisMask rotary = 0;
-    for (int a = 0; a < layout_.count; ++a)
-        if (layout_.rotary[a]) rotary |= 1u << a;
+    const AxisMask rotary = layout_.rotaryAxes();
     if (convertWhere(corrector_, outAt_, MoveSpace{r_->mode, r_->controlLength, r_->tipLength}, r_->end)) {
         outPos_ = outAt_.point.p;
         outKnown_ = all_;

@@ -62,9 +62,7 @@ void FrontEnd::afterPassThrough(const BlockResult& r) {
 void FrontEnd::switchMode(const BlockResult& r) {
     // The controller's position is the same machine; what the program's numbers mean changes (LinuxCNC re-reads the
     // world position of the new kinematics at the switch: M66 E0 L0 in the M428/M429 remaps).
-    AxisMask rotary = 0;
-    for (int a = 0; a < layout_.count; ++a)
-        if (layout_.rotary[a]) rotary |= 1u << a;
+    const AxisMask rotary = layout_.rotaryAxes();
     if (convertWhere(corrector_, nomAt_, MoveSpace{r.mode, r.controlLength, r.tipLength}, r.end)) {
         interp_.setPosition(nomAt_.point.p, all_);
     } else {

@@ -311,9 +311,7 @@ void KlartextInterpreter::mOnly(const std::vector<std::string>& rest, KlartextBl
 }
 
 void KlartextInterpreter::switchTcp(ProgramMode to, KlartextBlock&) {
-    AxisMask rotary = 0;
-    for (int a = 0; a < L_.count; ++a)
-        if (L_.rotary[a]) rotary |= 1u << a;
+    const AxisMask rotary = L_.rotaryAxes();
     if (convert_) known_ = convert_(mode_, to, tlo_, pos_, known_);
     else known_ &= rotary;
     mode_ = to;

@@ -38,6 +38,13 @@ struct AxisLayout {
         return upperLetter >= 'A' && upperLetter <= 'Z' ? ofLetter[upperLetter - 'A'] : -1;
     }
     AxisMask all() const { return count >= 32 ? ~0u : ((1u << count) - 1u); }
+    /// The rotary axes (bit a: axis a).
+    AxisMask rotaryAxes() const {
+        AxisMask m = 0;
+        for (int a = 0; a < count; ++a)
+            if (rotary[a]) m |= 1u << a;
+        return m;
+    }
 };
 
 enum class Motion : uint8_t { Unknown, Rapid, Linear, ArcCw, ArcCcw, Cycle, Other };

@@ -47,9 +47,7 @@ PosesSummary writePoses(const AxisLayout& layout, std::istream& in, std::ostream
         if (r.modeSwitch) {
             // Without the machine's kinematics the position cannot be carried into the other mode: rotary angles are
             // the same numbers in both, the linear positions are unknown until the program names them.
-            AxisMask rotary = 0;
-            for (int a = 0; a < layout.count; ++a)
-                if (layout.rotary[a]) rotary |= 1u << a;
+            const AxisMask rotary = layout.rotaryAxes();
             interp.setPosition(interp.position(), interp.known() & rotary);
         }
         const bool moveRow = r.kind == BlockKind::Move;
