@@ -1,7 +1,7 @@
 #pragma once
 // Identification as a library: the machine's deviations from a measurement plan and its measured runs, in one call.
-// `cnccomp identify` is a thin layer over it (src/cli/cmd_identify.cpp: parse → options → identify() → print, write);
-// tests call it directly.
+// `cnccomp identify` is a thin layer over it (src/cli/cmd_identify.cpp: parse → options → identify() → write the files
+// with identify_outputs.hpp → print); tests call both directly.
 //
 // The steps, in order (each fails with a ModelError / InputError naming what does not fit, before the next):
 //   1. the options alone (validateOptions, identify_options.hpp; as Ceres' Solver::Options::IsValid), then the bounds

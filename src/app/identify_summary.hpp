@@ -2,8 +2,8 @@
 // What an identification found (the façade's result, src/app/identify.hpp), with its reports as text: the brief
 // report (one line: what was identified, how) and the full report (the method's tables, the brief line, the
 // least-squares report or the circles' diagnostics), as Ceres' Solver::Summary gives BriefReport() and FullReport()
-// (ceres-solver, include/ceres/solver.h). Nothing is printed or written here: `cnccomp identify` prints the text and
-// stages the files.
+// (ceres-solver, include/ceres/solver.h). Nothing is printed or written here: identify_outputs.hpp stages and
+// commits the files, `cnccomp identify` prints the text.
 #include <functional>
 #include <optional>
 #include <ostream>
