@@ -354,7 +354,7 @@ static int ck_damping(double J[6][CK_NAX], double D[CK_NAX][CK_NAX]) {
 }
 
 /* Normal equations of the weighted residual; reg != 0 adds the damping of the rotary joints towards anchor
- * (ck_damping: N += D, g += D (anchor - q)) and the constant pull CK_REG of the extra linear joints in tool-tip mode. */
+ * (ck_damping: N += D, g += D (anchor - q)) and the constant pull CK_REG of the extra linear joints (not X Y Z). */
 static void ck_normal(double J[6][CK_NAX], const double *tip_t, const double *ax_t, const double *tip,
                       const double *ax, const double *q, const double *anchor, int reg, double N[CK_NAX][CK_NAX],
                       double *g) {

@@ -99,7 +99,8 @@ struct KinsComponentOptions {
 std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, const KinsComponentOptions& o = {});
 
 /// cnccomp's inverse (solveToolPose) with the component's objective: its weights, singular-pose policy and polish, and
-/// a tolerance at least as tight as the component's. The apply model (component_route.hpp) and the tests solve with these.
+/// a tolerance at least as tight as the component's. The apply model (component_route.hpp) and the tests solve with
+/// these.
 IkOptions kinsSolverOptions(const KinsComponentOptions& o = {});
 
 /// HAL pin name (without the component prefix) of coefficient k of deviation `index` of `m`: "dev.<lower iso name>"

@@ -22,8 +22,8 @@ ToolPose toolPose(const Kinematics& k, const AxisVector& q, const Vec3& tipInToo
 void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, PoseJacobian& J);
 
 /// The smallest singular value σ of J's axis rows over the rotary axes of m (rad/rad: the sine of the angle between the
-/// tool axis and the rotary axis that cannot turn it; 1 when the machine has no rotary axis): below IkOptions::singularZone
-/// the singular-pose policy damps.
+/// tool axis and the rotary axis that cannot turn it; 1 when the machine has no rotary axis): below
+/// IkOptions::singularZone the singular-pose policy damps.
 double rotarySingularValue(const MachineModel& m, const PoseJacobian& J);
 
 struct IkOptions {

@@ -370,8 +370,8 @@ TEST(LinuxcncKinsComponent, JointModeIndependentOfToolLengthWhereTheAxisIsMatche
     }
 }
 
-// The multi-tasking machine at B = 0 and ±180° (tool axis parallel to C: C cannot turn the axis), next to it, inside the
-// singular zone and at its edge (σ = sin B = 0.1 at 5.74°): the tip is still met, C stays next to its command (the
+// The multi-tasking machine at B = 0 and ±180° (tool axis parallel to C: C cannot turn the axis), next to it, inside
+// the singular zone and at its edge (σ = sin B = 0.1 at 5.74°): the tip is still met, C stays next to its command (the
 // singular-pose policy's damping), nothing fails, forward∘inverse is the identity, and the joints are cnccomp's inverse
 // with the same policy (solveToolPose with kinsSolverOptions: the C's Jacobi eigen-decomposition and damping against
 // Eigen's) to 1e-9 mm / deg.

@@ -1,8 +1,8 @@
 // The singular pose (tool axis parallel to a rotary axis) through the configurations of the inverse solver
 // (src/cnccomp/pose_solver.hpp, one damped step): the core's solveToolPose as the controllers' apply models and verify
 // use it (IkOptions: constant rotary pull + polish), as the LinuxCNC kinematics component mirrors it
-// (kinsSolverOptions: the singular-pose policy with a zone, no polish), and correct's chord Newton (postproc/correction:
-// the same policy with its own λ and zone). This test fixes what they share at the
+// (kinsSolverOptions: the singular-pose policy with a zone, no polish), and correct's chord Newton
+// (postproc/correction: the same policy with its own λ and zone). This test fixes what they share at the
 // singular pose: the tip is met, the rotary axis that cannot turn the tool axis stays where it was commanded (no
 // swing), and the tool-axis error that no axis can remove is left, the same in all three. Oracle: the exact forward
 // kinematics (cnccomp::Kinematics) at each solution.
