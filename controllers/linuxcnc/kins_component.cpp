@@ -46,7 +46,8 @@ std::string flatPose(const Pose& p) {
 // The C part (after ";;") that does not depend on the machine. Written from the model of src/cnccomp/kinematics.cpp
 // (link i = placement · E_location · motion(q) · E_component(q), errorTransform = translation then the exact rotation
 // of the rotation vector) and the solver of src/cnccomp/inverse_kinematics.cpp (Gauss–Newton on
-// |tip error|² + w²|axis error|² + r²|rotary − anchor|², screw Jacobian, then ≤ 4 polish steps without the pull).
+// |tip error|² + w²|axis error|² + (rotary − anchor)ᵀ D (rotary − anchor), D the singular-pose policy's damping of
+// src/cnccomp/pose_solver.hpp, screw Jacobian, then ≤ 4 polish steps without the damping when CK_POLISH).
 constexpr const char* kBody = R"C(
 /* ---------------------------------------------------------------------------------------------------------------
  * Machine-independent part: pose algebra, the two chains, the solver, the LinuxCNC entry points.
@@ -283,18 +284,31 @@ static int ck_cholesky_solve(double N[CK_NAX][CK_NAX], const double *g, double *
     return 0;
 }
 
-/* Smallest singular value of the tool axis' derivative over the rotary joints (rows 3..5 of J), by cyclic Jacobi
- * rotations of their Gram matrix (cnccomp::rotarySingularValue); 1 without rotary joints. */
-static double ck_rotary_sigma(double J[6][CK_NAX]) {
-    double G[CK_NAX][CK_NAX], lo;
-    int idx[CK_NAX], n = 0, a, b, k, sweep;
+/* The singular-pose policy (cnccomp::SingularPosePolicy, src/cnccomp/pose_solver.hpp) at this Jacobian: the damping
+ * D = CK_REG^2 sum_i phi(sigma_i) v_i v_i^T of the rotary joints (rows and columns of the rotary joints, 0 elsewhere),
+ * sigma_i^2 and v_i the eigenvalues and unit eigenvectors of G = Ja^T Ja, Ja the tool axis' derivatives by the rotary
+ * joints (rows 3..5 of J, unweighted: sigma in rad/rad), phi(s) = (1 - s/CK_SINGULAR_ZONE)^2 below the zone and 0 at
+ * or above it; without a zone phi = 1 (D = CK_REG^2 I). Eigen-decomposition by cyclic Jacobi rotations with the
+ * eigenvectors accumulated: none for one rotary joint, exactly one (the closed form) for two, sweeps until the
+ * off-diagonal part vanishes for three or more. 0 when no direction is damped (D = 0). */
+static int ck_damping(double J[6][CK_NAX], double D[CK_NAX][CK_NAX]) {
+    double G[CK_NAX][CK_NAX], V[CK_NAX][CK_NAX];
+    const double lam2 = CK_REG * CK_REG;
+    int idx[CK_NAX], n = 0, a, b, k, e, sweep, any = 0;
+    for (a = 0; a < CK_NAX; ++a)
+        for (b = 0; b < CK_NAX; ++b) D[a][b] = 0.0;
     for (a = 0; a < CK_NAX; ++a)
         if (ck_rotary[a]) idx[n++] = a;
-    if (n == 0) return 1.0;
+    if (n == 0) return 0;
+    if (!(CK_SINGULAR_ZONE > 0)) {
+        for (a = 0; a < n; ++a) D[idx[a]][idx[a]] = lam2;
+        return 1;
+    }
     for (a = 0; a < n; ++a)
         for (b = 0; b < n; ++b) {
             G[a][b] = 0.0;
             for (k = 0; k < 3; ++k) G[a][b] += J[3 + k][idx[a]] * J[3 + k][idx[b]];
+            V[a][b] = a == b ? 1.0 : 0.0;
         }
     for (sweep = 0; sweep < 12; ++sweep) {
         double off = 0.0;
@@ -314,7 +328,11 @@ static double ck_rotary_sigma(double J[6][CK_NAX]) {
                 G[b][b] += t * G[a][b];
                 G[a][b] = G[b][a] = 0.0;
                 for (k = 0; k < n; ++k) {
-                    double gka, gkb;
+                    double gka, gkb, vka, vkb;
+                    vka = V[k][a];
+                    vkb = V[k][b];
+                    V[k][a] = vka - sn * (vkb + tau * vka);
+                    V[k][b] = vkb + sn * (vka - tau * vkb);
                     if (k == a || k == b) continue;
                     gka = G[k][a];
                     gkb = G[k][b];
@@ -323,28 +341,25 @@ static double ck_rotary_sigma(double J[6][CK_NAX]) {
                 }
             }
     }
-    lo = G[0][0];
-    for (a = 1; a < n; ++a)
-        if (G[a][a] < lo) lo = G[a][a];
-    return lo > 0 ? sqrt(lo) : 0.0;
+    for (e = 0; e < n; ++e) {
+        const double sigma = G[e][e] > 0 ? sqrt(G[e][e]) : 0.0;
+        double phi;
+        if (!(sigma < CK_SINGULAR_ZONE)) continue;
+        phi = (1.0 - sigma / CK_SINGULAR_ZONE) * (1.0 - sigma / CK_SINGULAR_ZONE);
+        for (a = 0; a < n; ++a)
+            for (b = 0; b < n; ++b) D[idx[a]][idx[b]] += lam2 * phi * V[a][e] * V[b][e];
+        any = 1;
+    }
+    return any;
 }
 
-/* Weight of the rotary joints' pull at this Jacobian (cnccomp::IkOptions::singularZone): constant CK_REG without a
- * zone, else CK_REG (1 - (sigma/zone)^2) inside it and CK_REG * 1e-4 outside (a floor that keeps the normal
- * equations regular). */
-static double ck_pull(double J[6][CK_NAX]) {
-    double s;
-    if (!(CK_SINGULAR_ZONE > 0)) return CK_REG;
-    s = ck_rotary_sigma(J) / CK_SINGULAR_ZONE;
-    return CK_REG * (s >= 1.0 ? 1e-4 : (1.0 - s * s > 1e-4 ? 1.0 - s * s : 1e-4));
-}
-
-/* Normal equations of the weighted residual; reg != 0 adds the pull of the regularised joints towards anchor. */
+/* Normal equations of the weighted residual; reg != 0 adds the damping of the rotary joints towards anchor
+ * (ck_damping: N += D, g += D (anchor - q)) and the constant pull CK_REG of the extra linear joints (not X Y Z). */
 static void ck_normal(double J[6][CK_NAX], const double *tip_t, const double *ax_t, const double *tip,
                       const double *ax, const double *q, const double *anchor, int reg, double N[CK_NAX][CK_NAX],
                       double *g) {
-    double r[6];
-    const double pull = reg ? ck_pull(J) : 0.0;
+    double r[6], D[CK_NAX][CK_NAX];
+    const int damped = reg ? ck_damping(J, D) : 0;
     int i, j, k;
     for (k = 0; k < 3; ++k) {
         r[k] = tip_t[k] - tip[k];
@@ -354,14 +369,15 @@ static void ck_normal(double J[6][CK_NAX], const double *tip_t, const double *ax
         for (j = 0; j < CK_NAX; ++j) {
             double s = 0.0;
             for (k = 0; k < 3; ++k) s += J[k][i] * J[k][j] + CK_AXIS_WEIGHT * CK_AXIS_WEIGHT * J[3 + k][i] * J[3 + k][j];
-            N[i][j] = s;
+            N[i][j] = damped ? s + D[i][j] : s;
         }
         g[i] = 0.0;
         for (k = 0; k < 3; ++k) g[i] += J[k][i] * r[k] + CK_AXIS_WEIGHT * J[3 + k][i] * r[3 + k];
-        if (reg && ck_regularised[i]) {
-            const double w = ck_rotary[i] ? pull : CK_REG; /* extra linear axes (tool-tip mode): constant */
-            N[i][i] += w * w;
-            g[i] += w * w * (anchor[i] - q[i]);
+        if (damped)
+            for (j = 0; j < CK_NAX; ++j) g[i] += D[i][j] * (anchor[j] - q[j]);
+        if (reg && ck_regularised[i] && !ck_rotary[i]) { /* extra linear joints (tool-tip mode): constant pull */
+            N[i][i] += CK_REG * CK_REG;
+            g[i] += CK_REG * CK_REG * (anchor[i] - q[i]);
         }
     }
 }

@@ -32,17 +32,23 @@ struct KinsComponentOptions {
     double tolerance = 1e-11;
     /// mm per rad: weight of a tool-axis error against a tip error (as cnccomp::IkOptions::axisWeight).
     double axisWeight = 100.0;
-    /// mm per rad: pull of the rotary joints towards the nominal (joint mode) or commanded (tool-tip mode) angles,
-    /// as cnccomp::IkOptions::rotaryRegularization, acting only near a singular pose (singularZone): there the tool
-    /// axis cannot be turned by the rotary axes without swinging them. Chosen as axisWeight · singularZone, so the
-    /// pull and the axis weigh alike where the pull fades out.
+    /// mm per rad: λ of the singular-pose policy (cnccomp::SingularPosePolicy, src/cnccomp/pose_solver.hpp; as
+    /// cnccomp::IkOptions::rotaryRegularization): the damping D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ pulls the rotary joints towards
+    /// the nominal (joint mode) or commanded (tool-tip mode) angles in the directions that cannot turn the tool axis,
+    /// only near a singular pose (singularZone): damped least squares with variable damping [NakamuraHanafusa1986],
+    /// [Chiaverini1994] in the ill-conditioned directions only [MaciejewskiKlein1988]. Chosen as
+    /// axisWeight · singularZone, so the pull and the axis weigh alike where the damping fades out. Extra linear
+    /// joints (not X Y Z, on a machine with linear X Y Z) keep a constant pull of this weight in the component
+    /// (solveToolPose has none; no sample machine has such a joint).
     double rotaryRegularization = 10.0;
-    /// cnccomp::IkOptions::singularZone: the sine of the angle between the tool axis and a rotary axis below which
-    /// the pull acts (0.1: 5.7°). Outside it the axis is met exactly; inside, a tool-axis error δ turns the rotary
-    /// axes by at most about δ/0.1 = 10·δ (0.014° for 5″), smoothly across the singular pose, and the tip at the
-    /// tool-offset length is exact everywhere (the slides can always place it). With a constant pull of 0.1 mm/rad
-    /// the real LinuxCNC swung C by ±1.8° within a few servo cycles at B = ±180° on the multi-tasking sample (3 mm
-    /// of Y, 1.5 µm off the path after motion's joint interpolation).
+    /// cnccomp::IkOptions::singularZone: σ0 of the policy, the sine of the angle between the tool axis and a rotary
+    /// axis below which the damping acts in that direction, weighted φ(σ) = (1 − σ/σ0)² ([G], cnccomp's shape; σᵢ the
+    /// singular values of the tool axis' derivative over the rotary joints). Outside it the axis is met exactly
+    /// (nothing damped); inside, a tool-axis error δ turns the rotary axes by at most about 1.21·δ/0.1 = 12·δ (0.017°
+    /// for 5″), smoothly across the singular pose, and the tip at the tool-offset length is exact everywhere (the
+    /// slides can always place it). With a constant pull of 0.1 mm/rad the real LinuxCNC swung C by ±1.8° within a
+    /// few servo cycles at B = ±180° on the multi-tasking sample (3 mm of Y, 1.5 µm off the path after motion's joint
+    /// interpolation).
     double singularZone = 0.1;
     /// cnccomp::IkOptions::polish. Off: the joints are a smooth function of the world words, which the trajectory
     /// needs (a polish switched on and off near a singular pose makes the joints jump).
@@ -92,8 +98,9 @@ struct KinsComponentOptions {
 /// Throws ModelError for a machine the component cannot describe (axis names, more than 9 axes).
 std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, const KinsComponentOptions& o = {});
 
-/// cnccomp's inverse (solveToolPose) with the component's objective: its weights, pull and polish, and a tolerance
-/// at least as tight as the component's. The apply model (component_route.hpp) and the tests solve with these.
+/// cnccomp's inverse (solveToolPose) with the component's objective: its weights, singular-pose policy and polish, and
+/// a tolerance at least as tight as the component's. The apply model (component_route.hpp) and the tests solve with
+/// these.
 IkOptions kinsSolverOptions(const KinsComponentOptions& o = {});
 
 /// HAL pin name (without the component prefix) of coefficient k of deviation `index` of `m`: "dev.<lower iso name>"

@@ -47,15 +47,6 @@ double rotarySingularValue(const MachineModel& m, const PoseJacobian& J) {
     return c.smallestSingularValue();
 }
 
-/// The pull's weight at the current Jacobian (IkOptions::rotaryRegularization, singularZone).
-static double pullWeight(const MachineModel& m, const PoseJacobian& J, const IkOptions& o) {
-    if (o.singularZone <= 0) return o.rotaryRegularization;
-    // Outside the zone a floor of 1e-4 keeps the system regular (a redundant rotary axis); its share of the axis
-    // error is (1e-4 · rotaryRegularization / (axisWeight · σ))², below 1e-8 for the component's values.
-    const double s = rotarySingularValue(m, J) / o.singularZone;
-    return o.rotaryRegularization * (s >= 1.0 ? 1e-4 : std::max(1.0 - s * s, 1e-4));
-}
-
 IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& tipInToolFrame, const AxisVector& start,
                        const IkOptions& o) {
     const MachineModel& m = k.machine();
@@ -69,27 +60,34 @@ IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& 
     DampedNormalFactor normal;
     AxisConditioning cond;
     AxisVector step(n), offset(n);
-    // The weighted residual and Jacobian at r.q (tool-axis rows × axisWeight) and JᵀJ.
+    // The singular-pose policy (pose_solver.hpp): D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ over the rotary axes, λ = rotaryRegularization,
+    // σ0 = singularZone; without a zone φ ≡ 1 (the constant pull λ² I), which needs no decomposition.
+    const SingularPosePolicy policy{o.rotaryRegularization, o.singularZone};
+    const bool zone = o.singularZone > 0;
+    if (!zone) {
+        cond.k = 0;
+        for (int i = 0; i < n; ++i)
+            if (rotary & (1u << i)) cond.axes[cond.k++] = i;
+    }
+    // The weighted residual and Jacobian at r.q (tool-axis rows × axisWeight) and JᵀJ; with a zone the conditioning
+    // of the tool axis over the rotary axes (unweighted rows: σ in rad/rad).
     const auto linearise = [&]() {
         const ToolPose p = toolPose(k, r.q, tipInToolFrame);
         b.head<3>() = target.tip - p.tip;
         b.tail<3>() = (target.axis - p.axis) * o.axisWeight;
         toolPoseJacobian(k, r.q, tipInToolFrame, J);
-        const double pull = pullWeight(m, J, o);
+        if (zone) cond.compute(J, rotary, 1.0, true);
         J.bottomRows<3>() *= o.axisWeight;
         normalMatrix(J, JtJ);
-        return pull;
     };
     for (r.iterations = 0; r.iterations < o.maxIterations; ++r.iterations) {
-        const double pull = linearise();
+        linearise();
         r.tipError = b.head<3>().norm();
         r.axisError = b.tail<3>().norm() / o.axisWeight;
-        // The pull as the singular-pose policy's constant damping (pose_solver.hpp, zone 0: D = pull² on the rotary
-        // axes); with singularZone its weight follows the smallest singular value (pullWeight).
-        cond.k = 0;
-        for (int i = 0; i < n; ++i)
-            if (rotary & (1u << i)) cond.axes[cond.k++] = i;
-        const bool damped = singularDamping({pull, 0.0}, cond, n, D);
+        // Outside the zone nothing is damped, and no floor is needed: there every rotary direction turns the tool
+        // axis by at least σ0, so JᵀJ is regular wherever the slides place the tip; a rotary direction that cannot
+        // turn the tool axis (σ = 0) is damped fully (φ = 1).
+        const bool damped = singularDamping(policy, cond, n, D);
         offset = r.q - start;
         normal.factor(J, JtJ, damped ? &D : nullptr, all, 0.0);
         normal.step(b, damped ? &D : nullptr, offset, all, step);

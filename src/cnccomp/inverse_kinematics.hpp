@@ -21,8 +21,9 @@ ToolPose toolPose(const Kinematics& k, const AxisVector& q, const Vec3& tipInToo
 /// finite differences on machines without component errors).
 void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, PoseJacobian& J);
 
-/// σ of IkOptions::singularZone: the smallest singular value of J's axis rows over the rotary axes of m (1 when the
-/// machine has no rotary axis).
+/// The smallest singular value σ of J's axis rows over the rotary axes of m (rad/rad: the sine of the angle between the
+/// tool axis and the rotary axis that cannot turn it; 1 when the machine has no rotary axis): below
+/// IkOptions::singularZone the singular-pose policy damps.
 double rotarySingularValue(const MachineModel& m, const PoseJacobian& J);
 
 struct IkOptions {
@@ -35,17 +36,23 @@ struct IkOptions {
     /// for tilts below regularization/axisWeight (1e-3 rad) and still meets the tip exactly (the slides can).
     /// Away from such poses it costs a relative (regularization/axisWeight)² = 1e-6 of the axis correction.
     double rotaryRegularization = 0.1;
-    /// With singularZone > 0 the pull acts only near a singular pose, as rotaryRegularization·(1 − (σ/singularZone)²)
-    /// where σ < singularZone, σ being the smallest singular value of the tool axis' derivative over the rotary axes
-    /// (the sine of the angle between the tool axis and the rotary axis that cannot turn it): damped least squares
-    /// with variable damping (Nakamura & Hanafusa 1986; Chiaverini, Siciliano & Egeland 1994). Away from singular
-    /// poses the axis is met exactly; across one the rotary axes turn by at most about δ/singularZone for a tool-axis
-    /// error δ, smoothly. 0: the constant pull above.
+    /// With singularZone > 0 the pull acts only near a singular pose and only in the directions that cannot turn the
+    /// tool axis: the singular-pose policy of pose_solver.hpp, SingularPosePolicy{rotaryRegularization, singularZone},
+    /// the damping D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ of the rotary axes, σᵢ and vᵢ the singular values and right singular vectors
+    /// of the tool axis' derivative over the rotary axes (rad/rad), φ(σ) = (1 − σ/singularZone)² below the zone and 0
+    /// above it (this shape is cnccomp's [G]): damped least squares with variable damping [NakamuraHanafusa1986],
+    /// [Chiaverini1994] in the ill-conditioned directions only [MaciejewskiKlein1988] (README, References). Away from
+    /// singular poses the axis is met exactly (no pull, no floor); a direction that cannot turn the tool axis at all
+    /// (σ = 0) is pulled with the full λ; across a singular pose the rotary axes turn smoothly, for a tool-axis error
+    /// δ by at most about max over σ of w²σδ / (w²σ² + λ²φ(σ)), w = axisWeight: 1.21·δ/singularZone with
+    /// λ = w·singularZone (the LinuxCNC component's choice), δ/σ outside the zone. 0: the constant pull above (φ ≡ 1).
     double singularZone = 0.0;
     /// After the pulled solution, up to 4 steps without the pull where they lower the cost and swing no rotary axis by
-    /// regularization/axisWeight or more: regular poses then meet the axis fully. Off, the solution is a smooth
-    /// function of the target (no switch between polished and unpolished near a singular pose), as a joint
-    /// trajectory needs (the LinuxCNC kinematics component, controllers/linuxcnc/kins_component.hpp).
+    /// regularization/axisWeight or more: regular poses then meet the axis fully. With singularZone > 0 the pulled
+    /// solution is already exact outside the zone, and inside it a polish step would take back the policy's damping
+    /// wherever it swings the rotary axes by less than that bound. Off, the solution is a smooth function of the
+    /// target (no switch between polished and unpolished near a singular pose), as a joint trajectory needs (the
+    /// LinuxCNC kinematics component, controllers/linuxcnc/kins_component.hpp).
     bool polish = true;
 };
 

@@ -17,11 +17,15 @@
 // 0 above it: the solution is exact away from singular poses, and near one a rotary axis corrects at most about
 // axisWeight/(2λ) times the tool-axis error it removes instead of swinging, fading in smoothly. σ0 → ∞ (zone ≤ 0)
 // gives φ ≡ 1, the constant pull D = λ² I of every rotary axis (Tikhonov regularisation). The shape (1 − σ/σ0)² —
-// continuous with zero slope at σ0 — is cnccomp's choice [G]; the papers weight by the smallest singular value, as the
-// LinuxCNC component's variant (IkOptions::singularZone) still does: its realtime C mirrors it.
+// continuous with zero slope at σ0 — is cnccomp's choice [G] (the papers weight by the smallest singular value). It is
+// the one policy of every inverse solver; no floor is needed outside the zone: there every rotary direction turns the
+// tool axis by at least σ0, so JᵀJ is regular wherever the slides place the tip.
 // Configurations: correct (postproc/correction.hpp: λ² = rotaryDamping² + continuity², σ0 = singularSine = 0.1),
-// solveToolPose (λ = rotaryRegularization = 0.1 mm/rad, no zone). A third policy, the pseudo-inverse truncated at 1e-4
-// of the largest singular value (formerly controllers/common/tcp_solver), was removed: no controller called it.
+// solveToolPose (IkOptions: λ = rotaryRegularization, σ0 = singularZone; by default 0.1 mm/rad and no zone), the
+// LinuxCNC kinematics component (controllers/linuxcnc/kins_component.hpp: λ = 10 mm/rad, σ0 = 0.1), whose realtime C
+// (ck_damping) computes the same D by Jacobi rotations and which the apply model solves with solveToolPose. A pull
+// weighted by the smallest singular value alone (formerly the component's) and the pseudo-inverse truncated at 1e-4
+// of the largest singular value (formerly controllers/common/tcp_solver) were removed.
 #include <cstdint>
 
 #include <Eigen/Cholesky>
