@@ -89,7 +89,9 @@ IkResult solveToolPose(const Kinematics& k, const ToolPose& target, const Vec3& 
         // turn the tool axis (σ = 0) is damped fully (φ = 1).
         const bool damped = singularDamping(policy, cond, n, D);
         offset = r.q - start;
-        normal.factor(J, JtJ, damped ? &D : nullptr, all, 0.0);
+        // A normal matrix that cannot be factorised (a NaN in J) gives no step: not converged, never a zero step
+        // taken for a settled one.
+        if (!normal.factor(J, JtJ, damped ? &D : nullptr, all, 0.0)) break;
         normal.step(b, damped ? &D : nullptr, offset, all, step);
         r.q += step;
         if (step.norm() <= std::max(1e-13 * (1.0 + r.q.norm()), 0.1 * o.tolerance)) {

@@ -276,16 +276,20 @@ MapStatistics run(const Plan& plan, MapSink& sink) {
                         pts = buffers[slot].data();
                     }
                     where[slot] = pts;
-                    acc[slot] = Accumulator{};
+                    // Summed on this thread's stack and stored once per block: the slots' accumulators lie side by side,
+                    // and updating one per point made the two workers fight over a shared cache line (two threads took
+                    // 1.45× the CPU time of one; now 1.05×, BM_MapStatistics1M).
+                    Accumulator sum;
                     r.grid.unflatten(lo, idx.data());
                     for (long k = 0; k < count; ++k) {
                         evaluate(plan, idx.data(), pts[k], ws);
-                        acc[slot].add(lo + k, pts[k]);
+                        sum.add(lo + k, pts[k]);
                         for (int i = static_cast<int>(r.grid.axes.size()) - 1; i >= 0; --i) {  // next grid point
                             if (++idx[i] < r.grid.axes[i].count) break;
                             idx[i] = 0;
                         }
                     }
+                    acc[slot] = sum;
                     sink.evaluated(slot, lo, std::span<const MapPoint>(pts, static_cast<size_t>(count)));
                 } catch (...) {
                     errors[slot] = std::current_exception();

@@ -1,6 +1,7 @@
 // Tool-pose Jacobian against central finite differences; inverse kinematics round trips.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "cnccomp/inverse_kinematics.hpp"
@@ -94,6 +95,37 @@ TEST(InverseKinematics, SingularPoseOfMillTurnKeepsCAndMeetsTheTip) {
         EXPECT_LT(r.tipError, 1e-9);
         EXPECT_NEAR(r.q[m.requireAxis("C")], c, 1e-4);
     }
+}
+
+TEST(InverseKinematics, ANaNStartOrTargetIsNoConvergence) {
+    // The solver's contract: converged means the iteration settled on finite commands. A NaN in the start or the
+    // target must come back as not converged, with or without the singular zone (the LinuxCNC component's options).
+    // (A normal matrix that cannot be factorised now also ends the iteration unconverged, instead of a zero step taken
+    // for a settled one; with the rotary damping that matrix is positive definite on every sample, so no test reaches
+    // that branch: it is defensive.) Oracle: the contract, on both policies.
+    const MachineModel& m = test::multitasking();
+    const Kinematics k(m);
+    const Vec3 tip = k.toolPoint(200.0);
+    AxisVector q = AxisVector::Zero(m.axisCount());
+    q[m.requireAxis("X")] = 40;
+    q[m.requireAxis("Z")] = 500;
+    q[m.requireAxis("B")] = 0.5;
+    const ToolPose target = toolPose(k, q, tip);
+    AxisVector start = q;
+    start[m.requireAxis("B")] = std::nan("");
+    for (double zone : {0.0, 0.1}) {
+        IkOptions o;
+        o.singularZone = zone;
+        const IkResult r = solveToolPose(k, target, tip, start, o);
+        EXPECT_FALSE(r.converged) << "zone " << zone;
+        EXPECT_FALSE(r.tipError < 1e-6) << "zone " << zone;
+        ToolPose bad = target;
+        bad.tip.x() = std::nan("");
+        EXPECT_FALSE(solveToolPose(k, bad, tip, q, o).converged) << "zone " << zone;
+    }
+    // The same start without the NaN converges: the refusal is the NaN's, not the pose's.
+    start[m.requireAxis("B")] = 0.45;
+    EXPECT_TRUE(solveToolPose(k, target, tip, start).converged);
 }
 
 INSTANTIATE_TEST_SUITE_P(SampleMachines, PerMachine, ::testing::Values("multitasking", "tilting-head-b", "table-table-ac"));

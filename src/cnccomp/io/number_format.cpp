@@ -47,12 +47,47 @@ size_t writeFixed(uint64_t scaled, int d, char* out) {
     return whole + 1 + static_cast<size_t>(d);
 }
 
+/// 10^0 … 10^15 as integers.
+constexpr uint64_t kPow10u[] = {1ull, 10ull, 100ull, 1000ull, 10000ull, 100000ull, 1000000ull, 10000000ull,
+                                100000000ull, 1000000000ull, 10000000000ull, 100000000000ull, 1000000000000ull,
+                                10000000000000ull, 100000000000000ull, 1000000000000000ull};
+
+/// Exactly `d` digits of v (< 10^d, d ≤ 9) at `out`, two per division by a constant on 32 bits.
+inline void writeDigits32(uint32_t v, int d, char* out) {
+    char* p = out + d;
+    for (; d >= 2; d -= 2) {
+        const uint32_t r = v % 100;
+        v /= 100;
+        p -= 2;
+        std::memcpy(p, kPairs + 2 * r, 2);
+    }
+    if (d) *--p = static_cast<char>('0' + v);
+}
+
+/// v's decimal digits (no leading zeros, "0" for 0) at `out`; returns the length.
+inline size_t writeUnsigned32(uint32_t v, char* out) {
+    const int n = v < 10 ? 1 : v < 100 ? 2 : v < 1000 ? 3 : v < 10000 ? 4 : v < 100000 ? 5 : v < 1000000 ? 6
+                : v < 10000000 ? 7 : v < 100000000 ? 8 : v < 1000000000 ? 9 : 10;
+    if (n == 10) {
+        writeDigits32(v % 1000000000u, 9, out + 1);
+        out[0] = static_cast<char>('0' + v / 1000000000u);
+    } else {
+        writeDigits32(v, n, out);
+    }
+    return static_cast<size_t>(n);
+}
+
 /// NumberStyle::exact. The product p = |value| · 10^d is computed with one rounding (10^d is exact), so it is within
 /// p · 2^-53 of the exact product; unless p is that close to a half-integer, rounding p to the nearest integer rounds
 /// the exact product too, which is printf's result. The rare undecided cases (and non-finite or huge values) go to
 /// snprintf itself.
+/// The digits: with up to 9 decimals and an integer part below 2^32 (every number a map or a program holds), the
+/// integer part is |value| truncated (exact) and the fraction the rounded product less it times 10^d, at most one
+/// carry: rounding is monotone, so p ≥ ⌊|value|⌋ · 10^d. Both are written on 32 bits, two digits per step, without the
+/// 64-bit divisions of the general path (about twice as fast: BM_MapCsvRowsFormat).
 size_t formatExact(double value, int d, char* out) {
-    const double p = std::fabs(value) * kPow10[d];
+    const double a = std::fabs(value);
+    const double p = a * kPow10[d];
     if (!(p < 4e15)) return viaPrintf(value, d, out);  // also NaN and infinities
     const uint64_t whole = static_cast<uint64_t>(p);      // p < 2^52: truncation is floor, and exact
     const double frac = p - static_cast<double>(whole);  // exact
@@ -60,6 +95,18 @@ size_t formatExact(double value, int d, char* out) {
     const uint64_t scaled = whole + (frac > 0.5 ? 1 : 0);
     size_t n = 0;
     if (std::signbit(value)) out[n++] = '-';
+    if (d <= 9 && a < 4294967295.0) {
+        uint64_t integer = static_cast<uint64_t>(a);
+        uint64_t fraction = scaled - integer * kPow10u[d];
+        if (fraction >= kPow10u[d]) fraction -= kPow10u[d], ++integer;
+        if (integer <= 0xffffffffull) {
+            n += writeUnsigned32(static_cast<uint32_t>(integer), out + n);
+            if (d == 0) return n;
+            out[n++] = '.';
+            writeDigits32(static_cast<uint32_t>(fraction), d, out + n);
+            return n + static_cast<size_t>(d);
+        }
+    }
     return n + writeFixed(scaled, d, out + n);
 }
 }  // namespace
