@@ -1,6 +1,7 @@
 #pragma once
 // Shared fixtures for the tests: sample paths, a scratch folder, running the CLI.
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "cnccomp/io/machine_xml.hpp"
@@ -25,6 +26,11 @@ struct ScratchDir {
 /// Writes `text` to a file.
 void writeText(const std::string& path, const std::string& text);
 std::string readText(const std::string& path);
+
+/// The message of the exception `f` throws; "" when it throws none.
+std::string errorOf(const std::function<void()>& f);
+/// The message of the InputError `f` throws; "no InputError" when it throws none (another exception escapes).
+std::string inputErrorOf(const std::function<void()>& f);
 
 struct CliResult {
     int exitCode;

@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include "cnccomp/error.hpp"
+
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -37,6 +39,24 @@ ScratchDir::~ScratchDir() {
 
 void writeText(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    return "";
+}
+
+std::string inputErrorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no InputError";
 }
 
 std::string readText(const std::string& path) {

@@ -1,6 +1,6 @@
 #pragma once
 // Exact forward kinematics of a machine with a deviation set (full rotation matrices, no small-angle
-// truncation). Seed 000: the tool chain reproduces T = E_Z M_YZ E_Y M_XY E_X M_XB E_B M_BT T_T (eq. (7)),
+// truncation). [MultiTasking]: the tool chain reproduces T = E_Z M_YZ E_Y M_XY E_X M_XB E_B M_BT T_T (eq. (7)),
 // the workpiece chain W = M_CZ E_C W_C (eq. (10)).
 #include <array>
 #include <vector>

@@ -33,14 +33,7 @@ std::string simulateInto(const test::ScratchDir& dir, const MeasurementPlan& pla
     return dir.path.string();
 }
 
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::errorOf;
 
 TEST(IdentifyFacade, TheRegistryServesEveryKindOfPlanAndNamesItsMethods) {
     for (PlanMethod k : {PlanMethod::Ballbar, PlanMethod::HeadPatterns, PlanMethod::RtestLocation, PlanMethod::RtestTables,

@@ -28,14 +28,7 @@ const std::string kPlan = test::sourcePath("samples/plans/multitasking-six-circl
 const std::string kTruth = test::sourcePath("samples/deviations/multitasking-truth.csv");
 const std::string kMachine = test::sourcePath("samples/machines/multitasking.xml");
 
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::errorOf;
 
 /// The sample plan's runs simulated on the true machine into a folder kept for the whole test run, and the plan.
 struct Simulated {

@@ -107,7 +107,7 @@ TEST(Verify, IsoFiguresEccentricityAndJsonOfAnIdealCompensation) {
     EXPECT_EQ(cRadial["passes"][0]["direction"].string, "CW");
     EXPECT_EQ(cRadial["passes"][1]["direction"].string, "CCW");
     EXPECT_EQ(cRadial["passes"][0]["dL_before_um"].array.size(), 360u);
-    // Seed 000 Table 5 sign convention: the C-radial eccentricity before is the one `simulate` + eccentricities give.
+    // [MultiTasking] Table 5 sign convention: the C-radial eccentricity before is the one `simulate` + eccentricities give.
     const MachineModel& mm = test::multitasking();
     const MeasurementPlan plan = readPlanXml(p);
     const DeviationSet truth = readDeviationCsv(t, mm);

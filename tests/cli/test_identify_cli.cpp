@@ -151,7 +151,7 @@ TEST(IdentifyCli, PlanThenSimulateThenIdentify) {
 }
 
 TEST(IdentifyCli, SimulateWritesNothingWhenALaterRunFails) {
-    // Issue 11: the first run is fine, the second leaves the X travel (RC = 5 m); no trace of the first may remain.
+    // A half-written output once stayed behind: the first run is fine, the second leaves the X travel (RC = 5 m); no trace of the first may remain.
     test::ScratchDir dir("sim-fail");
     test::writeText(dir.file("p.xml"), R"(<plan machine="multitasking">
   <run name="ok" test="B-X" LB="100" RB="200" RC="50" ZC="100" start="-180" end="180" step="10"/>

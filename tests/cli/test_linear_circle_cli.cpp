@@ -304,7 +304,7 @@ TEST(LinearCircleCli, CirclesMixedWithOtherRunsAreRefused) {
 
 
 TEST(LinearCircleCli, Dbb5LinearCirclesOnAThreeAxisMachinePointToCircleRuns) {
-    // Issue 20: a 3-axis mill's XY circle written as a DBB5 run exited 2 "needs a tilting rotary table"; it still
+    // A 3-axis mill's XY circle written as a DBB5 run exited 2 "needs a tilting rotary table"; it still
     // cannot take the DBB5 method, but the message names the route that fits.
     test::ScratchDir dir("circle-cli-dbb5");
     test::writeText(dir.file("p.xml"), "<plan>\n  <dbb5 name=\"a\" kind=\"linear\" LB=\"100\" ball=\"0 0 -350\" plane=\"XY\"/>\n</plan>\n");

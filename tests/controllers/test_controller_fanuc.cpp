@@ -47,15 +47,6 @@ DeviationSet claimedOnly(const DeviationSet& d, const EmitResult& r) {
     return c;
 }
 
-std::string messageOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "no InputError";
-}
-
 /// N<5 digits>Q<0|1>(P<v>|L<n>P<v>|(A<n>P<v>)+), <v> = [+-]digits[.digits]: checked character by character,
 /// independently of the reader.
 bool matchesGrammar(const std::string& l) {
@@ -107,7 +98,7 @@ TEST(ControllerFanuc, GoldenFilesOtherSampleMachinesParseBack) {
     }
 }
 
-// Seed 000's machine: the four pivot/offset errors are claimed; the nine angles are listed NOT compensated.
+// [MultiTasking]'s machine: the four pivot/offset errors are claimed; the nine angles are listed NOT compensated.
 TEST(ControllerFanuc, MultitaskingPivotErrors) {
     const MachineModel& m = test::multitasking();
     const DeviationSet d = readDeviationCsv(sourcePath("samples/deviations/multitasking-truth.csv"), m);
@@ -320,7 +311,7 @@ TEST(ControllerFanuc, MalformedFilesAreRejectedWithFileAndLine) {
     const EmitResult r = fanuc30i().emit({m, pitchTruth(), "x", "2024-01-01"});
     const std::string text = r.files[0].content;
     const auto apply = [&](const std::string& content) {
-        return messageOf([&] { fanuc30i().apply(m, {{fanuc::kParameterFile, content}}); });
+        return test::inputErrorOf([&] { fanuc30i().apply(m, {{fanuc::kParameterFile, content}}); });
     };
     const int typeLine = test::lineOf(text, "N19680Q1L1P");
     EXPECT_EQ(apply(test::replaceLine(text, typeLine, "N19680Q1L1P5")),
@@ -357,7 +348,7 @@ TEST(ControllerFanuc, MalformedFilesAreRejectedWithFileAndLine) {
     EXPECT_NE(apply(gap).find(fmt::format("parameter {} is missing", 10000 + cFirst + 5)), std::string::npos) << apply(gap);
     EXPECT_EQ(apply(test::replaceLine(text, typeLine, "N01005Q1A1P1")),
               fmt::format("CNCCOMP.PRM:{}: parameter 1005 is not one cnccomp writes or models", typeLine));
-    EXPECT_EQ(messageOf([&] { fanuc30i().apply(m, {{"OTHER.TXT", text}}); }), "OTHER.TXT: not a fanuc-30i file (expected CNCCOMP.PRM)");
+    EXPECT_EQ(test::inputErrorOf([&] { fanuc30i().apply(m, {{"OTHER.TXT", text}}); }), "OTHER.TXT: not a fanuc-30i file (expected CNCCOMP.PRM)");
 }
 
 }  // namespace
@@ -462,7 +453,7 @@ TEST(ControllerFanuc, RotaryReferencePointHoldsTheLastPointsValue) {
     // A file that breaks the rule is refused at the reference point's line.
     const int refLine = test::lineOf(text, fmt::format("N{}Q0P", 10000 + ref));
     const std::string broken = test::replaceLine(text, refLine, fmt::format("N{}Q0P0", 10000 + ref));
-    const std::string msg = messageOf([&] { fanuc30i().apply(m, {{fanuc::kParameterFile, broken}}); });
+    const std::string msg = test::inputErrorOf([&] { fanuc30i().apply(m, {{fanuc::kParameterFile, broken}}); });
     EXPECT_EQ(msg.rfind(fmt::format("CNCCOMP.PRM:{}:", refLine), 0), 0u) << msg;
     EXPECT_NE(msg.find("must equal the value at the last point"), std::string::npos) << msg;
 }

@@ -49,15 +49,6 @@ const OutputFile& file(const EmitResult& r, const std::string& name) {
     throw std::runtime_error("no file " + name);
 }
 
-std::string messageOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "no InputError";
-}
-
 TEST(ControllerHeidenhain, RegisteredUnderItsName) { EXPECT_EQ(tnc().name(), "heidenhain-tnc"); }
 
 TEST(ControllerHeidenhain, GoldenFilesMultitaskingParseBack) {
@@ -235,7 +226,7 @@ TEST(ControllerHeidenhain, MalformedFilesAreRejectedWithFileAndLine) {
         std::vector<OutputFile> files = r.files;
         for (auto& f : files)
             if (f.name == name) f.content = content;
-        return messageOf([&] { tnc().apply(m, files); });
+        return test::inputErrorOf([&] { tnc().apply(m, files); });
     };
     const auto row = [&](const std::string& text, const std::string& nr) { return test::lineOf(text, "\n" + nr + " ") + 1; };
     // Row 3 numbered 7.
@@ -284,9 +275,9 @@ TEST(ControllerHeidenhain, MalformedFilesAreRejectedWithFileAndLine) {
     std::vector<OutputFile> noCom;
     for (const auto& f : r.files)
         if (f.name != "X.COM") noCom.push_back(f);
-    EXPECT_NE(messageOf([&] { tnc().apply(m, noCom); }).find("COMPTAB names 'X.COM', which is not among the files"), std::string::npos);
+    EXPECT_NE(test::inputErrorOf([&] { tnc().apply(m, noCom); }).find("COMPTAB names 'X.COM', which is not among the files"), std::string::npos);
     // No .TAB at all.
-    EXPECT_EQ(messageOf([&] { tnc().apply(m, {}); }), "<heidenhain-tnc files>: no kinematics description (.TAB)");
+    EXPECT_EQ(test::inputErrorOf([&] { tnc().apply(m, {}); }), "<heidenhain-tnc files>: no kinematics description (.TAB)");
 }
 
 

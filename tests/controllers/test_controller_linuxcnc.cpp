@@ -531,7 +531,7 @@ TEST(ControllerLinuxcnc, ComponentRouteReadersNameFileAndLine) {
 }
 
 TEST(ControllerLinuxcnc, TestProgramsRunInJointModeWhereTheTrtPinsDoNothing) {
-    // Issue 17: verify ran cnccomp testprog's machine-coordinate programs through the trt pins (tool-tip mode) and
+    // A bug once found: verify ran cnccomp testprog's machine-coordinate programs through the trt pins (tool-tip mode) and
     // predicted 18.7 um where the real LinuxCNC, running them with the identity kinematics, gave 60.1 um.
     // 1. The programs say their mode.
     test::ScratchDir dir("linuxcnc-joint-mode");
@@ -605,7 +605,7 @@ TEST(ControllerLinuxcnc, TestProgramsRunInJointModeWhereTheTrtPinsDoNothing) {
 }
 
 TEST(ControllerLinuxcnc, TableTableAxisTurningTheOtherWayIsRefusedByNameInThePinsRoute) {
-    // Issue 17: C about −Z silently got trivkins, and README's "replace the key" swapped out the user's tool-tip
+    // A bug once found: C about −Z silently got trivkins, and README's "replace the key" swapped out the user's tool-tip
     // kinematics. The pins route refuses it naming the axis; the component route holds any structure.
     test::ScratchDir dir("linuxcnc-minus-z");
     std::string xml = test::readText(test::sourcePath("samples/machines/table-table-ac.xml"));

@@ -271,15 +271,6 @@ TEST(ControllerSiemens, LinearAxisOnARotaryAxisIsRefused) {
     EXPECT_THROW(siemens().emit({m, d, "x", "2024-01-01"}), ModelError);
 }
 
-std::string messageOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "no InputError";
-}
-
 // Broken files are refused with the file name and the line.
 TEST(ControllerSiemens, MalformedFilesAreRejectedWithFileAndLine) {
     const MachineModel& m = componentsMachine();
@@ -288,7 +279,7 @@ TEST(ControllerSiemens, MalformedFilesAreRejectedWithFileAndLine) {
         std::vector<OutputFile> files = r.files;
         for (auto& f : files)
             if (f.name == name) f.content = content;
-        return messageOf([&] { siemens().apply(m, files); });
+        return test::inputErrorOf([&] { siemens().apply(m, files); });
     };
     const std::string cec = file(r, siemens::kCecFile).content;
     const std::string eec = file(r, siemens::kEecFile).content;
@@ -348,11 +339,11 @@ TEST(ControllerSiemens, MalformedFilesAreRejectedWithFileAndLine) {
     std::vector<OutputFile> noChain;
     for (const auto& f : r.files)
         if (f.name != siemens::kChainFile) noChain.push_back(f);
-    EXPECT_EQ(messageOf([&] { siemens().apply(m, noChain); }),
+    EXPECT_EQ(test::inputErrorOf([&] { siemens().apply(m, noChain); }),
               "CNCCOMP_KINCHAIN.SPF: missing: the kinematic chain file is needed for TRAORI");
     std::vector<OutputFile> extra = r.files;
     extra.push_back({"NOTES.TXT", "hello"});
-    EXPECT_NE(messageOf([&] { siemens().apply(m, extra); }).find("NOTES.TXT: not a siemens-840d file"), std::string::npos);
+    EXPECT_NE(test::inputErrorOf([&] { siemens().apply(m, extra); }).find("NOTES.TXT: not a siemens-840d file"), std::string::npos);
     // Binary content.
     EXPECT_NE(withFile(siemens::kCecFile, std::string("%_N_NC_CEC_INI\n\x01\x02\n")).find("binary content"), std::string::npos);
 }

@@ -1,4 +1,4 @@
-// Seed 000 section 4: each deviation alone (±20 µm, ±0.005°; LB = 100, ZC = 100, RB = 200, RC = 50 mm)
+// [MultiTasking] section 4: each deviation alone (±20 µm, ±0.005°; LB = 100, ZC = 100, RB = 200, RC = 50 mm)
 // against Table 3 (which trajectories change), Table 5 (eccentricity expressions) and Table 4 (mounting errors).
 #include <gtest/gtest.h>
 

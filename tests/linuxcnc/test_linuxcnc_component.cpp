@@ -258,7 +258,7 @@ void oracle(const std::string& machine, const std::string& deviations, const std
     if (const std::string why = sim::componentUnavailableReason(); !why.empty()) GTEST_SKIP() << why;
     const Figures f = runComponentOracle(machine, deviations, tag, plan);
     EXPECT_GE(f.poses, 20);
-    // Issue 17: joint commands agree with cnccomp's model to 1e-6 mm / 1e-6 deg; the tool tip on the erroneous machine is
+    // Joint commands agree with cnccomp's model to 1e-6 mm / 1e-6 deg; the tool tip on the erroneous machine is
     // within 0.1 um of nominal. (The driver reads the joints once they hold still: the arrival test on stat.position
     // can pass a servo cycle before the joint pins carry that cycle's inverse, which once looked like a 1e-3 gap.)
     EXPECT_LE(f.jointMode, 1e-6);

@@ -1,4 +1,4 @@
-// Issue 21, the loop closed on the real LinuxCNC 2.9 (Debian 12 linuxcnc-uspace + linuxcnc-uspace-dev, headless
+// The probe loop closed on the real LinuxCNC 2.9 (Debian 12 linuxcnc-uspace + linuxcnc-uspace-dev, headless
 // simulation): touch probe and calibration sphere on the A/C table-table machine (samples/machines/table-table-ac.xml).
 // The oracle is the virtual sphere (tests/linuxcnc/virtual_sphere.comp, checked alone in
 // test_linuxcnc_virtual_sphere.cpp): a realtime HAL component with a forward model of the ERRONEOUS machine written

@@ -69,7 +69,7 @@ TEST(PostprocCorrectGuards, HeaderToolLengthIsFoundCaseInsensitively) {
 
 TEST(PostprocCorrectGuards, TestProgramWithoutToolLengthOptionTakesItsHeaders) {
     // Oracle: the same program corrected with the length given on the command line (the header's number) gives the
-    // same bytes. Issue 18: with an assumed 0 they left 45 um on the true machine, so on some of them the output for 0
+    // same bytes. With an assumed 0 they left 45 um on the true machine, so on some of them the output for 0
     // differs.
     test::ScratchDir dir("pp-guard-header");
     (void)testProgram(dir, "C-radial");

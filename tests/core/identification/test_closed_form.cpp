@@ -1,4 +1,4 @@
-// Seed 000 section 5: closed-form identification, eq. (17)-(28), round trips with the section 5.4 geometry.
+// [MultiTasking] section 5: closed-form identification, eq. (17)-(28), round trips with the section 5.4 geometry.
 #include <gtest/gtest.h>
 
 #include <random>

@@ -93,7 +93,7 @@ TEST(PlannerMultitasking, AtMostSixRunsIdentifyTheTwelveFromRawTraces) {
 
 TEST(PlannerMultitasking, EccentricitiesNeedTheCXRunForSquarenessXY) {
     // Planning for [MultiTasking]'s closed-form input (circle centres only): six runs still suffice for the twelve, and
-    // γXY is seen by a single run type. Seed 000 section 4.2 names the Y-direction run; in the exact model with the
+    // γXY is seen by a single run type. [MultiTasking] section 4.2 names the Y-direction run; in the exact model with the
     // W-side ball set on the T-side ball it is the X-direction run (see Table3.SquarenessXYShowsInTheCXRunNotTheCYRun).
     const MachineModel& m = test::multitasking();
     PlannerOptions o;

@@ -1,4 +1,4 @@
-// Seed 004: the six kinematic errors of A and C of the cradle as functions of angle. The small-angle model of
+// [RotaryTableModel]: the six kinematic errors of A and C of the cradle as functions of angle. The small-angle model of
 // eq. (1)–(7) against the exact kinematics, the per-angle solution from R-test runs with three balls, and the
 // least-squares equivalent on the component-error tables with the gauge (C errors zero at C = 0).
 #include <gtest/gtest.h>

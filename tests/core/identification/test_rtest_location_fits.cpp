@@ -1,4 +1,4 @@
-// Seed 001: R-test on the table-table machine. Round trips with the sample plan and the paper's error values
+// [Moravek2019]: R-test on the table-table machine. Round trips with the sample plan and the paper's error values
 // (Tables 1–2): the paper's fits with defect correction, the least-squares equivalent, and the volumetric error
 // along the XYZAC trajectory (section 3.2).
 #include <gtest/gtest.h>

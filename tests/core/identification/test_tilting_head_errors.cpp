@@ -1,4 +1,4 @@
-// Seed 002: the tilting head B from absolute ball-bar runs in Y, X and Z patterns with two tool lengths.
+// [FanWuLi]: the tilting head B from absolute ball-bar runs in Y, X and Z patterns with two tool lengths.
 // Eq. (4), (13), (20) checked against the exact simulation for single errors; eq. (7), (9), (16), (21) and the
 // least-squares equivalent recover the truth of samples/deviations/tilting-head-b-truth.csv.
 #include <gtest/gtest.h>
