@@ -208,36 +208,43 @@ std::vector<Row> binnedRows(const std::vector<Row>& rows, double origin, double 
     return out;
 }
 
-MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const RunCapture& cap, const std::string& machine) {
-    CsvReader reader(path);
-    const CsvRow& header = reader.header();
-    const int headerLine = header.line;
-    const char separator = reader.separator();
-    MeasuredTrace out;
-    out.path = path;
-    TraceImportSummary& sum = out.summary;
-    if (run) checkMetadata(path, reader.comments(), 0, *run, machine, sum);
-    const size_t commentsChecked = reader.comments().size();
+/// The file's columns, as the header names them.
+struct Columns {
+    int headerLine = 0;
+    char separator = ',';
+    int x = -1, dL = -1, pass = -1;  ///< angle or time; ΔL; pass label (-1: none)
+    bool timeSampled = false;
+    std::string nameX, nameL, namePass;
+};
 
-    const int cL = findColumn(header, cap.lengthColumn);
-    if (cL < 0)
-        throw InputError(path, headerLine, fmt::format("missing column '{}' (ΔL) in the header", cap.lengthColumn));
-    int cX = findColumn(header, cap.angleColumn);
-    const bool timeSampled = cX < 0;
-    if (timeSampled) cX = findColumn(header, cap.timeColumn);
-    if (cX < 0)
-        throw InputError(path, headerLine, fmt::format("missing column '{}' (angle) or '{}' (time) in the header (found {} "
-                                                       "column(s) separated by '{}')",
-                                                       cap.angleColumn, cap.timeColumn, header.cells.size(),
-                                                       separatorName(separator)));
-    const int cP = findColumn(header, cap.passColumn);
-    const std::string nameX = header.cells[cX], nameL = header.cells[cL], nameP = cP >= 0 ? header.cells[cP] : "";
-    sum.layout = timeSampled ? "time" : "angle";
-    const double xUnit = timeSampled ? cap.timeUnit : cap.angleUnit;
+Columns findColumns(const std::string& path, const CsvRow& header, char separator, const RunCapture& cap) {
+    Columns c;
+    c.headerLine = header.line;
+    c.separator = separator;
+    c.dL = findColumn(header, cap.lengthColumn);
+    if (c.dL < 0)
+        throw InputError(path, c.headerLine, fmt::format("missing column '{}' (ΔL) in the header", cap.lengthColumn));
+    c.x = findColumn(header, cap.angleColumn);
+    c.timeSampled = c.x < 0;
+    if (c.timeSampled) c.x = findColumn(header, cap.timeColumn);
+    if (c.x < 0)
+        throw InputError(path, c.headerLine, fmt::format("missing column '{}' (angle) or '{}' (time) in the header (found {} "
+                                                         "column(s) separated by '{}')",
+                                                         cap.angleColumn, cap.timeColumn, header.cells.size(),
+                                                         separatorName(separator)));
+    c.pass = findColumn(header, cap.passColumn);
+    c.nameX = header.cells[c.x];
+    c.nameL = header.cells[c.dL];
+    c.namePass = c.pass >= 0 ? header.cells[c.pass] : "";
+    return c;
+}
 
-    // Rows → samples, one row at a time (a large file streams).
+/// Rows → samples, one row at a time (a large file streams); `labels` gets the pass labels, one entry per change of
+/// label down the file.
+std::vector<Row> readRows(const std::string& path, CsvReader& reader, const Columns& col, const RunCapture& cap,
+                          std::vector<std::string>& labels, TraceImportSummary& sum) {
+    const double xUnit = col.timeSampled ? cap.timeUnit : cap.angleUnit;
     std::vector<Row> rows;
-    std::vector<std::string> labels;  // pass labels, one entry per change of label down the file
     CsvRow csvRow;
     while (reader.next(csvRow)) {
         ++sum.rows;
@@ -247,50 +254,53 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
             static const std::string empty;
             return c < static_cast<int>(cells.size()) ? cells[c] : empty;
         };
-        if (isMissing(cell(cX)) || isMissing(cell(cL))) {
+        if (isMissing(cell(col.x)) || isMissing(cell(col.dL))) {
             ++sum.missing;
             continue;
         }
         Row r;
         r.line = line;
-        r.x = parseCell(path, line, nameX, cell(cX), separator, cap.decimal) * xUnit;
-        r.dL = parseCell(path, line, nameL, cell(cL), separator, cap.decimal) * cap.lengthUnit;
-        if (cP >= 0) {
-            const std::string& label = cell(cP);
-            if (label.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", nameP));
+        r.x = parseCell(path, line, col.nameX, cell(col.x), col.separator, cap.decimal) * xUnit;
+        r.dL = parseCell(path, line, col.nameL, cell(col.dL), col.separator, cap.decimal) * cap.lengthUnit;
+        if (col.pass >= 0) {
+            const std::string& label = cell(col.pass);
+            if (label.empty()) throw InputError(path, line, fmt::format("column '{}' is empty", col.namePass));
             if (labels.empty() || labels.back() != label) labels.push_back(label);
             r.label = static_cast<int>(labels.size()) - 1;
         }
         rows.push_back(std::move(r));
     }
-    if (run) checkMetadata(path, reader.comments(), commentsChecked, *run, machine, sum);
-    if (rows.empty()) throw InputError(path, headerLine, "no samples: every row lacks a value");
-    if (run) {
-        // Against the bar length: a ball bar records at most ±1 mm (or 1% of a long bar); more is a unit mistake
-        // (a µm export read under length-unit="mm").
-        double lo = HUGE_VAL, hi = -HUGE_VAL;
-        const Row* worst = &rows.front();
-        for (const Row& r : rows) {
-            lo = std::min(lo, r.dL);
-            hi = std::max(hi, r.dL);
-            if (std::abs(r.dL) > std::abs(worst->dL)) worst = &r;
-        }
-        const double size = cap.relativeLength ? hi - lo : std::abs(worst->dL);
-        const double limit = maxBallbarTravel(run->LB);
-        if (size > limit)
-            throw InputError(path, worst->line,
-                             fmt::format("ΔL {} {:.4g} mm, more than a ball bar of {:g} mm records (±{:g} mm): the file is "
-                                         "likely in {} while the plan reads it in {} (length-unit of <instrument> or of run "
-                                         "'{}')",
-                                         cap.relativeLength ? "spans" : "reaches", size, run->LB, limit,
-                                         cap.lengthUnit == 1.0 ? "um" : cap.lengthUnit == 1e-3 ? "nm" : "a smaller unit",
-                                         lengthUnitText(cap.lengthUnit), run->name));
-    }
+    return rows;
+}
 
-    const std::vector<int> planned = run && !run->capture.passes.empty() ? run->capture.passes
-                                     : std::vector<int>{run && run->stepDeg < 0 ? -1 : +1};
+/// Against the bar length: a ball bar records at most ±1 mm (or 1% of a long bar); more is a unit mistake (a µm export
+/// read under length-unit="mm").
+void checkBarTravel(const std::string& path, const std::vector<Row>& rows, const BallbarRun& run, const RunCapture& cap) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    const Row* worst = &rows.front();
+    for (const Row& r : rows) {
+        lo = std::min(lo, r.dL);
+        hi = std::max(hi, r.dL);
+        if (std::abs(r.dL) > std::abs(worst->dL)) worst = &r;
+    }
+    const double size = cap.relativeLength ? hi - lo : std::abs(worst->dL);
+    const double limit = maxBallbarTravel(run.LB);
+    if (size > limit)
+        throw InputError(path, worst->line,
+                         fmt::format("ΔL {} {:.4g} mm, more than a ball bar of {:g} mm records (±{:g} mm): the file is "
+                                     "likely in {} while the plan reads it in {} (length-unit of <instrument> or of run "
+                                     "'{}')",
+                                     cap.relativeLength ? "spans" : "reaches", size, run.LB, limit,
+                                     cap.lengthUnit == 1.0 ? "um" : cap.lengthUnit == 1e-3 ? "nm" : "a smaller unit",
+                                     lengthUnitText(cap.lengthUnit), run.name));
+}
+
+/// The rows split into passes: by the pass column, by time going back (time-sampled), or where the angle turns back;
+/// directions from the labels or the plan (`planned`).
+std::vector<Pass> splitPasses(const std::string& path, std::vector<Row>& rows, const std::vector<std::string>& labels,
+                              const Columns& col, const std::vector<int>& planned) {
     std::vector<Pass> passes;
-    if (cP >= 0) {
+    if (col.pass >= 0) {
         std::vector<std::string> seen;
         for (const Row& r : rows) {
             const std::string& label = labels[static_cast<size_t>(r.label)];
@@ -315,7 +325,7 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
             }
             passes.back().rows.push_back(r);
         }
-    } else if (timeSampled) {
+    } else if (col.timeSampled) {
         for (const Row& r : rows) {
             if (passes.empty() || r.x < passes.back().rows.back().x) passes.emplace_back();
             passes.back().rows.push_back(r);
@@ -341,22 +351,31 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         }
         for (size_t i = 0; i < passes.size(); ++i) passes[i].direction = planned[std::min(i, planned.size() - 1)];
     }
-    if (run && passes.size() != planned.size())
+    return passes;
+}
+
+/// The passes against the run: as many, in the plan's directions.
+void checkPassesAgainstPlan(const std::string& path, const std::vector<Pass>& passes, const BallbarRun& run,
+                            const std::vector<int>& planned, int headerLine) {
+    if (passes.size() != planned.size())
         throw InputError(path, passes.size() > planned.size() ? passes[planned.size()].rows.front().line : headerLine,
                          fmt::format("the file has {} pass(es), but run '{}' of the plan records {} ({})", passes.size(),
-                                     run->name, planned.size(), planned.size() == 2 ? "a CCW and a CW pass" : "one pass"));
-    for (size_t i = 0; i < passes.size() && run; ++i)
+                                     run.name, planned.size(), planned.size() == 2 ? "a CCW and a CW pass" : "one pass"));
+    for (size_t i = 0; i < passes.size(); ++i)
         if (passes[i].direction != planned[i])
             throw InputError(path, passes[i].rows.front().line,
                              fmt::format("pass {} is {}, but the plan's run '{}' records {} first", i + 1,
-                                         passes[i].direction > 0 ? "CCW" : "CW", run->name,
+                                         passes[i].direction > 0 ? "CCW" : "CW", run.name,
                                          planned[0] > 0 ? "CCW" : "CW"));
+}
 
-    const double lo = run ? std::min(run->startDeg, run->endDeg) : -HUGE_VAL;
-    const double hi = run ? std::max(run->startDeg, run->endDeg) : HUGE_VAL;
-
-    // Time → angle.
-    std::vector<std::vector<double>> tau(passes.size());  // time (s) or row order, for the drift
+/// Time → angle for a time-sampled file (the run's feed on its radius, from the overshoot's start), with the feed
+/// checked against the data; returns each sample's time (s) or, angle-sampled, its row order, for the drift.
+std::vector<std::vector<double>> timeToAngle(const std::string& path, std::vector<Pass>& passes, const BallbarRun* run,
+                                             const Columns& col, double lo, double hi, TraceImportSummary& sum) {
+    const bool timeSampled = col.timeSampled;
+    const int headerLine = col.headerLine;
+    std::vector<std::vector<double>> tau(passes.size());
     for (size_t p = 0; p < passes.size(); ++p) {
         Pass& ps = passes[p];
         for (const Row& r : ps.rows) tau[p].push_back(timeSampled ? r.x : static_cast<double>(r.line));
@@ -402,106 +421,143 @@ MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const R
         }
         for (Row& r : ps.rows) r.x = a0 + ps.direction * omegaDeg * (r.x - t0);
     }
+    return tau;
+}
 
-    // Linear drift in time, from two samples at the same angle.
-    if (run && run->capture.removeDrift) {
-        const bool fullTurn = hi - lo >= 360.0 - 1e-9;
-        std::vector<std::vector<double>> ang(passes.size()), val(passes.size());
-        for (size_t p = 0; p < passes.size(); ++p)
-            for (const Row& r : passes[p].rows) ang[p].push_back(r.x), val[p].push_back(r.dL);
-        double v1 = 0, t1 = 0, v2 = 0, t2 = 0;
-        if (passes.size() == 2) {
-            // Both ends of the sweep are seen by both passes: at the first pass's start long apart, at its end just
-            // apart. The difference of the two differences is drift alone (a constant CCW/CW hysteresis cancels).
-            const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
-            double v3 = 0, t3 = 0, v4 = 0, t4 = 0;
-            sampleAt(ang[0], val[0], tau[0], s, v1, t1);
-            sampleAt(ang[1], val[1], tau[1], s, v2, t2);
-            sampleAt(ang[0], val[0], tau[0], e, v3, t3);
-            sampleAt(ang[1], val[1], tau[1], e, v4, t4);
-            v2 -= v4 - v3;
-            t2 -= t4 - t3;
-        } else if (fullTurn) {
-            const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
-            sampleAt(ang[0], val[0], tau[0], s, v1, t1);
-            sampleAt(ang[0], val[0], tau[0], e, v2, t2);
-        } else {
-            throw InputError(path, headerLine, fmt::format("drift removal needs a full turn or a CCW and a CW pass; run "
-                                                             "'{}' sweeps {:g}° in one pass", run->name, hi - lo));
-        }
-        if (!(t2 > t1 + 1e-12))
-            throw InputError(path, headerLine, "drift removal: the samples at the sweep's ends are not apart in time");
-        const double rate = (v2 - v1) / (t2 - t1);
-        const double tFirst = tau[0].front();
-        double tLast = tFirst;
-        for (size_t p = 0; p < passes.size(); ++p)
-            for (size_t i = 0; i < passes[p].rows.size(); ++i) {
-                passes[p].rows[i].dL -= rate * (tau[p][i] - tFirst);
-                tLast = std::max(tLast, tau[p][i]);
-            }
-        sum.driftRemoved = rate * (tLast - tFirst);
+/// Linear drift in time, from two samples at the same angle, taken out of every sample.
+void removeDrift(const std::string& path, std::vector<Pass>& passes, const std::vector<std::vector<double>>& tau,
+                 const BallbarRun& run, double lo, double hi, int headerLine, TraceImportSummary& sum) {
+    const bool fullTurn = hi - lo >= 360.0 - 1e-9;
+    std::vector<std::vector<double>> ang(passes.size()), val(passes.size());
+    for (size_t p = 0; p < passes.size(); ++p)
+        for (const Row& r : passes[p].rows) ang[p].push_back(r.x), val[p].push_back(r.dL);
+    double v1 = 0, t1 = 0, v2 = 0, t2 = 0;
+    if (passes.size() == 2) {
+        // Both ends of the sweep are seen by both passes: at the first pass's start long apart, at its end just
+        // apart. The difference of the two differences is drift alone (a constant CCW/CW hysteresis cancels).
+        const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
+        double v3 = 0, t3 = 0, v4 = 0, t4 = 0;
+        sampleAt(ang[0], val[0], tau[0], s, v1, t1);
+        sampleAt(ang[1], val[1], tau[1], s, v2, t2);
+        sampleAt(ang[0], val[0], tau[0], e, v3, t3);
+        sampleAt(ang[1], val[1], tau[1], e, v4, t4);
+        v2 -= v4 - v3;
+        t2 -= t4 - t3;
+    } else if (fullTurn) {
+        const double s = passes[0].direction > 0 ? lo : hi, e = passes[0].direction > 0 ? hi : lo;
+        sampleAt(ang[0], val[0], tau[0], s, v1, t1);
+        sampleAt(ang[0], val[0], tau[0], e, v2, t2);
+    } else {
+        throw InputError(path, headerLine, fmt::format("drift removal needs a full turn or a CCW and a CW pass; run "
+                                                         "'{}' sweeps {:g}° in one pass", run.name, hi - lo));
     }
+    if (!(t2 > t1 + 1e-12))
+        throw InputError(path, headerLine, "drift removal: the samples at the sweep's ends are not apart in time");
+    const double rate = (v2 - v1) / (t2 - t1);
+    const double tFirst = tau[0].front();
+    double tLast = tFirst;
+    for (size_t p = 0; p < passes.size(); ++p)
+        for (size_t i = 0; i < passes[p].rows.size(); ++i) {
+            passes[p].rows[i].dL -= rate * (tau[p][i] - tFirst);
+            tLast = std::max(tLast, tau[p][i]);
+        }
+    sum.driftRemoved = rate * (tLast - tFirst);
+}
 
-    // Trim to the sweep and check each pass against the run.
+/// One pass trimmed to the sweep [lo, hi] and checked against the run (direction, gaps, coverage, sample count);
+/// binned to the plan's step when densely sampled.
+std::vector<Row> trimAndCheckPass(const std::string& path, const Pass& ps, size_t p, size_t passCount,
+                                  const BallbarRun* run, double lo, double hi, int headerLine, TraceImportSummary& sum) {
     const double eps = 1e-9 * std::max(1.0, std::max(std::abs(lo), std::abs(hi)));
     const double step = run ? std::abs(run->stepDeg) : 0.0;
     const double gapLimit = std::max(4.0 * step, 2.0);
+    std::vector<Row> kept;
+    for (const Row& r : ps.rows) {
+        if (r.x < lo - eps || r.x > hi + eps) {
+            ++sum.trimmed;
+            continue;
+        }
+        kept.push_back(r);
+    }
+    const int d = ps.direction;
+    const std::string which = passCount > 1 ? fmt::format(" pass {} ({})", p + 1, d > 0 ? "CCW" : "CW") : "";
+    if (run) {
+        if (kept.empty())
+            throw InputError(path, ps.rows.front().line,
+                             fmt::format("no sample of{} lies in run '{}''s sweep {:g}..{:g}°: is this the file of "
+                                         "another run?", which, run->name, run->startDeg, run->endDeg));
+        for (size_t i = 1; i < kept.size(); ++i) {
+            const double da = (kept[i].x - kept[i - 1].x) * d;
+            if (da < -1e-6)
+                throw InputError(path, kept[i].line,
+                                 fmt::format("angle goes back from {:g} to {:g}°, but{} runs {}", kept[i - 1].x, kept[i].x,
+                                             which.empty() ? " the run" : which, d > 0 ? "CCW (increasing)" : "CW (decreasing)"));
+            if (da > gapLimit + 1e-9)
+                throw InputError(path, kept[i].line,
+                                 fmt::format("no samples between {:g} and {:g}°{}: at most {:g}° may be missing "
+                                             "(4 steps of the plan)", kept[i - 1].x, kept[i].x, which, gapLimit));
+        }
+        const double first = d > 0 ? lo : hi, last = d > 0 ? hi : lo;
+        if ((kept.front().x - first) * d > gapLimit + 1e-9 || (last - kept.back().x) * d > gapLimit + 1e-9)
+            throw InputError(path, kept.front().line,
+                             fmt::format("{}covers {:g}..{:g}°, but run '{}' sweeps {:g}..{:g}° (at most {:g}° may be "
+                                         "missing at either end): a partial trace or the file of another run",
+                                         which.empty() ? "the trace " : which.substr(1) + " ", kept.front().x,
+                                         kept.back().x, run->name, first, last, gapLimit));
+        const double expected = std::floor((hi - lo) / step + 1e-9) + 1;
+        if (static_cast<double>(kept.size()) < 0.75 * expected)
+            throw InputError(path, kept.back().line,
+                             fmt::format("{}has {} samples in the sweep, but the plan's step of {:g}° gives {:g}: "
+                                         "too many are missing, or the file was recorded with another step",
+                                         which.empty() ? "the trace " : which.substr(1) + " ", kept.size(),
+                                         run->stepDeg, expected));
+    }
+    const size_t minimum = run ? 5 : 3;
+    if (kept.size() < minimum)
+        throw InputError(path, kept.empty() ? headerLine : kept.back().line,
+                         fmt::format("{} sample(s){}; at least {} are needed to fit the trace", kept.size(), which,
+                                     minimum));
+    // A densely sampled file (a 1 kHz instrument: thousands of samples a degree) is averaged into bins of the plan's
+    // step, centred on its sweep angles: the fit sees the step the plan asked for, with each bin's mean angle and
+    // mean ΔL (the noise of a bin drops by √n; the harmonics a step can carry are unchanged). Only beyond
+    // kBinFactor samples a step, so files recorded at the plan's step are fitted sample by sample.
+    if (run && step > 0 && static_cast<double>(kept.size()) > kBinFactor * (std::floor((hi - lo) / step + 1e-9) + 1))
+        kept = binnedRows(kept, run->startDeg, step, sum);
+    return kept;
+}
+
+MeasuredTrace importImpl(const std::string& path, const BallbarRun* run, const RunCapture& cap, const std::string& machine) {
+    CsvReader reader(path);
+    const CsvRow& header = reader.header();  // read first: it settles the separator
+    const char separator = reader.separator();
+    MeasuredTrace out;
+    out.path = path;
+    TraceImportSummary& sum = out.summary;
+    if (run) checkMetadata(path, reader.comments(), 0, *run, machine, sum);
+    const size_t commentsChecked = reader.comments().size();
+    const Columns col = findColumns(path, header, separator, cap);
+    sum.layout = col.timeSampled ? "time" : "angle";
+
+    std::vector<std::string> labels;
+    std::vector<Row> rows = readRows(path, reader, col, cap, labels, sum);
+    if (run) checkMetadata(path, reader.comments(), commentsChecked, *run, machine, sum);
+    if (rows.empty()) throw InputError(path, col.headerLine, "no samples: every row lacks a value");
+    if (run) checkBarTravel(path, rows, *run, cap);
+
+    const std::vector<int> planned = run && !run->capture.passes.empty() ? run->capture.passes
+                                     : std::vector<int>{run && run->stepDeg < 0 ? -1 : +1};
+    std::vector<Pass> passes = splitPasses(path, rows, labels, col, planned);
+    if (run) checkPassesAgainstPlan(path, passes, *run, planned, col.headerLine);
+
+    const double lo = run ? std::min(run->startDeg, run->endDeg) : -HUGE_VAL;
+    const double hi = run ? std::max(run->startDeg, run->endDeg) : HUGE_VAL;
+    const std::vector<std::vector<double>> tau = timeToAngle(path, passes, run, col, lo, hi, sum);
+    if (run && run->capture.removeDrift) removeDrift(path, passes, tau, *run, lo, hi, col.headerLine, sum);
+
     for (size_t p = 0; p < passes.size(); ++p) {
-        Pass& ps = passes[p];
-        std::vector<Row> kept;
-        for (const Row& r : ps.rows) {
-            if (r.x < lo - eps || r.x > hi + eps) {
-                ++sum.trimmed;
-                continue;
-            }
-            kept.push_back(r);
-        }
-        const int d = ps.direction;
-        const std::string which = passes.size() > 1 ? fmt::format(" pass {} ({})", p + 1, d > 0 ? "CCW" : "CW") : "";
-        if (run) {
-            if (kept.empty())
-                throw InputError(path, ps.rows.front().line,
-                                 fmt::format("no sample of{} lies in run '{}''s sweep {:g}..{:g}°: is this the file of "
-                                             "another run?", which, run->name, run->startDeg, run->endDeg));
-            for (size_t i = 1; i < kept.size(); ++i) {
-                const double da = (kept[i].x - kept[i - 1].x) * d;
-                if (da < -1e-6)
-                    throw InputError(path, kept[i].line,
-                                     fmt::format("angle goes back from {:g} to {:g}°, but{} runs {}", kept[i - 1].x, kept[i].x,
-                                                 which.empty() ? " the run" : which, d > 0 ? "CCW (increasing)" : "CW (decreasing)"));
-                if (da > gapLimit + 1e-9)
-                    throw InputError(path, kept[i].line,
-                                     fmt::format("no samples between {:g} and {:g}°{}: at most {:g}° may be missing "
-                                                 "(4 steps of the plan)", kept[i - 1].x, kept[i].x, which, gapLimit));
-            }
-            const double first = d > 0 ? lo : hi, last = d > 0 ? hi : lo;
-            if ((kept.front().x - first) * d > gapLimit + 1e-9 || (last - kept.back().x) * d > gapLimit + 1e-9)
-                throw InputError(path, kept.front().line,
-                                 fmt::format("{}covers {:g}..{:g}°, but run '{}' sweeps {:g}..{:g}° (at most {:g}° may be "
-                                             "missing at either end): a partial trace or the file of another run",
-                                             which.empty() ? "the trace " : which.substr(1) + " ", kept.front().x,
-                                             kept.back().x, run->name, first, last, gapLimit));
-            const double expected = std::floor((hi - lo) / step + 1e-9) + 1;
-            if (static_cast<double>(kept.size()) < 0.75 * expected)
-                throw InputError(path, kept.back().line,
-                                 fmt::format("{}has {} samples in the sweep, but the plan's step of {:g}° gives {:g}: "
-                                             "too many are missing, or the file was recorded with another step",
-                                             which.empty() ? "the trace " : which.substr(1) + " ", kept.size(),
-                                             run->stepDeg, expected));
-        }
-        const size_t minimum = run ? 5 : 3;
-        if (kept.size() < minimum)
-            throw InputError(path, kept.empty() ? headerLine : kept.back().line,
-                             fmt::format("{} sample(s){}; at least {} are needed to fit the trace", kept.size(), which,
-                                         minimum));
-        // A densely sampled file (a 1 kHz instrument: thousands of samples a degree) is averaged into bins of the plan's
-        // step, centred on its sweep angles: the fit sees the step the plan asked for, with each bin's mean angle and
-        // mean ΔL (the noise of a bin drops by √n; the harmonics a step can carry are unchanged). Only beyond
-        // kBinFactor samples a step, so files recorded at the plan's step are fitted sample by sample.
-        if (run && step > 0 && static_cast<double>(kept.size()) > kBinFactor * (std::floor((hi - lo) / step + 1e-9) + 1))
-            kept = binnedRows(kept, run->startDeg, step, sum);
+        const std::vector<Row> kept = trimAndCheckPass(path, passes[p], p, passes.size(), run, lo, hi, col.headerLine, sum);
         DirectedTrace dt;
-        dt.direction = d;
+        dt.direction = passes[p].direction;
         for (const Row& r : kept) {
             dt.trace.angleDeg.push_back(r.x);
             dt.trace.dL.push_back(r.dL);
