@@ -44,13 +44,7 @@ struct BoundItem {
 /// The names are checked against the machine by parseBounds.
 std::vector<BoundItem> boundItems(const std::string& text) {
     std::vector<BoundItem> out;
-    size_t pos = 0;
-    while (pos < text.size()) {
-        size_t end = text.find(',', pos);
-        if (end == std::string::npos) end = text.size();
-        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
-        pos = end + 1;
-        if (item.empty()) continue;
+    for (const std::string& item : commaItems(text)) {
         const size_t eq = item.find('='), colon = item.find(':', eq == std::string::npos ? 0 : eq);
         if (eq == std::string::npos || colon == std::string::npos)
             throw ModelError(fmt::format("--bounds item '{}': expected NAME=LOWER:UPPER (um or arcsec)", item));

@@ -32,18 +32,6 @@ std::vector<std::pair<std::string, std::string>> outputPaths(const Identificatio
             {"--volumetric-out", o.volumetricOut}, {"--iso-out", o.isoOut}, {"--profile-out", o.profileOut}};
 }
 
-std::vector<std::string> splitList(const std::string& text) {
-    std::vector<std::string> out;
-    size_t pos = 0;
-    while (pos <= text.size()) {
-        const size_t end = std::min(text.find(',', pos), text.size());
-        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
-        if (!item.empty()) out.push_back(item);
-        pos = end + 1;
-    }
-    return out;
-}
-
 bool htmlReport(const IdentificationOutputs& o) { return !o.report.empty() && report::isHtmlPath(o.report); }
 
 /// The extra outputs asked for, each with the summary's writer; ModelError for one the method does not write.
@@ -86,7 +74,7 @@ report::ReportData leastSquaresReportData(const MachineModel& m, const Measureme
     mo.grid = o.reportGrid;
     mo.plane = o.reportPlane;
     mo.toolLength = plan && !plan->runs.empty() ? plan->runs.front().RB : 0.0;
-    report::addCompensationSections(d, m, res.deviations, splitList(o.reportControllers), mo);
+    report::addCompensationSections(d, m, res.deviations, commaItems(o.reportControllers), mo);
     return d;
 }
 
@@ -162,7 +150,7 @@ void checkOutputRequests(const IdentificationOutputs& o, const IdentificationOpt
     const std::vector<std::pair<std::string, std::string>> outputs = outputPaths(o);
     for (size_t i = 0; i < outputs.size(); ++i) {
         if (outputs[i].second.empty()) continue;
-        for (const std::string& in : inputs) refuseToOverwrite(outputs[i].second, {in});
+        refuseToOverwrite(outputs[i].second, inputs);
         for (size_t j = 0; j < i; ++j)
             if (outputs[j].second == outputs[i].second)
                 throw ModelError(fmt::format("{} and {} name the same file '{}'", outputs[j].first, outputs[i].first,

@@ -25,13 +25,7 @@ struct Options {
 
 std::vector<double> numbers(const std::string& text, const char* option) {
     std::vector<double> v;
-    size_t pos = 0;
-    while (pos <= text.size()) {
-        size_t end = text.find(',', pos);
-        if (end == std::string::npos) end = text.size();
-        const auto item = trim(std::string_view(text).substr(pos, end - pos));
-        pos = end + 1;
-        if (item.empty()) continue;
+    for (const std::string& item : commaItems(text)) {
         const auto x = parseNumber(item);
         if (!x || !std::isfinite(*x) || *x <= 0)
             throw ModelError(fmt::format("{}: '{}' is not a positive length in mm", option, item));
@@ -43,13 +37,7 @@ std::vector<double> numbers(const std::string& text, const char* option) {
 
 std::vector<BallbarTest> parseTypes(const std::string& text) {
     std::vector<BallbarTest> v;
-    size_t pos = 0;
-    while (pos <= text.size()) {
-        size_t end = text.find(',', pos);
-        if (end == std::string::npos) end = text.size();
-        const std::string item(trim(std::string_view(text).substr(pos, end - pos)));
-        pos = end + 1;
-        if (item.empty()) continue;
+    for (const std::string& item : commaItems(text)) {
         if (item == "all") {
             for (BallbarTest t : kAllBallbarTests) v.push_back(t);
             continue;

@@ -226,7 +226,7 @@ TEST(PostprocLineReader, LoneCarriageReturnsEndLinesAndPiecesShareTheirLineNumbe
     }
 }
 
-TEST(PostprocLineReader, OverlongLineScannerSkipsCommentsAndCollectsWordLetters) {
+TEST(PostprocLineReader, OverlongLineScannerPassesOverCommentsAndCollectsWordLetters) {
     OverlongLine o;
     o.feed("(comment X1 G0");
     o.feed(" still comment) ");

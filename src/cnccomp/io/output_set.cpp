@@ -75,9 +75,7 @@ void OutputSet::add(const std::string& path, const std::function<void(std::ostre
     const fs::file_status st = fs::status(target, ec);
     if (fs::exists(st) && !fs::is_regular_file(st))
         throw InputError(path, 0, "exists and is not a regular file; refusing to replace it");
-    for (const std::string& in : inputs_)
-        if (!in.empty() && fs::exists(st) && fs::exists(in, ec) && fs::equivalent(target, in, ec))
-            throw InputError(path, 0, fmt::format("refusing to overwrite the input file '{}'", in));
+    refuseToOverwrite(path, inputs_);
     for (const std::string& t : targets_)
         if (fs::absolute(t, ec).lexically_normal() == fs::absolute(target, ec).lexically_normal())
             throw InputError(path, 0, "this command would write the same file twice");

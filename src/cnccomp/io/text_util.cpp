@@ -1,5 +1,6 @@
 #include "cnccomp/io/text_util.hpp"
 
+#include <algorithm>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -38,7 +39,19 @@ std::optional<double> parseNumber(std::string_view s) {
     return v;
 }
 
-void refuseToOverwrite(const std::string& output, std::initializer_list<std::string> inputs) {
+std::vector<std::string> commaItems(std::string_view text) {
+    std::vector<std::string> out;
+    size_t pos = 0;
+    while (pos <= text.size()) {
+        const size_t end = std::min(text.find(',', pos), text.size());
+        const std::string_view item = trim(text.substr(pos, end - pos));
+        if (!item.empty()) out.emplace_back(item);
+        pos = end + 1;
+    }
+    return out;
+}
+
+void refuseToOverwrite(const std::string& output, std::span<const std::string> inputs) {
     namespace fs = std::filesystem;
     std::error_code ec;
     for (const std::string& in : inputs) {

@@ -4,8 +4,10 @@
 #include <iosfwd>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace cnccomp::io {
 
@@ -58,7 +60,13 @@ private:
 /// Writes through `write` into an AtomicFile at `path` and commits it.
 /// A failure leaves no half file. Refuses non-regular targets before `write` runs.
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
-/// Throws InputError if `output` names the same file as one of the inputs.
-void refuseToOverwrite(const std::string& output, std::initializer_list<std::string> inputs);
+/// Throws InputError if `output` names the same file as one of the inputs ("" entries match nothing).
+void refuseToOverwrite(const std::string& output, std::span<const std::string> inputs);
+inline void refuseToOverwrite(const std::string& output, std::initializer_list<std::string> inputs) {
+    refuseToOverwrite(output, std::span<const std::string>(inputs.begin(), inputs.size()));
+}
+
+/// The items of a comma list (an option's value such as "X, Y,,Z"), each trimmed, empty items left out.
+std::vector<std::string> commaItems(std::string_view text);
 
 }  // namespace cnccomp::io

@@ -13,6 +13,7 @@
 #include "cnccomp/error.hpp"
 #include "cnccomp/io/csv.hpp"
 #include "cnccomp/io/deviation_csv.hpp"
+#include "cnccomp/io/text_util.hpp"
 #include "cnccomp/io/plan_xml.hpp"
 #include "cnccomp/io/trace_import.hpp"
 #include "test_support.hpp"
@@ -135,6 +136,17 @@ TEST(CsvReader, OnlyRegularFilesAreRead) {
     // The same for an XML input.
     e = inputErrorOf([&] { readPlanXml(fifo); });
     EXPECT_NE(e.find("FIFO"), std::string::npos) << e;
+}
+
+TEST(TextUtil, CommaItemsAreTrimmedAndEmptyOnesLeftOut) {
+    // The one splitter of comma-list options (--report-controllers, --bounds, plan --lb/--candidates). Oracle: the
+    // lists written out by hand.
+    using V = std::vector<std::string>;
+    EXPECT_EQ(io::commaItems("linuxcnc, fanuc-30i ,,siemens-840d,"), (V{"linuxcnc", "fanuc-30i", "siemens-840d"}));
+    EXPECT_EQ(io::commaItems(""), V{});
+    EXPECT_EQ(io::commaItems(" , ,"), V{});
+    EXPECT_EQ(io::commaItems("EX0C=-5:5"), V{"EX0C=-5:5"});
+    EXPECT_EQ(io::commaItems("\t360 ,410\t"), (V{"360", "410"}));
 }
 
 }  // namespace
