@@ -26,8 +26,7 @@ using namespace cnccomp::io;
 EmitResult emitFiles(const EmitRequest& request, const PitchOptions& o) {
     const MachineModel& m = request.machine;
     const DeviationSet& d = request.deviations;
-    if (&d.machine() != &m && d.machine().name != m.name)
-        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", d.machine().name, m.name));
+    d.requireMachine(m);
     if (!d.values.allFinite()) throw ModelError("the deviation set holds a value that is not a finite number");
     const TcpParameters tcp = tcpFromMachine(m, d.values);
     const PitchPlan pitch = pitchFromDeviations(m, d, o);

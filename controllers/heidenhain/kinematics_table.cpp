@@ -80,8 +80,7 @@ std::string names(const std::vector<std::string>& v) {
 EmitResult emitFiles(const EmitRequest& request, const Options& o) {
     const MachineModel& m = request.machine;
     const DeviationSet& d = request.deviations;
-    if (&d.machine() != &m && d.machine().name != m.name)
-        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", d.machine().name, m.name));
+    d.requireMachine(m);
     if (!d.values.allFinite()) throw ModelError("the deviation set holds a value that is not a finite number");
     for (int a = 0; a < m.axisCount(); ++a) {
         const Link& l = m.axisLink(a);

@@ -682,8 +682,7 @@ std::string kinematicsComponent(const MachineModel& m, const DeviationSet& d, co
         throw ModelError(fmt::format("kinematics component name '{}': expected lower-case letters, digits and '_', "
                                      "starting with a letter",
                                      o.name));
-    if (&d.machine() != &m && d.machine().name != m.name)
-        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", d.machine().name, m.name));
+    d.requireMachine(m);
     if (!(o.maxIterations >= 1 && o.tolerance > 0 && o.axisWeight > 0 && o.rotaryRegularization > 0 && o.singularZone >= 0))
         throw ModelError("kinematics component options: maxIterations >= 1, tolerance, axisWeight and "
                          "rotaryRegularization > 0 expected");

@@ -303,8 +303,7 @@ struct Builder {
 }  // namespace
 
 Plan makePlan(const MachineModel& m, const DeviationSet& d, const Options& o) {
-    if (&d.machine() != &m && d.machine().name != m.name)
-        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", d.machine().name, m.name));
+    d.requireMachine(m);
     if (!d.values.allFinite()) throw ModelError("the deviation set holds a value that is not a finite number");
     Builder b(m, d, o);
     b.chains();

@@ -91,4 +91,9 @@ bool DeviationSet::hasReversal() const {
     return false;
 }
 
+void DeviationSet::requireMachine(const MachineModel& m) const {
+    if (machine_ != &m && machine_->name != m.name)
+        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", machine_->name, m.name));
+}
+
 }  // namespace cnccomp

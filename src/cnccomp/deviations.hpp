@@ -30,6 +30,9 @@ public:
     void set(std::string_view nameOrAlias, double value);
     /// Index of a deviation by name or alias; throws ModelError naming the machine when unknown.
     int require(std::string_view nameOrAlias) const;
+    /// Throws ModelError when this set belongs to another machine than `m` (checked by name when the objects differ):
+    /// every model that evaluates a set calls it, since the set's values are laid out for its own machine.
+    void requireMachine(const MachineModel& m) const;
 
     /// ISO value of location deviation `index` (Σ isoTerms · link values).
     double isoValue(int index) const;

@@ -11,9 +11,7 @@ namespace cnccomp {
 Kinematics::Kinematics(const MachineModel& machine) : machine_(&machine) { build(nullptr); }
 
 Kinematics::Kinematics(const MachineModel& machine, const DeviationSet& deviations) : machine_(&machine) {
-    if (&deviations.machine() != &machine && deviations.machine().name != machine.name)
-        throw ModelError(fmt::format("deviation set is for machine '{}', not '{}'", deviations.machine().name,
-                                     machine.name));
+    deviations.requireMachine(machine);
     build(&deviations);
 }
 

@@ -74,6 +74,7 @@ KinematicsModel::KinematicsModel(const MachineModel& machine, const DeviationSet
       exact_(arithmetic == Arithmetic::AsExactModel),
       id_(nextModelId()),
       values_(deviations ? deviations->values : Eigen::VectorXd::Zero(machine.parameterCount())) {
+    if (deviations) deviations->requireMachine(machine);
     int slots = 0;
     compile(machine.workpiece, Side::Workpiece, workpiece_, slots);
     compile(machine.tool, Side::Tool, tool_, slots);

@@ -110,7 +110,8 @@ public:
         Fast,          ///< constants folded, affine chains summed, angle addition near the last angle
         AsExactModel,  ///< the operations of cnccomp::Kinematics and toolPose in their order: their bits
     };
-    /// `deviations` nullptr: the nominal machine. The machine must outlive this object.
+    /// `deviations` nullptr: the nominal machine; a set of another machine is refused (ModelError, requireMachine).
+    /// The machine must outlive this object.
     KinematicsModel(const MachineModel& machine, const DeviationSet* deviations, Arithmetic arithmetic = Arithmetic::Fast);
 
     const MachineModel& machine() const { return *machine_; }

@@ -18,12 +18,6 @@ namespace {
 
 constexpr int kMaxGridAxes = 16;
 
-/// `d`, once Kinematics has accepted it for `m` (a set of another machine is refused with its ModelError).
-const DeviationSet& checkedFor(const MachineModel& m, const DeviationSet& d) {
-    (void)Kinematics(m, d);
-    return d;
-}
-
 /// Everything a worker needs, prepared once (the per-point kernel only reads it).
 struct Plan {
     const MapRequest* request = nullptr;
@@ -42,7 +36,7 @@ struct Plan {
         : request(&r),
           nominal(r.machine),
           nominalModel(r.machine, nullptr, KinematicsModel::Arithmetic::AsExactModel),
-          actualModel(r.machine, &checkedFor(r.machine, r.deviations), KinematicsModel::Arithmetic::AsExactModel) {}
+          actualModel(r.machine, &r.deviations, KinematicsModel::Arithmetic::AsExactModel) {}
 };
 
 void prepare(Plan& p) {

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <random>
 
+#include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/kinematics_engine.hpp"
@@ -139,6 +140,23 @@ TEST(KinematicsEngine, AWorkspaceFollowsItsModel) {
     const ToolPose ref = toolPose(Kinematics(m, d), q, Kinematics(m, d).toolPoint(100.0));
     EXPECT_LT((tipA - ref.tip).norm(), 1e-12);
     EXPECT_GT((tipA - tipN).norm(), 1e-6);  // the deviations show: not the nominal pose from the cache
+}
+
+TEST(KinematicsEngine, ASetOfAnotherMachineIsRefused) {
+    // The set's values are laid out for its own machine: the engine refuses another machine's set, as the exact model
+    // does, instead of reading past its values. Oracle: the message written out by hand.
+    const MachineModel ac = readMachineXml(test::sourcePath("samples/machines/table-table-ac.xml"));
+    const MachineModel& mt = test::multitasking();
+    const DeviationSet other(mt);
+    for (auto arithmetic : {KinematicsModel::Arithmetic::Fast, KinematicsModel::Arithmetic::AsExactModel}) {
+        try {
+            const KinematicsModel model(ac, &other, arithmetic);
+            ADD_FAILURE() << "another machine's set was accepted";
+        } catch (const ModelError& e) {
+            EXPECT_EQ(std::string(e.what()), "deviation set is for machine 'multitasking', not '" + ac.name + "'");
+        }
+    }
+    EXPECT_THROW(Kinematics(ac, other), ModelError);
 }
 
 TEST(KinematicsEngine, InclinedRotaryAxis) {
