@@ -17,12 +17,12 @@ ToolPose toolPose(const Kinematics& k, const AxisVector& q, const Vec3& tipInToo
 void toolPoseJacobian(const Kinematics& k, const AxisVector& q, const Vec3& tipInToolFrame, PoseJacobian& J) {
     const int n = static_cast<int>(q.size());
     J.resize(6, n);
-    const auto joints = k.jointFrames(q);
-    const Pose bMw = k.baseToWorkpiece(q);
-    const Pose bMt = k.baseToTool(q);
-    const Mat3 wRb = bMw.linear().transpose();
-    const Vec3 tipB = bMt * tipInToolFrame;
-    const Vec3 axisB = bMt.linear() * k.machine().toolDirection;
+    JointFrames joints;  // both chains' frames and joint lines in one walk each
+    const Frame bMw = k.model().chainFrame(Side::Workpiece, q, &joints);
+    const Frame bMt = k.model().chainFrame(Side::Tool, q, &joints);
+    const Mat3 wRb = bMw.R.transpose();
+    const Vec3 tipB = bMt.R * tipInToolFrame + bMt.t;
+    const Vec3 axisB = bMt.R * k.machine().toolDirection;
     J.setZero();
     for (const JointFrame& j : joints) {
         // Tool-side motion moves the tool; workpiece-side motion moves the workpiece, i.e. the tool relative

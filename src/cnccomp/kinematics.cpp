@@ -8,71 +8,32 @@
 
 namespace cnccomp {
 
-Kinematics::Kinematics(const MachineModel& machine) : machine_(&machine) { build(nullptr); }
+namespace {
 
-Kinematics::Kinematics(const MachineModel& machine, const DeviationSet& deviations) : machine_(&machine) {
-    deviations.requireMachine(machine);
-    build(&deviations);
+Pose asPose(const Frame& f) {
+    Pose p = Pose::Identity();
+    p.linear() = f.R;
+    p.translation() = f.t;
+    return p;
 }
 
-void Kinematics::build(const DeviationSet* deviations) {
-    values_ = deviations ? deviations->values : Eigen::VectorXd::Zero(machine_->parameterCount());
-    for (Side side : {Side::Workpiece, Side::Tool}) {
-        const Chain& chain = machine_->chain(side);
-        auto& out = side == Side::Tool ? tool_ : workpiece_;
-        out.clear();
-        for (int i = 0; i < static_cast<int>(chain.links.size()); ++i) {
-            const Link& l = chain.links[i];
-            Vec6 location = Vec6::Zero();
-            LinkData d{Pose::Identity(), l.direction, l.kind, l.axisIndex, l.modulo, {}};
-            for (int k = 0; k < static_cast<int>(machine_->deviations.size()); ++k) {
-                const DeviationDef& def = machine_->deviations[k];
-                if (def.side != side || def.link != i) continue;
-                if (def.kind == DeviationKind::Location)
-                    location[def.component] += values_[def.offset];
-                else
-                    d.components.push_back(k);
-            }
-            d.placed = l.placement * errorTransform(location);
-            out.push_back(std::move(d));
-        }
-    }
-}
+}  // namespace
 
-Pose Kinematics::chainPose(const std::vector<LinkData>& links, const AxisVector& q, Side side,
-                           JointFrames* joints) const {
-    Pose m = Pose::Identity();
-    for (const LinkData& l : links) {
-        m = m * l.placed;
-        if (joints && l.kind != AxisKind::Fixed)
-            joints->items[joints->count++] = {side, l.axis, l.kind == AxisKind::Rotary, m.linear() * l.direction,
-                                              m.translation()};
-        if (l.kind == AxisKind::Linear) {
-            m.translation() += m.linear() * (l.direction * q[l.axis]);
-        } else if (l.kind == AxisKind::Rotary) {
-            m.linear() = m.linear() * axisRotation(l.direction, q[l.axis]);
-        }
-        if (!l.components.empty()) {
-            Vec6 e = Vec6::Zero();
-            for (int k : l.components) {
-                const DeviationDef& def = machine_->deviations[k];
-                e[def.component] += def.basis.evaluate(q[l.axis], values_.data() + def.offset, l.modulo);
-            }
-            m = m * errorTransform(e);
-        }
-    }
-    return m;
-}
+Kinematics::Kinematics(const MachineModel& machine)
+    : model_(machine, nullptr, KinematicsModel::Arithmetic::AsExactModel) {}
+
+Kinematics::Kinematics(const MachineModel& machine, const DeviationSet& deviations)
+    : model_(machine, &deviations, KinematicsModel::Arithmetic::AsExactModel) {}
 
 JointFrames Kinematics::jointFrames(const AxisVector& q) const {
     JointFrames j;
-    chainPose(workpiece_, q, Side::Workpiece, &j);
-    chainPose(tool_, q, Side::Tool, &j);
+    model_.chainFrame(Side::Workpiece, q, &j);
+    model_.chainFrame(Side::Tool, q, &j);
     return j;
 }
 
-Pose Kinematics::baseToWorkpiece(const AxisVector& q) const { return chainPose(workpiece_, q); }
-Pose Kinematics::baseToTool(const AxisVector& q) const { return chainPose(tool_, q); }
+Pose Kinematics::baseToWorkpiece(const AxisVector& q) const { return asPose(model_.chainFrame(Side::Workpiece, q)); }
+Pose Kinematics::baseToTool(const AxisVector& q) const { return asPose(model_.chainFrame(Side::Tool, q)); }
 
 Pose Kinematics::workpieceToTool(const AxisVector& q) const {
     return baseToWorkpiece(q).inverse(Eigen::Isometry) * baseToTool(q);
@@ -83,11 +44,11 @@ Vec3 Kinematics::toolPointInWorkpiece(const AxisVector& q, const Vec3& p) const 
 }
 
 void Kinematics::checkTravel(const AxisVector& q) const {
-    if (q.size() != machine_->axisCount())
-        throw ModelError(fmt::format("machine '{}' has {} axes, got {} commands", machine_->name,
-                                     machine_->axisCount(), q.size()));
+    if (q.size() != machine().axisCount())
+        throw ModelError(fmt::format("machine '{}' has {} axes, got {} commands", machine().name,
+                                     machine().axisCount(), q.size()));
     for (int i = 0; i < q.size(); ++i) {
-        const Link& l = machine_->axisLink(i);
+        const Link& l = machine().axisLink(i);
         const double scale = l.kind == AxisKind::Rotary ? 1.0 / kDeg : 1.0;
         const char* unit = l.kind == AxisKind::Rotary ? "deg" : "mm";
         if (!std::isfinite(q[i]))

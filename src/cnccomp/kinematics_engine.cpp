@@ -152,6 +152,7 @@ void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
 }
 
 void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& slots) {
+    c.side = side;
     std::vector<Op>& ops = c.ops;
     std::vector<int>& axes = c.axes;
     ops.clear();
@@ -239,14 +240,55 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
     }
 }
 
-void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const {
+template <class TrigOf>
+void KinematicsModel::exactWalk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const {
+    // From the identity, every link's product done (no folding), as the model's equations read: [MultiTasking] eq. (7), (10).
+    f.R.setIdentity();
+    f.t.setZero();
+    for (const Op& op : c.ops) {
+        switch (op.kind) {
+            case OpKind::Constant:
+                f.t += f.R * op.t;
+                f.R = f.R * op.R;
+                break;
+            case OpKind::Linear:
+                if (lines) lines->items[lines->count++] = {c.side, op.axis, false, f.R * op.dir, f.t};
+                f.t += f.R * (op.dir * q[op.axis]);
+                break;
+            case OpKind::Rotary: {
+                if (lines) lines->items[lines->count++] = {c.side, op.axis, true, f.R * op.dir, f.t};
+                double cs, sn;
+                trigOf(op, q[op.axis], cs, sn);
+                f.R = f.R * angleAxisMatrix(op.dir, cs, sn);
+                break;
+            }
+            case OpKind::Component: {
+                const Pose E = componentError(op, q);
+                f.t += f.R * E.translation();
+                f.R = f.R * E.linear();
+                break;
+            }
+        }
+    }
+}
+
+Frame KinematicsModel::chainFrame(Side side, const AxisVector& q, JointFrames* joints) const {
+    Frame f;
+    exactWalk(side == Side::Tool ? tool_ : workpiece_, q, f, joints, [](const Op&, double angle, double& cs, double& sn) {
+        cs = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
+        sn = std::sin(angle);
+    });
+    return f;
+}
+
+void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines) const {
     if (c.affine.ok) {
         const Affine& a = c.affine;
         f.R = a.R;
         f.t = a.t0;
         Vec3 moved = Vec3::Zero();  // by the axes before the current one
         for (int k = 0; k < a.count; ++k) {
-            if (lines) lines->items[lines->count++] = {a.axis[k], false, a.col[k], a.start[k] + moved};
+            if (lines) lines->items[lines->count++] = {c.side, a.axis[k], false, a.col[k], a.start[k] + moved};
             moved += a.col[k] * q[a.axis[k]];
         }
         f.t += moved;
@@ -254,34 +296,8 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
     }
     const std::vector<Op>& ops = c.ops;
     auto op0 = ops.begin();
-    if (exact_) {  // Kinematics::chainPose: from the identity, every product done
-        f.R.setIdentity();
-        f.t.setZero();
-        for (const Op& op : ops) {
-            switch (op.kind) {
-                case OpKind::Constant:
-                    f.t += f.R * op.t;
-                    f.R = f.R * op.R;
-                    break;
-                case OpKind::Linear:
-                    if (lines) lines->items[lines->count++] = {op.axis, false, f.R * op.dir, f.t};
-                    f.t += f.R * (op.dir * q[op.axis]);
-                    break;
-                case OpKind::Rotary: {
-                    if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
-                    double c, sn;
-                    trigOf(d, op, q[op.axis], c, sn);
-                    f.R = f.R * angleAxisMatrix(op.dir, c, sn);
-                    break;
-                }
-                case OpKind::Component: {
-                    const Pose E = componentError(op, q);
-                    f.t += f.R * E.translation();
-                    f.R = f.R * E.linear();
-                    break;
-                }
-            }
-        }
+    if (exact_) {
+        exactWalk(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trigOf(d, op, angle, cs, sn); });
         return;
     }
     if (op0 != ops.end() && op0->kind == OpKind::Constant) {  // a leading constant transform is the frame so far
@@ -300,11 +316,11 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
                 if (!op.identityR) f.R = f.R * op.R;
                 break;
             case OpKind::Linear:
-                if (lines) lines->items[lines->count++] = {op.axis, false, f.R * op.dir, f.t};
+                if (lines) lines->items[lines->count++] = {c.side, op.axis, false, f.R * op.dir, f.t};
                 f.t += f.R * (op.dir * q[op.axis]);
                 break;
             case OpKind::Rotary: {
-                if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
+                if (lines) lines->items[lines->count++] = {c.side, op.axis, true, f.R * op.dir, f.t};
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
                 if (op.unit >= 0) {
@@ -492,7 +508,7 @@ void KinematicsModel::jacobian(KinematicsData& d, const AxisVector& q, double le
     for (const ChainEntry* e : {&we, &te}) {
         const double sign = e == &we ? -1.0 : 1.0;
         for (int k = 0; k < e->lines.count; ++k) {
-            const JointLine& j = e->lines.items[k];
+            const JointFrame& j = e->lines.items[k];
             if (j.rotary) {
                 J.block<3, 1>(0, j.axis) = sign * (wRb * j.direction.cross(tipB - j.point));
                 J.block<3, 1>(3, j.axis) = sign * (wRb * j.direction.cross(dirB));
@@ -522,7 +538,7 @@ void KinematicsModel::pointJacobian(KinematicsData& d, const AxisVector& q, doub
     for (const ChainEntry* e : {&we, &te}) {
         const double sign = e == &we ? -1.0 : 1.0;
         for (int k = 0; k < e->lines.count; ++k) {
-            const JointLine& j = e->lines.items[k];
+            const JointFrame& j = e->lines.items[k];
             for (int c = 0; c < 3; ++c)
                 if (axes[c] == j.axis) J.col(c) = sign * (wRb * (j.rotary ? j.direction.cross(tipB - j.point) : j.direction));
         }

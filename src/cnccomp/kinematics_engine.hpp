@@ -1,29 +1,32 @@
 #pragma once
-// The kinematics engine: the forward kinematics of one machine (nominal, or with a deviation set) compiled once into
-// an immutable model, evaluated with an explicit workspace that the caller owns (the split of Pinocchio's Model and
-// Data: Carpentier et al., "The Pinocchio C++ library", SII 2019, §III-A). The model is the one of cnccomp::Kinematics
-// (link i = placement · E_location · motion(q) · E_component(q), exact rotations; [MultiTasking] eq. (7), (10)), with
-// the constant transforms between two motions folded into one, rotations about a coordinate axis built from one
-// sincos, component errors whose coefficients are all zero left out, no allocation per call.
+// The kinematics engine, the one chain walk of cnccomp: the forward kinematics of one machine (nominal, or with a
+// deviation set) compiled once into an immutable model, evaluated with an explicit workspace that the caller owns (the
+// split of Pinocchio's Model and Data: Carpentier et al., "The Pinocchio C++ library", SII 2019, §III-A). The model:
+// link i = placement · E_location · motion(q) · E_component(q), exact rotations ([MultiTasking] eq. (7), (10)).
 //
 // KinematicsModel is immutable and may be shared between threads. KinematicsData holds everything an evaluation
 // reuses from the previous ones (the last two poses of each chain, the last angles' cosines and sines); give each
 // thread its own. A Data follows the model it was last used with: handed to another model it starts empty.
-// Every evaluation agrees with cnccomp::Kinematics (tests/core/test_kinematics_engine.cpp: every sample machine, random
-// deviations and poses, to 1e-12 mm); the last bits may differ (folded products, angle addition).
-// A model compiled with Arithmetic::AsExactModel does the exact model's floating-point operations in its order instead
-// (no folding across links, no affine shortcut, sin and cos of every angle as Eigen's AngleAxis, toolPose through the
-// inverse of the workpiece pose): its frames and toolPose are bit for bit those of cnccomp::Kinematics and toolPose
-// (inverse_kinematics.hpp), for outputs that must not change by a digit with the engine (the volumetric map's files).
-// It keeps the workspace's savings that change no bit: the last kFrameMemo frames of each chain (keyed by the bit
-// patterns of the chain's own axes) and the cosines and sines of the last kAngleMemo angles of each rotary operation (a
-// grid's innermost axis, or a rotary axis, takes few distinct values).
+// Two arithmetics:
+// - Arithmetic::Fast (`correct`): the constant transforms between two motions folded into one, rotations about a
+//   coordinate axis built from one sincos, component errors whose coefficients are all zero left out, affine chains
+//   summed, angles near the last one by angle addition, no allocation per call. It agrees with the exact walk
+//   (tests/core/test_kinematics_engine.cpp: every sample machine, random deviations and poses, to 1e-12 mm); the last
+//   bits may differ.
+// - Arithmetic::AsExactModel, the exact model: every link's product from the identity, sin and cos of every angle as
+//   Eigen's AngleAxis, toolPose through the inverse of the workpiece pose. cnccomp::Kinematics (kinematics.hpp) is such
+//   a model evaluated without a workspace (chainFrame: simulation, identification, the inverse solver, the
+//   controllers' apply models); with a workspace (the volumetric map) the frames and toolPose are bit for bit the same,
+//   with the savings that change no bit: the last kFrameMemo frames of each chain (keyed by the bit patterns of the
+//   chain's own axes) and the cosines and sines of the last kAngleMemo angles of each rotary operation (a grid's
+//   innermost axis, or a rotary axis, takes few distinct values).
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "cnccomp/deviations.hpp"
-#include "cnccomp/inverse_kinematics.hpp"
+#include "cnccomp/machine.hpp"
 
 namespace cnccomp {
 
@@ -33,6 +36,26 @@ struct Frame {
     Vec3 t = Vec3::Zero();
     Vec3 operator*(const Vec3& p) const { return R * p + t; }
 };
+
+/// A moving axis at given commands, in the bed frame: its direction and a point on its line.
+struct JointFrame {
+    Side side = Side::Tool;
+    int axis = -1;
+    bool rotary = false;
+    Vec3 direction = Vec3::UnitZ();
+    Vec3 point = Vec3::Zero();
+};
+
+/// Fixed-capacity list of joint frames (no allocation).
+struct JointFrames {
+    std::array<JointFrame, kMaxAxes> items;
+    int count = 0;
+    const JointFrame* begin() const { return items.data(); }
+    const JointFrame* end() const { return items.data() + count; }
+};
+
+/// d(tip, axis)/dq: 6 × axis count, workpiece frame; rows 0–2 the tool point, rows 3–5 the tool axis.
+using PoseJacobian = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxAxes>;
 
 class KinematicsModel;
 
@@ -66,21 +89,12 @@ private:
             for (uint64_t& k : key) k = kEmptyAngle;
         }
     };
-    struct JointLine {
-        int axis = -1;
-        bool rotary = false;
-        Vec3 direction, point;
-    };
-    struct Lines {
-        JointLine items[kMaxAxes];
-        int count = 0;
-    };
     /// One evaluation of a chain, reused while the positions of its own axes are unchanged.
     struct ChainEntry {
         bool valid = false, hasLines = false;
         double key[kMaxAxes] = {};
         Frame frame;
-        Lines lines;
+        JointFrames lines;
     };
     /// The last two evaluations of a chain (consecutive evaluations often share the rotary positions: the nominal
     /// target, the TCP world point, the check).
@@ -108,7 +122,7 @@ public:
     /// How the model rounds (see the file comment).
     enum class Arithmetic : uint8_t {
         Fast,          ///< constants folded, affine chains summed, angle addition near the last angle
-        AsExactModel,  ///< the operations of cnccomp::Kinematics and toolPose in their order: their bits
+        AsExactModel,  ///< the exact model's operations in their order (cnccomp::Kinematics is this arithmetic)
     };
     /// `deviations` nullptr: the nominal machine; a set of another machine is refused (ModelError, requireMachine).
     /// The machine must outlive this object.
@@ -138,11 +152,16 @@ public:
     Frame baseToWorkpiece(KinematicsData& d, const AxisVector& q) const;
     Frame baseToTool(KinematicsData& d, const AxisVector& q) const;
 
+    /// The frame of one chain at q (bMw for Side::Workpiece, bMt for Side::Tool) and, when `joints`, its moving axes'
+    /// lines appended there, without a workspace: the exact model's arithmetic (every link's product from the
+    /// identity, sin and cos of every angle as Eigen's AngleAxis), nothing cached, safe to call from any thread. With
+    /// Arithmetic::AsExactModel this is cnccomp::Kinematics, which calls it; with Arithmetic::Fast it walks the folded
+    /// operations (agreeing to round-off).
+    Frame chainFrame(Side side, const AxisVector& q, JointFrames* joints = nullptr) const;
+
 private:
     friend class KinematicsData;
     using Trig = KinematicsData::Trig;
-    using Lines = KinematicsData::Lines;
-    using JointLine = KinematicsData::JointLine;
     using ChainEntry = KinematicsData::ChainEntry;
     using ChainCache = KinematicsData::ChainCache;
     enum class OpKind : uint8_t { Constant, Linear, Rotary, Component };
@@ -171,6 +190,7 @@ private:
         Vec3 start[kMaxAxes];  ///< where each axis' joint line starts with the axes before it at 0
     };
     struct ChainOps {
+        Side side = Side::Tool;
         std::vector<Op> ops;
         std::vector<int> axes;
         Affine affine;
@@ -192,7 +212,11 @@ private:
     void intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const;
     /// The error transform of a Component op at q.
     Pose componentError(const Op& op, const AxisVector& q) const;
-    void evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, Lines* lines) const;
+    /// The exact model's walk of chain c (see chainFrame); `trigOf(op, angle, c, s)` gives cos and sin of a rotary op's
+    /// angle.
+    template <class TrigOf>
+    void exactWalk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const;
+    void evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines) const;
     /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
     const ChainEntry& cached(KinematicsData& d, const ChainOps& c, ChainCache& cache, const AxisVector& q,
                              bool lines) const;

@@ -21,11 +21,10 @@ constexpr int kMaxGridAxes = 16;
 /// Everything a worker needs, prepared once (the per-point kernel only reads it).
 struct Plan {
     const MapRequest* request = nullptr;
-    /// The nominal machine for the inverse solver (orientation mode: solveToolPose takes the exact model).
-    Kinematics nominal;
-    /// The kinematics engine, with the exact model's arithmetic: the map's numbers are those of toolPose(Kinematics)
-    /// to the bit, so its files do not change by a digit with the engine (each worker has its own workspaces).
-    KinematicsModel nominalModel, actualModel;
+    /// The nominal machine (orientation mode: the inverse solver's) and the erroneous one. Each worker evaluates their
+    /// engine models (Kinematics::model, the exact model's arithmetic) with workspaces of its own: the map's numbers
+    /// are those of toolPose(Kinematics) to the bit, its repeated frames and angles found in the workspace.
+    Kinematics nominal, actual;
     Vec3 tipInTool = Vec3::Zero();
     AxisVector base;
     std::array<int, kMaxGridAxes> target{};  ///< axes mode: machine axis index; orientation mode: 0..2 = x y z
@@ -35,8 +34,7 @@ struct Plan {
     Plan(const MapRequest& r)
         : request(&r),
           nominal(r.machine),
-          nominalModel(r.machine, nullptr, KinematicsModel::Arithmetic::AsExactModel),
-          actualModel(r.machine, &r.deviations, KinematicsModel::Arithmetic::AsExactModel) {}
+          actual(r.machine, r.deviations) {}
 };
 
 void prepare(Plan& p) {
@@ -131,7 +129,7 @@ void prepare(Plan& p) {
 /// pose is reused) and the sines of the rotary axes' last angles (a grid's rotary axis takes few values).
 struct Scratch {
     KinematicsData nominal, actual;
-    explicit Scratch(const Plan& p) : nominal(p.nominalModel.createData()), actual(p.actualModel.createData()) {}
+    explicit Scratch(const Plan& p) : nominal(p.nominal.model().createData()), actual(p.actual.model().createData()) {}
 };
 
 /// The per-point kernel at per-axis grid indices `idx`: no allocation.
@@ -160,7 +158,7 @@ void evaluate(const Plan& p, const long* idx, MapPoint& out, Scratch& ws) {
         q = s.q;
         // Accept only a pose that is met (the solver's "converged" means the iteration settled).
         Vec3 gotTip, gotAxis;
-        p.nominalModel.toolPose(ws.nominal, q, r.toolLength, gotTip, gotAxis);
+        p.nominal.model().toolPose(ws.nominal, q, r.toolLength, gotTip, gotAxis);
         if (!s.converged || (gotTip - t.tip).norm() > 1e-6 || (gotAxis - t.axis).norm() > 1e-8) out.ok = false;
         for (int a = 0; a < q.size() && out.ok; ++a) {
             const Link& l = r.machine.axisLink(a);
@@ -170,8 +168,8 @@ void evaluate(const Plan& p, const long* idx, MapPoint& out, Scratch& ws) {
     out.q.fill(0.0);
     for (int a = 0; a < q.size(); ++a) out.q[a] = q[a];
     ToolPose n, a;
-    p.nominalModel.toolPose(ws.nominal, q, r.toolLength, n.tip, n.axis);
-    p.actualModel.toolPose(ws.actual, q, r.toolLength, a.tip, a.axis);
+    p.nominal.model().toolPose(ws.nominal, q, r.toolLength, n.tip, n.axis);
+    p.actual.model().toolPose(ws.actual, q, r.toolLength, a.tip, a.axis);
     out.tip = n.tip;
     out.error = a.tip - n.tip;
     const Vec3 cr = n.axis.cross(a.axis);

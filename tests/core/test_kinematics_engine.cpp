@@ -1,10 +1,12 @@
-// The kinematics engine (src/cnccomp/kinematics_engine.hpp: folded constant transforms, affine chains evaluated
-// without walking them, rotations from the last angle by angle addition, two cached evaluations per chain in the
-// caller's workspace; toolPoseOnce with the workpiece chain inverted onto the tool point) against the exact
-// cnccomp::Kinematics / toolPoseJacobian, an independent implementation of the same model (oracle: the same equations
-// coded twice, one link at a time there): every machine in samples/machines (location and component errors), and an
-// inclined rotary axis (a 45° head, the general rotation path), to 1e-12 mm and 1e-13 rad. Sequences of nearby and far
-// poses exercise every cache path.
+// The kinematics engine (src/cnccomp/kinematics_engine.hpp). Two kinds of check:
+// - Arithmetic::Fast (folded constant transforms, affine chains evaluated without walking them, rotations from the last
+//   angle by angle addition, two cached evaluations per chain in the caller's workspace; toolPoseOnce with the
+//   workpiece chain inverted onto the tool point) against cnccomp::Kinematics / toolPoseJacobian, the same model
+//   walked link by link without folding, caches or angle addition: every machine in samples/machines (location and
+//   component errors), and an inclined rotary axis (a 45° head, the general rotation path), to 1e-12 mm and 1e-13 rad.
+//   Sequences of nearby and far poses exercise every cache path.
+// - The exact walk itself (cnccomp::Kinematics, and Arithmetic::AsExactModel with its workspace) against ReferenceChain,
+//   an independent transcription of the model's equations, to the bit.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -168,6 +170,40 @@ TEST(KinematicsEngine, InclinedRotaryAxis) {
     compare(m, randomSet(m, rng), "inclined head with errors");
 }
 
+/// The exact model as its equations read, written out link by link with Eigen isometries (oracle: an independent
+/// transcription of [MultiTasking] eq. (7), (10) from machine.hpp's link and deviation definitions, not from the
+/// engine): link i = placement · E_location · motion(q) · E_component(q), each product taken as it comes.
+struct ReferenceChain {
+    const MachineModel& m;
+    Eigen::VectorXd values;
+    Pose walk(Side side, const AxisVector& q, JointFrames* joints = nullptr) const {
+        const Chain& chain = m.chain(side);
+        Pose p = Pose::Identity();
+        for (int i = 0; i < static_cast<int>(chain.links.size()); ++i) {
+            const Link& l = chain.links[i];
+            Vec6 location = Vec6::Zero(), component = Vec6::Zero();
+            bool hasComponents = false;
+            for (const DeviationDef& def : m.deviations) {
+                if (def.side != side || def.link != i) continue;
+                if (def.kind == DeviationKind::Location) {
+                    location[def.component] += values[def.offset];
+                } else {
+                    component[def.component] += def.basis.evaluate(q[l.axisIndex], values.data() + def.offset, l.modulo);
+                    hasComponents = true;
+                }
+            }
+            p = p * (l.placement * errorTransform(location));
+            if (joints && l.kind != AxisKind::Fixed)
+                joints->items[joints->count++] = {side, l.axisIndex, l.kind == AxisKind::Rotary, p.linear() * l.direction,
+                                                  p.translation()};
+            if (l.kind == AxisKind::Linear) p.translation() += p.linear() * (l.direction * q[l.axisIndex]);
+            if (l.kind == AxisKind::Rotary) p.linear() = p.linear() * Eigen::AngleAxisd(q[l.axisIndex], l.direction).toRotationMatrix();
+            if (hasComponents) p = p * errorTransform(component);
+        }
+        return p;
+    }
+};
+
 bool sameBits(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b) {
     if (a.rows() != b.rows() || a.cols() != b.cols()) return false;
     for (int i = 0; i < a.rows(); ++i)
@@ -176,12 +212,14 @@ bool sameBits(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const
     return true;
 }
 
-/// Arithmetic::AsExactModel against Kinematics and toolPose (oracle: the exact model, an independent implementation;
-/// here not to a tolerance but to the bit, ±0 included): chain frames and tool pose, on poses met in a grid's order
-/// (one axis stepping, the others held, a rotary axis back to earlier angles: the cache and angle-table paths) and at
-/// random, nominal and with deviations (location and component errors).
+/// Arithmetic::AsExactModel with a workspace (the map's), and cnccomp::Kinematics (the same model without one), against
+/// ReferenceChain, not to a tolerance but to the bit, ±0 included: chain frames, joint lines and tool pose, on poses met
+/// in a grid's order (one axis stepping, the others held, a rotary axis back to earlier angles: the cache and
+/// angle-table paths) and at random, nominal and with deviations (location and component errors). The tool pose's
+/// reference is toolPose's definition, wMt = bMw⁻¹ · bMt, on the reference frames.
 void compareBits(const MachineModel& m, const DeviationSet& d, const std::string& name) {
-    const Kinematics ref(m, d);
+    const ReferenceChain ref{m, d.values};
+    const Kinematics exact(m, d);
     const KinematicsModel k(m, &d, KinematicsModel::Arithmetic::AsExactModel);
     EXPECT_EQ(k.arithmetic(), KinematicsModel::Arithmetic::AsExactModel);
     KinematicsData data = k.createData();
@@ -199,21 +237,35 @@ void compareBits(const MachineModel& m, const DeviationSet& d, const std::string
         }
         if (trial % 11 == 0) q[a] = -0.0;
         const Frame w = k.baseToWorkpiece(data, q), t = k.baseToTool(data, q);
-        const Pose rw = ref.baseToWorkpiece(q), rt = ref.baseToTool(q);
+        JointFrames refJoints;
+        const Pose rw = ref.walk(Side::Workpiece, q, &refJoints), rt = ref.walk(Side::Tool, q, &refJoints);
         EXPECT_TRUE(sameBits(w.R, rw.linear()) && sameBits(w.t, rw.translation())) << name << " workpiece frame, trial " << trial;
         EXPECT_TRUE(sameBits(t.R, rt.linear()) && sameBits(t.t, rt.translation())) << name << " tool frame, trial " << trial;
+        const Pose ew = exact.baseToWorkpiece(q), et = exact.baseToTool(q);
+        EXPECT_TRUE(sameBits(ew.matrix(), rw.matrix()) && sameBits(et.matrix(), rt.matrix())) << name << " Kinematics, trial " << trial;
+        const JointFrames joints = exact.jointFrames(q);
+        EXPECT_EQ(joints.count, refJoints.count);
+        for (int j = 0; j < std::min(joints.count, refJoints.count); ++j) {
+            const JointFrame &a = joints.items[j], &b = refJoints.items[j];
+            EXPECT_TRUE(a.side == b.side && a.axis == b.axis && a.rotary == b.rotary && sameBits(a.direction, b.direction) &&
+                        sameBits(a.point, b.point))
+                << name << " joint line " << j << ", trial " << trial;
+        }
+        const Pose wMt = rw.inverse(Eigen::Isometry) * rt;
         for (double L : {0.0, 120.0, 360.0}) {
             Vec3 tip, axis;
             k.toolPose(data, q, L, tip, axis);
-            const ToolPose r = toolPose(ref, q, ref.toolPoint(L));
-            EXPECT_TRUE(sameBits(tip, r.tip) && sameBits(axis, r.axis)) << name << " tool pose, trial " << trial << ", L " << L;
+            const Vec3 refTip = wMt * Vec3(m.toolDirection * L + Vec3::Zero()), refAxis = wMt.linear() * m.toolDirection;
+            EXPECT_TRUE(sameBits(tip, refTip) && sameBits(axis, refAxis)) << name << " tool pose, trial " << trial << ", L " << L;
+            const ToolPose e = toolPose(exact, q, exact.toolPoint(L));
+            EXPECT_TRUE(sameBits(e.tip, refTip) && sameBits(e.axis, refAxis)) << name << " toolPose, trial " << trial << ", L " << L;
             ++checked;
         }
     }
     EXPECT_EQ(checked, 1200);
 }
 
-TEST(KinematicsEngine, AsExactModelIsTheExactKinematicsToTheBit) {
+TEST(KinematicsEngine, TheExactModelIsTheLinkByLinkTranscriptionToTheBit) {
     std::mt19937_64 rng(9);
     for (const auto& file : sampleMachineFiles()) {
         const MachineModel m = readMachineXml(file.string());
