@@ -110,24 +110,9 @@ const Frame& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, st
     return e.frame;
 }
 
-void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
-    if (!exact_) {
-        trig(d.trig_[op.slot], angle, c, s);
-        return;
-    }
-    KinematicsData::AngleMemo& m = d.angles_[static_cast<size_t>(op.slot)];
-    const uint64_t key = std::bit_cast<uint64_t>(angle);
-    const int i = static_cast<int>((key * 0x9E3779B97F4A7C15ULL) >> 58);  // kAngleMemo = 64 entries
-    static_assert(kAngleMemo == 64);
-    if (m.key[i] != key) {
-        m.key[i] = key;
-        m.c[i] = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
-        m.s[i] = std::sin(angle);
-    }
-    c = m.c[i], s = m.s[i];
-}
-
-void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
+// Inlined into the Fast path's evaluations (one call per rotary operation and evaluation, about a tenth of correct's
+// kinematics time as a call: the results went through memory and the call was on the dependent chain).
+[[gnu::always_inline]] inline void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
     if (angle == t.asked) {  // the same angle again (a pose and its frame, a chain walked twice)
         c = t.askedC, s = t.askedS;
         return;
@@ -149,6 +134,23 @@ void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
         t.last = angle, t.lastC = c, t.lastS = s;  // only exact evaluations become bases: no drift
     }
     t.askedC = c, t.askedS = s;
+}
+
+void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
+    if (!exact_) {
+        trig(d.trig_[op.slot], angle, c, s);
+        return;
+    }
+    KinematicsData::AngleMemo& m = d.angles_[static_cast<size_t>(op.slot)];
+    const uint64_t key = std::bit_cast<uint64_t>(angle);
+    const int i = static_cast<int>((key * 0x9E3779B97F4A7C15ULL) >> 58);  // kAngleMemo = 64 entries
+    static_assert(kAngleMemo == 64);
+    if (m.key[i] != key) {
+        m.key[i] = key;
+        m.c[i] = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
+        m.s[i] = std::sin(angle);
+    }
+    c = m.c[i], s = m.s[i];
 }
 
 void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& slots) {
@@ -306,7 +308,7 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
             case OpKind::Rotary: {
                 if (lines) lines->items[lines->count++] = {op.axis, true, f.R * op.dir, f.t};
                 double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
+                trig(d.trig_[op.slot], q[op.axis], c, sn);  // the Fast branch
                 if (op.unit >= 0) {
                     rotateAboutUnit(f.R, op.unit, c, sn);
                 } else {
@@ -396,7 +398,8 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
+                if (exact_) trigOf(d, op, q[op.axis], c, sn);
+                else trig(d.trig_[op.slot], q[op.axis], c, sn);
                 if constexpr (WithPoint) rotateBack(op, c, sn, point);
                 rotateBack(op, c, sn, direction);
                 break;
@@ -458,7 +461,8 @@ Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, co
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
+                if (exact_) trigOf(d, op, q[op.axis], c, sn);
+                else trig(d.trig_[op.slot], q[op.axis], c, sn);
                 rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }
