@@ -415,7 +415,7 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
 }
 
 void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
-    bind(d);
+    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
     if (workpiece_.affine.ok) {
         toolPose(d, q, length, tip, axis);
         return;
@@ -435,7 +435,7 @@ void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, doubl
 }
 
 Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const {
-    bind(d);
+    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
     if (workpiece_.affine.ok) {
         Vec3 tip, axis;
         toolPose(d, q, 0.0, tip, axis);
@@ -448,7 +448,7 @@ Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const
 }
 
 Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const {
-    bind(d);
+    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
     if (workpiece_.affine.ok) return workpiece_.affine.R * v;
     Vec3 r = v;
     for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
