@@ -52,7 +52,7 @@ bool BlockEdits::add(uint32_t begin, uint32_t end, std::string_view text) {
             return false;
         }
         at = used_;
-        if (!text.empty()) std::memcpy(arena_.data() + used_, text.data(), text.size());
+        copyBytes(arena_.data() + used_, text.data(), text.size());
         used_ += text.size();
     }
     edits_[count_] = {begin, end, static_cast<uint32_t>(at), static_cast<uint32_t>(text.size()),
@@ -81,7 +81,33 @@ void BlockEdits::apply(std::string_view line, OutputBuffer& out) {
     // Usually added in the order of the line already (the words, then what is appended after them).
     if (!std::is_sorted(edits_.begin(), edits_.begin() + count_, before))
         std::sort(edits_.begin(), edits_.begin() + count_, before);
+    // The edited line's length first: it is copied into the output buffer in one reservation.
+    size_t total = 0;
+    bool inLine = true;
     uint32_t pos = 0;
+    for (int i = 0; i < count_ && inLine; ++i) {
+        const Edit& e = edits_[i];
+        if (e.begin < pos) continue;
+        inLine = e.begin <= line.size() && e.end <= line.size();
+        total += (e.begin - pos) + e.textLen;
+        pos = e.end;
+    }
+    char* at = inLine ? out.reserve(total + (line.size() - pos)) : nullptr;
+    if (at) {
+        char* const start = at;
+        pos = 0;
+        for (int i = 0; i < count_; ++i) {
+            const Edit& e = edits_[i];
+            if (e.begin < pos) continue;
+            at = copyBytes(at, line.data() + pos, e.begin - pos);
+            at = copyBytes(at, arena_.data() + e.textBegin, e.textLen);
+            pos = e.end;
+        }
+        at = copyBytes(at, line.data() + pos, line.size() - pos);
+        out.commit(static_cast<size_t>(at - start));
+        return;
+    }
+    pos = 0;
     for (int i = 0; i < count_; ++i) {
         const Edit& e = edits_[i];
         if (e.begin < pos) continue;  // overlapping edit: cannot happen with word spans; ignore defensively

@@ -4,12 +4,39 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <ostream>
 #include <string_view>
 #include <vector>
 
 namespace cnccomp::postproc {
+
+/// Copies n bytes to d and returns d + n: words and the spans between them are a few bytes, for which a call to
+/// memmove costs more than the copy (two overlapping fixed-size moves up to 16 bytes).
+inline char* copyBytes(char* d, const char* s, size_t n) {
+    if (n > 16) {
+        std::memcpy(d, s, n);
+    } else if (n >= 8) {
+        uint64_t a, b;
+        std::memcpy(&a, s, 8);
+        std::memcpy(&b, s + n - 8, 8);
+        std::memcpy(d, &a, 8);
+        std::memcpy(d + n - 8, &b, 8);
+    } else if (n >= 4) {
+        uint32_t a, b;
+        std::memcpy(&a, s, 4);
+        std::memcpy(&b, s + n - 4, 4);
+        std::memcpy(d, &a, 4);
+        std::memcpy(d + n - 4, &b, 4);
+    } else if (n > 0) {
+        const char a = s[0], b = s[n / 2], c = s[n - 1];
+        d[0] = a;
+        d[n / 2] = b;
+        d[n - 1] = c;
+    }
+    return d + n;
+}
 
 /// Buffered writes to a stream: at most `capacity` bytes are held before they are written. The storage is not
 /// allocated at full capacity up front: it starts at 4 KiB and doubles as the output grows (never zero-filled), so a
@@ -31,6 +58,13 @@ public:
         std::copy(s.begin(), s.end(), buf_.get() + used_);
         used_ += s.size();
     }
+    /// Room for `n` more bytes (the storage grown or flushed), nullptr when n exceeds the capacity; the caller writes at
+    /// most n bytes there and commits the count it wrote.
+    char* reserve(size_t n) {
+        if (n > size_ - used_ && !makeRoom(n)) return nullptr;
+        return buf_.get() + used_;
+    }
+    void commit(size_t n) { used_ += n; }
     void flush();
     uint64_t bytesWritten() const { return written_ + used_; }
 

@@ -314,7 +314,7 @@ void ProgramCorrector::writeMove(const Record& rec, const Line& ln, const MovePi
             if (replace && existing >= 0 && existing < b_->count) {
                 replaceNumber(b_->words[static_cast<size_t>(existing)], w, len);
             } else {
-                std::memcpy(buf + used, w, len);
+                copyBytes(buf + used, w, len);
                 used += len;
             }
         };

@@ -99,7 +99,7 @@ size_t ProgramCorrector::composeWord(char letter, const char* num, size_t n, int
         }
         for (int k = 0; k < gap && k < 8; ++k) out[len++] = ' ';
     }
-    std::memcpy(out + len, num, n);
+    copyBytes(out + len, num, n);
     return len + n;
 }
 
@@ -189,7 +189,7 @@ bool ProgramCorrector::axisWord(int a, double q, int existing, char* text, size_
     outKnown_ |= bit;
     if (orig) {
         replace = true;
-        std::memcpy(text, num, n);
+        copyBytes(text, num, n);
         len = n;
     } else {
         len = composeWord(layout_.letter[a], num, n, 0, true, text);

@@ -110,24 +110,9 @@ const Frame& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, st
     return e.frame;
 }
 
-void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
-    if (!exact_) {
-        trig(d.trig_[op.slot], angle, c, s);
-        return;
-    }
-    KinematicsData::AngleMemo& m = d.angles_[static_cast<size_t>(op.slot)];
-    const uint64_t key = std::bit_cast<uint64_t>(angle);
-    const int i = static_cast<int>((key * 0x9E3779B97F4A7C15ULL) >> 58);  // kAngleMemo = 64 entries
-    static_assert(kAngleMemo == 64);
-    if (m.key[i] != key) {
-        m.key[i] = key;
-        m.c[i] = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
-        m.s[i] = std::sin(angle);
-    }
-    c = m.c[i], s = m.s[i];
-}
-
-void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
+// Inlined into the Fast path's evaluations (one call per rotary operation and evaluation, about a tenth of correct's
+// kinematics time as a call: the results went through memory and the call was on the dependent chain).
+[[gnu::always_inline]] inline void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
     if (angle == t.asked) {  // the same angle again (a pose and its frame, a chain walked twice)
         c = t.askedC, s = t.askedS;
         return;
@@ -149,6 +134,23 @@ void KinematicsModel::trig(Trig& t, double angle, double& c, double& s) {
         t.last = angle, t.lastC = c, t.lastS = s;  // only exact evaluations become bases: no drift
     }
     t.askedC = c, t.askedS = s;
+}
+
+void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
+    if (!exact_) {
+        trig(d.trig_[op.slot], angle, c, s);
+        return;
+    }
+    KinematicsData::AngleMemo& m = d.angles_[static_cast<size_t>(op.slot)];
+    const uint64_t key = std::bit_cast<uint64_t>(angle);
+    const int i = static_cast<int>((key * 0x9E3779B97F4A7C15ULL) >> 58);  // kAngleMemo = 64 entries
+    static_assert(kAngleMemo == 64);
+    if (m.key[i] != key) {
+        m.key[i] = key;
+        m.c[i] = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
+        m.s[i] = std::sin(angle);
+    }
+    c = m.c[i], s = m.s[i];
 }
 
 void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& slots) {
@@ -322,7 +324,7 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
             case OpKind::Rotary: {
                 if (lines) lines->items[lines->count++] = {c.side, op.axis, true, f.R * op.dir, f.t};
                 double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
+                trig(d.trig_[op.slot], q[op.axis], c, sn);  // the Fast branch
                 if (op.unit >= 0) {
                     rotateAboutUnit(f.R, op.unit, c, sn);
                 } else {
@@ -412,7 +414,8 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
+                if (exact_) trigOf(d, op, q[op.axis], c, sn);
+                else trig(d.trig_[op.slot], q[op.axis], c, sn);
                 if constexpr (WithPoint) rotateBack(op, c, sn, point);
                 rotateBack(op, c, sn, direction);
                 break;
@@ -428,7 +431,7 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
 }
 
 void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
-    bind(d);
+    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
     if (workpiece_.affine.ok) {
         toolPose(d, q, length, tip, axis);
         return;
@@ -448,7 +451,7 @@ void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, doubl
 }
 
 Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const {
-    bind(d);
+    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
     if (workpiece_.affine.ok) {
         Vec3 tip, axis;
         toolPose(d, q, 0.0, tip, axis);
@@ -461,7 +464,7 @@ Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const
 }
 
 Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const {
-    bind(d);
+    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
     if (workpiece_.affine.ok) return workpiece_.affine.R * v;
     Vec3 r = v;
     for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
@@ -474,7 +477,8 @@ Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, co
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
+                if (exact_) trigOf(d, op, q[op.axis], c, sn);
+                else trig(d.trig_[op.slot], q[op.axis], c, sn);
                 rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }

@@ -5,9 +5,11 @@
 // here cross every growth step of the 1 MiB default and of small capacities.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "postproc/block_writer.hpp"
 
@@ -65,6 +67,54 @@ TEST(PostprocOutputBuffer, NothingReachesTheStreamBeforeTheCapacityIsExceededOrF
     b.flush();
     EXPECT_EQ(out.str(), expected + "z");
     EXPECT_EQ(b.bytesWritten(), expected.size() + 1);
+}
+
+// BlockEdits::apply copies the edited line into the buffer in one reservation, every span and word by copyBytes (sizes
+// 0 to 16 by overlapping fixed-size moves, more by memcpy), and falls back to piecewise writes when the line exceeds
+// the buffer's capacity. Oracle: the splice written out here with std::string (replacements and insertions in position
+// order, insertions before a replacement starting at the same byte), over random lines and edits of every size from 0
+// to 40 bytes, into a large and a small buffer.
+TEST(PostprocOutputBuffer, EditedLinesAreTheSpliceOfTheirEditsWhateverTheSizes) {
+    std::mt19937 rng(11);
+    for (const size_t capacity : {size_t{64}, size_t{1} << 20}) {
+        SCOPED_TRACE(capacity);
+        std::ostringstream out;
+        std::string expected;
+        postproc::OutputBuffer b(out, capacity);
+        postproc::BlockEdits edits;
+        for (int i = 0; i < 3000; ++i) {
+            const std::string line = piece(rng, rng() % 200);
+            // Disjoint spans in position order (some empty: insertions), each replaced by 0–40 bytes.
+            struct Span {
+                uint32_t begin, end;
+                std::string text;
+            };
+            std::vector<Span> spans;
+            uint32_t pos = 0;
+            while (spans.size() < 12) {
+                const uint32_t begin = pos + static_cast<uint32_t>(rng() % 20);
+                if (begin > line.size()) break;
+                const uint32_t end = std::min<uint32_t>(static_cast<uint32_t>(line.size()), begin + static_cast<uint32_t>(rng() % 12));
+                spans.push_back({begin, end, std::string(rng() % 41, static_cast<char>('A' + rng() % 26))});
+                pos = end + 1;  // not touching: replacements of neighbouring words have a separator between them
+            }
+            edits.clear();
+            for (const Span& s : spans) ASSERT_TRUE(edits.add(s.begin, s.end, s.text));
+            std::string spliced;
+            uint32_t at = 0;
+            for (const Span& s : spans) {
+                spliced += line.substr(at, s.begin - at);
+                spliced += s.text;
+                at = s.end;
+            }
+            spliced += line.substr(at);
+            edits.apply(line, b);
+            expected += spliced;
+            ASSERT_EQ(b.bytesWritten(), expected.size());
+        }
+        b.flush();
+        EXPECT_EQ(out.str(), expected);
+    }
 }
 
 }  // namespace
