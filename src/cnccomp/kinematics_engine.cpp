@@ -242,16 +242,26 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
     }
 }
 
-template <class TrigOf>
-void KinematicsModel::exactWalk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const {
-    // From the identity, every link's product done (no folding), as the model's equations read: [MultiTasking] eq. (7), (10).
-    f.R.setIdentity();
-    f.t.setZero();
-    for (const Op& op : c.ops) {
+template <bool Exact, class TrigOf>
+void KinematicsModel::walk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const {
+    // Link by link as the model's equations read ([MultiTasking] eq. (7), (10)). Exact: from the identity, every
+    // product done, rotations as Eigen's AngleAxis builds them; Fast: a leading constant transform is the frame so far,
+    // identity rotations skipped, rotations about a coordinate axis turning two columns.
+    auto it = c.ops.begin();
+    if (!Exact && it != c.ops.end() && it->kind == OpKind::Constant) {
+        f.R = it->R;
+        f.t = it->t;
+        ++it;
+    } else {
+        f.R.setIdentity();
+        f.t.setZero();
+    }
+    for (; it != c.ops.end(); ++it) {
+        const Op& op = *it;
         switch (op.kind) {
             case OpKind::Constant:
                 f.t += f.R * op.t;
-                f.R = f.R * op.R;
+                if (Exact || !op.identityR) f.R = f.R * op.R;
                 break;
             case OpKind::Linear:
                 if (lines) lines->items[lines->count++] = {c.side, op.axis, false, f.R * op.dir, f.t};
@@ -261,7 +271,20 @@ void KinematicsModel::exactWalk(const ChainOps& c, const AxisVector& q, Frame& f
                 if (lines) lines->items[lines->count++] = {c.side, op.axis, true, f.R * op.dir, f.t};
                 double cs, sn;
                 trigOf(op, q[op.axis], cs, sn);
-                f.R = f.R * angleAxisMatrix(op.dir, cs, sn);
+                if constexpr (Exact) {
+                    f.R = f.R * angleAxisMatrix(op.dir, cs, sn);
+                } else if (op.unit >= 0) {
+                    rotateAboutUnit(f.R, op.unit, cs, sn);
+                } else {
+                    // Rodrigues: R(u, θ) = c I + s [u]× + (1 − c) u uᵀ.
+                    const Vec3& u = op.dir;
+                    const double c1 = 1 - cs;
+                    Mat3 Ru;
+                    Ru << cs + u.x() * u.x() * c1, u.x() * u.y() * c1 - u.z() * sn, u.x() * u.z() * c1 + u.y() * sn,
+                        u.y() * u.x() * c1 + u.z() * sn, cs + u.y() * u.y() * c1, u.y() * u.z() * c1 - u.x() * sn,
+                        u.z() * u.x() * c1 - u.y() * sn, u.z() * u.y() * c1 + u.x() * sn, cs + u.z() * u.z() * c1;
+                    f.R = f.R * Ru;
+                }
                 break;
             }
             case OpKind::Component: {
@@ -276,7 +299,7 @@ void KinematicsModel::exactWalk(const ChainOps& c, const AxisVector& q, Frame& f
 
 Frame KinematicsModel::chainFrame(Side side, const AxisVector& q, JointFrames* joints) const {
     Frame f;
-    exactWalk(side == Side::Tool ? tool_ : workpiece_, q, f, joints, [](const Op&, double angle, double& cs, double& sn) {
+    walk<true>(side == Side::Tool ? tool_ : workpiece_, q, f, joints, [](const Op&, double angle, double& cs, double& sn) {
         cs = std::cos(angle);  // as Eigen::AngleAxis::toRotationMatrix
         sn = std::sin(angle);
     });
@@ -296,56 +319,10 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
         f.t += moved;
         return;
     }
-    const std::vector<Op>& ops = c.ops;
-    auto op0 = ops.begin();
-    if (exact_) {
-        exactWalk(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trigOf(d, op, angle, cs, sn); });
-        return;
-    }
-    if (op0 != ops.end() && op0->kind == OpKind::Constant) {  // a leading constant transform is the frame so far
-        f.R = op0->R;
-        f.t = op0->t;
-        ++op0;
-    } else {
-        f.R.setIdentity();
-        f.t.setZero();
-    }
-    for (auto it = op0; it != ops.end(); ++it) {
-        const Op& op = *it;
-        switch (op.kind) {
-            case OpKind::Constant:
-                f.t += f.R * op.t;
-                if (!op.identityR) f.R = f.R * op.R;
-                break;
-            case OpKind::Linear:
-                if (lines) lines->items[lines->count++] = {c.side, op.axis, false, f.R * op.dir, f.t};
-                f.t += f.R * (op.dir * q[op.axis]);
-                break;
-            case OpKind::Rotary: {
-                if (lines) lines->items[lines->count++] = {c.side, op.axis, true, f.R * op.dir, f.t};
-                double c, sn;
-                trig(d.trig_[op.slot], q[op.axis], c, sn);  // the Fast branch
-                if (op.unit >= 0) {
-                    rotateAboutUnit(f.R, op.unit, c, sn);
-                } else {
-                    // Rodrigues: R(u, θ) = c I + s [u]× + (1 − c) u uᵀ.
-                    const Vec3& u = op.dir;
-                    Mat3 Ru;
-                    Ru << c + u.x() * u.x() * (1 - c), u.x() * u.y() * (1 - c) - u.z() * sn, u.x() * u.z() * (1 - c) + u.y() * sn,
-                        u.y() * u.x() * (1 - c) + u.z() * sn, c + u.y() * u.y() * (1 - c), u.y() * u.z() * (1 - c) - u.x() * sn,
-                        u.z() * u.x() * (1 - c) - u.y() * sn, u.z() * u.y() * (1 - c) + u.x() * sn, c + u.z() * u.z() * (1 - c);
-                    f.R = f.R * Ru;
-                }
-                break;
-            }
-            case OpKind::Component: {
-                const Pose E = componentError(op, q);
-                f.t += f.R * E.translation();
-                f.R = f.R * E.linear();
-                break;
-            }
-        }
-    }
+    if (exact_)
+        walk<true>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trigOf(d, op, angle, cs, sn); });
+    else
+        walk<false>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trig(d.trig_[op.slot], angle, cs, sn); });
 }
 
 const KinematicsModel::ChainEntry& KinematicsModel::cached(KinematicsData& d, const ChainOps& c, ChainCache& cache,

@@ -212,10 +212,10 @@ private:
     void intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const;
     /// The error transform of a Component op at q.
     Pose componentError(const Op& op, const AxisVector& q) const;
-    /// The exact model's walk of chain c (see chainFrame); `trigOf(op, angle, c, s)` gives cos and sin of a rotary op's
-    /// angle.
-    template <class TrigOf>
-    void exactWalk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const;
+    /// The walk of chain c's operations with the exact model's arithmetic (Exact; see chainFrame) or the fast one;
+    /// `trigOf(op, angle, c, s)` gives cos and sin of a rotary op's angle.
+    template <bool Exact, class TrigOf>
+    void walk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const;
     void evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines) const;
     /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
     const ChainEntry& cached(KinematicsData& d, const ChainOps& c, ChainCache& cache, const AxisVector& q,
