@@ -315,16 +315,29 @@ void checkLinearCirclePass(const LinearCirclePass& pass, int index) {
                                      who, first, last, pass.startDeg, pass.sweepDeg, tol));
 }
 
-std::vector<double> predictLinearCircle(const LinearCircle& circle, const LinearCirclePass& pass,
-                                        const LinearCircleDiagnostics& d, const Eigen::Vector2d& centringUm,
-                                        double radiusOffsetUm, const LinearCircleSettings& settings) {
+namespace {
+
+/// The diagnostics with the set-up's centring and radius offset as the model's parameter vector (finite, else
+/// ModelError).
+linear_circle_detail::CanonVector canonParameters(const LinearCircleDiagnostics& d, const Eigen::Vector2d& centringUm,
+                                                  double radiusOffsetUm) {
     using namespace linear_circle_detail;
-    const PassGeometry g = preparePass(circle, pass, settings.spikeDecayDeg);
     CanonVector p = toCanon(d);
     p[kCentU] = centringUm.x();
     p[kCentV] = centringUm.y();
     p[kRadius] = radiusOffsetUm;
     if (!p.allFinite()) throw ModelError("linear circle: the parameters must be finite numbers");
+    return p;
+}
+
+}  // namespace
+
+std::vector<double> predictLinearCircle(const LinearCircle& circle, const LinearCirclePass& pass,
+                                        const LinearCircleDiagnostics& d, const Eigen::Vector2d& centringUm,
+                                        double radiusOffsetUm, const LinearCircleSettings& settings) {
+    using namespace linear_circle_detail;
+    const PassGeometry g = preparePass(circle, pass, settings.spikeDecayDeg);
+    const CanonVector p = canonParameters(d, centringUm, radiusOffsetUm);
     std::vector<double> out(g.theta.size());
     for (size_t i = 0; i < out.size(); ++i) out[i] = evalSample(circle, g, i, settings, p, nullptr);
     return out;
@@ -335,11 +348,7 @@ Eigen::MatrixXd linearCircleJacobian(const LinearCircle& circle, const LinearCir
                                      double radiusOffsetUm, const LinearCircleSettings& settings) {
     using namespace linear_circle_detail;
     const PassGeometry g = preparePass(circle, pass, settings.spikeDecayDeg);
-    CanonVector p = toCanon(d);
-    p[kCentU] = centringUm.x();
-    p[kCentV] = centringUm.y();
-    p[kRadius] = radiusOffsetUm;
-    if (!p.allFinite()) throw ModelError("linear circle: the parameters must be finite numbers");
+    const CanonVector p = canonParameters(d, centringUm, radiusOffsetUm);
     Eigen::MatrixXd J(static_cast<Eigen::Index>(g.theta.size()), static_cast<Eigen::Index>(kCanon));
     CanonVector G;
     for (size_t i = 0; i < g.theta.size(); ++i) {
