@@ -109,11 +109,20 @@ size_t formatExact(double value, int d, char* out) {
     }
     return n + writeFixed(scaled, d, out + n);
 }
+/// std::round (half away from zero), inline: x86-64's baseline has no rounding instruction and the library call costs
+/// more than the number's other arithmetic. For |x| < 2^52 the truncation t is exact, so is x − t (the fraction of
+/// x) and t ± 1; the sign is x's, −0 included. Larger values are integers already (NaN and infinities pass).
+inline double roundHalfAway(double x) {
+    if (!(std::fabs(x) < 0x1p52)) return x;
+    const double t = static_cast<double>(static_cast<int64_t>(x));
+    return std::copysign(std::fabs(x - t) >= 0.5 ? t + std::copysign(1.0, x) : t, x);
+}
+
 }  // namespace
 
 double roundToStyle(double value, const NumberStyle& style) {
     const int d = clampDecimals(style);
-    const double scaled = std::round(value * kPow10[d]);
+    const double scaled = roundHalfAway(value * kPow10[d]);
     return scaled / kPow10[d];
 }
 
@@ -121,17 +130,27 @@ size_t formatNumber(double value, const NumberStyle& style, char* out) {
     const int d = clampDecimals(style);
     if (style.exact && style.point && style.fixed && !style.plus && !style.bareFraction) return formatExact(value, d, out);
     if (!std::isfinite(value)) value = 0.0;
-    const double scaledAbs = std::round(std::fabs(value) * kPow10[d]);
+    const double a = std::fabs(value);
+    const double scaledAbs = roundHalfAway(a * kPow10[d]);
     size_t n = 0;
     if (scaledAbs >= 9e18) return viaPrintf(value, d, out);
     uint64_t scaled = static_cast<uint64_t>(scaledAbs);
     const bool negative = value < 0 && scaled != 0;
     if (negative) out[n++] = '-';
     else if (style.plus) out[n++] = '+';
-    uint64_t p10 = 1;
-    for (int k = 0; k < d; ++k) p10 *= 10;
-    const uint64_t ip = scaled / p10;
-    uint64_t frac = scaled % p10;
+    const uint64_t p10 = kPow10u[d];
+    // ip = scaled / 10^d and frac = scaled % 10^d without a 64-bit division by a variable: below 2^52 the integer part
+    // of a is exact and ⌊a⌋ · 10^d ≤ scaled ≤ (⌊a⌋ + 1) · 10^d (rounding is monotone, both bounds representable), so
+    // the quotient is ⌊a⌋ or one more.
+    uint64_t ip, frac;
+    if (scaledAbs < 0x1p52) {
+        ip = static_cast<uint64_t>(a);
+        frac = scaled - ip * p10;
+        if (frac >= p10) frac -= p10, ++ip;
+    } else {
+        ip = scaled / p10;
+        frac = scaled % p10;
+    }
     char digits[24];
     int fd = d;
     if (style.point && !style.fixed) {
