@@ -12,23 +12,25 @@
 
 namespace cnccomp::postproc {
 
+/// n bytes (sizeof(Word) ≤ n ≤ 2 sizeof(Word)) from s to d as two overlapping Word moves: the first and the last Word.
+template <class Word>
+inline void copyTwoWords(char* d, const char* s, size_t n) {
+    Word a, b;
+    std::memcpy(&a, s, sizeof a);
+    std::memcpy(&b, s + n - sizeof b, sizeof b);
+    std::memcpy(d, &a, sizeof a);
+    std::memcpy(d + n - sizeof b, &b, sizeof b);
+}
+
 /// Copies n bytes to d and returns d + n: words and the spans between them are a few bytes, for which a call to
 /// memmove costs more than the copy (two overlapping fixed-size moves up to 16 bytes).
 inline char* copyBytes(char* d, const char* s, size_t n) {
     if (n > 16) {
         std::memcpy(d, s, n);
     } else if (n >= 8) {
-        uint64_t a, b;
-        std::memcpy(&a, s, 8);
-        std::memcpy(&b, s + n - 8, 8);
-        std::memcpy(d, &a, 8);
-        std::memcpy(d + n - 8, &b, 8);
+        copyTwoWords<uint64_t>(d, s, n);
     } else if (n >= 4) {
-        uint32_t a, b;
-        std::memcpy(&a, s, 4);
-        std::memcpy(&b, s + n - 4, 4);
-        std::memcpy(d, &a, 4);
-        std::memcpy(d + n - 4, &b, 4);
+        copyTwoWords<uint32_t>(d, s, n);
     } else if (n > 0) {
         const char a = s[0], b = s[n / 2], c = s[n - 1];
         d[0] = a;
