@@ -83,8 +83,7 @@ KinematicsModel::KinematicsModel(const MachineModel& machine, const DeviationSet
 
 KinematicsData::KinematicsData(const KinematicsModel& model) { model.bind(*this); }
 
-void KinematicsModel::bind(KinematicsData& d) const {
-    if (d.model_ == id_) return;
+void KinematicsModel::rebind(KinematicsData& d) const {
     d = KinematicsData();
     d.model_ = id_;
     if (exact_) {
@@ -136,11 +135,7 @@ const Frame& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, st
     t.askedC = c, t.askedS = s;
 }
 
-void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
-    if (!exact_) {
-        trig(d.trig_[op.slot], angle, c, s);
-        return;
-    }
+void KinematicsModel::exactTrig(KinematicsData& d, const Op& op, double angle, double& c, double& s) const {
     KinematicsData::AngleMemo& m = d.angles_[static_cast<size_t>(op.slot)];
     const uint64_t key = std::bit_cast<uint64_t>(angle);
     const int i = static_cast<int>((key * 0x9E3779B97F4A7C15ULL) >> 58);  // kAngleMemo = 64 entries
@@ -151,6 +146,12 @@ void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, doub
         m.s[i] = std::sin(angle);
     }
     c = m.c[i], s = m.s[i];
+}
+
+[[gnu::always_inline]] inline void KinematicsModel::trigOf(KinematicsData& d, const Op& op, double angle, double& c,
+                                                           double& s) const {
+    if (exact_) exactTrig(d, op, angle, c, s);
+    else trig(d.trig_[op.slot], angle, c, s);
 }
 
 void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& slots) {
@@ -320,7 +321,7 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
         return;
     }
     if (exact_)
-        walk<true>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trigOf(d, op, angle, cs, sn); });
+        walk<true>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { exactTrig(d, op, angle, cs, sn); });
     else
         walk<false>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trig(d.trig_[op.slot], angle, cs, sn); });
 }
@@ -391,8 +392,7 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                if (exact_) trigOf(d, op, q[op.axis], c, sn);
-                else trig(d.trig_[op.slot], q[op.axis], c, sn);
+                trigOf(d, op, q[op.axis], c, sn);
                 if constexpr (WithPoint) rotateBack(op, c, sn, point);
                 rotateBack(op, c, sn, direction);
                 break;
@@ -408,7 +408,7 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
 }
 
 void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
-    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
+    bind(d);
     if (workpiece_.affine.ok) {
         toolPose(d, q, length, tip, axis);
         return;
@@ -428,7 +428,7 @@ void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, doubl
 }
 
 Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const {
-    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
+    bind(d);
     if (workpiece_.affine.ok) {
         Vec3 tip, axis;
         toolPose(d, q, 0.0, tip, axis);
@@ -441,7 +441,7 @@ Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const
 }
 
 Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const {
-    if (d.model_ != id_) bind(d);  // (bind's own test, without the call)
+    bind(d);
     if (workpiece_.affine.ok) return workpiece_.affine.R * v;
     Vec3 r = v;
     for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
@@ -454,8 +454,7 @@ Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, co
                 break;
             case OpKind::Rotary: {
                 double c, sn;
-                if (exact_) trigOf(d, op, q[op.axis], c, sn);
-                else trig(d.trig_[op.slot], q[op.axis], c, sn);
+                trigOf(d, op, q[op.axis], c, sn);
                 rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }

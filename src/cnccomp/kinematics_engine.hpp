@@ -196,14 +196,18 @@ private:
         Affine affine;
     };
     void compile(const Chain& chain, Side side, ChainOps& c, int& slots);
-    /// `d` emptied when it belongs to another model.
-    void bind(KinematicsData& d) const;
+    /// `d` emptied when it belongs to another model (the test inline: every evaluation makes it).
+    void bind(KinematicsData& d) const {
+        if (d.model_ != id_) rebind(d);
+    }
+    void rebind(KinematicsData& d) const;
     /// cos and sin of `angle` for a rotary op: the same angle again from `asked`, an angle near the last exactly
     /// computed one by angle addition, else exactly.
     static void trig(Trig& t, double angle, double& c, double& s);
-    /// cos and sin of a rotary op's angle: trig, or with Arithmetic::AsExactModel std::cos and std::sin (as Eigen's
-    /// AngleAxis) through the workspace's table of the last angles.
+    /// cos and sin of a rotary op's angle: trig (inlined into the caller), or with Arithmetic::AsExactModel exactTrig.
     void trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const;
+    /// std::cos and std::sin (as Eigen's AngleAxis) through the workspace's table of the last angles.
+    void exactTrig(KinematicsData& d, const Op& op, double angle, double& c, double& s) const;
     /// v ← Rot(op's direction, θ)ᵀ v, given c = cos θ and s = sin θ.
     static void rotateBack(const Op& op, double c, double s, Vec3& v);
     /// A base-frame point (WithPoint) and direction into the workpiece frame at q, the workpiece chain's operations
