@@ -2,13 +2,16 @@
 //  - a generated 5-axis program on the multitasking machine (joint mode): identity and correction;
 //  - the real impeller of LinuxCNC's xyzac-trt sim (../shared/gcode-corpus/impeller-7bl-xyzac.ngc, its body repeated
 //    to >= 1 M lines after M428): identity and correction in TCP mode on the sim's machine (skipped without the
-//    corpus), on one and on two threads (--threads; the argument), in wall-clock time: the ratio correction / identity
-//    of one run is the throughput figure.
+//    corpus), on one and on two threads (--threads; the argument), in wall-clock time; and the two in turn, pair by
+//    pair (BM_PostprocImpellerPairs): the median of the pairs' ratios identity time / correction time is the issue's
+//    throughput figure (correction throughput / identity throughput).
 // Reports lines/s and bytes/s (CPU time of the calling thread, real time for the impeller); memory use does not depend
 // on the program size (fixed read and write buffers; the output goes to a counting sink).
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -165,22 +168,36 @@ const Impeller& impeller() {
     return im;
 }
 
-void runImpeller(benchmark::State& state, bool identity) {
+/// The impeller's machine, its deviation set and the options of the TCP correction (null when the corpus is missing).
+struct ImpellerJob {
+    const MachineModel* machine = nullptr;
+    const DeviationSet* truth = nullptr;
+    postproc::CorrectOptions options;
+};
+
+bool impellerJob(benchmark::State& state, ImpellerJob& job) {
     const Impeller& im = impeller();
     if (!im.ok) {
         state.SkipWithError("no ../shared/gcode-corpus/impeller-7bl-xyzac.ngc");
-        return;
+        return false;
     }
     static const MachineModel m = readMachineXml(im.machine);
     static const DeviationSet truth = readDeviationCsv(im.deviations, m);
-    const DeviationSet zero(m);
-    postproc::CorrectOptions o;
-    o.dialect = postproc::Dialect::Rs274ngc;
-    o.setup.addToolLength("30");
-    o.tcpOnM = 428;
-    o.tcpOffM = 429;
-    o.threads = static_cast<int>(state.range(0));
-    measure(state, m, identity ? zero : truth, im.program, o);
+    job.machine = &m;
+    job.truth = &truth;
+    job.options.dialect = postproc::Dialect::Rs274ngc;
+    job.options.setup.addToolLength("30");
+    job.options.tcpOnM = 428;
+    job.options.tcpOffM = 429;
+    job.options.threads = static_cast<int>(state.range(0));
+    return true;
+}
+
+void runImpeller(benchmark::State& state, bool identity) {
+    ImpellerJob job;
+    if (!impellerJob(state, job)) return;
+    const DeviationSet zero(*job.machine);
+    measure(state, *job.machine, identity ? zero : *job.truth, impeller().program, job.options);
 }
 
 void BM_PostprocImpellerIdentity(benchmark::State& state) { runImpeller(state, true); }
@@ -188,5 +205,48 @@ void BM_PostprocImpellerCorrectTcp(benchmark::State& state) { runImpeller(state,
 
 BENCHMARK(BM_PostprocImpellerIdentity)->ArgName("threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_PostprocImpellerCorrectTcp)->ArgName("threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// The throughput figure on a machine whose speed drifts: identity and correction in turn, one pair per
+/// iteration (the order alternating from pair to pair), each pair's ratio identity time / correction time (=
+/// correction throughput / identity throughput), and the median of the pairs' ratios with their spread. Two runs far
+/// apart in time (as the two benchmarks above) can differ by 40 % on a shared host; the two halves of a pair cannot
+/// drift apart by much. Wall-clock time of the whole correction (both threads' work on two).
+void BM_PostprocImpellerPairs(benchmark::State& state) {
+    ImpellerJob job;
+    if (!impellerJob(state, job)) return;
+    const DeviationSet zero(*job.machine);
+    const std::string& path = impeller().program;
+    auto seconds = [&](const DeviationSet& d) {
+        std::ifstream in(path, std::ios::binary);
+        CountingBuf sink;
+        std::ostream out(&sink);
+        const auto t0 = std::chrono::steady_clock::now();
+        postproc::correctProgram(*job.machine, d, in, out, job.options);
+        benchmark::DoNotOptimize(sink.bytes);
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    std::vector<double> ratios, identity, correction;
+    for (auto _ : state) {
+        double ti, tc;
+        if (ratios.size() % 2 == 0) ti = seconds(zero), tc = seconds(*job.truth);
+        else tc = seconds(*job.truth), ti = seconds(zero);
+        identity.push_back(ti);
+        correction.push_back(tc);
+        ratios.push_back(ti / tc);
+    }
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const size_t n = v.size();
+        return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    };
+    state.counters["ratio median"] = median(ratios);
+    state.counters["ratio min"] = ratios.empty() ? 0.0 : *std::min_element(ratios.begin(), ratios.end());
+    state.counters["ratio max"] = ratios.empty() ? 0.0 : *std::max_element(ratios.begin(), ratios.end());
+    state.counters["identity ms"] = 1e3 * median(identity);
+    state.counters["correction ms"] = 1e3 * median(correction);
+    state.counters["pairs"] = double(ratios.size());
+}
+
+BENCHMARK(BM_PostprocImpellerPairs)->ArgName("threads")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(9);
 
 }  // namespace
