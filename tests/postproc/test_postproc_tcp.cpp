@@ -270,18 +270,30 @@ TEST(PostprocTcp, ImpellerDemoCorrectedInTcpMode) {
 }
 
 TEST(PostprocTcp, BoatDemoFromTheLinuxCncTreeCorrectedInTcpMode) {
-    // Read in place from a fetched LinuxCNC repository (never copied into this one).
-    const std::string git = "/work/.mirror/LinuxCNC+linuxcnc/repo";
-    if (!std::filesystem::exists(git)) GTEST_SKIP() << "no LinuxCNC mirror at " << git << ": boat demo not checked";
-    test::ScratchDir dir("pp-tcp-boat");
-    const std::string file = dir.file("boat-xyzac.ngc");
-    const std::string cmd = "git --git-dir=" + git +
-                            " show HEAD:configs/sim/axis/vismach/5axis/table-rotary-tilting/demos/boat-xyzac.ngc > " + file +
-                            " 2>/dev/null";
-    if (std::system(cmd.c_str()) != 0 || std::filesystem::file_size(file) == 0)
-        GTEST_SKIP() << "boat-xyzac.ngc not found in " << git;
+    // Read in place (never copied into this repository): LinuxCNC's own demo as Debian's linuxcnc-uspace ships it with
+    // the sample configurations (tools/deps.sh installs the package, so this runs in CI), else from a fetched LinuxCNC
+    // repository.
+    const std::string installed =
+        "/usr/share/doc/linuxcnc/examples/sample-configs/sim/axis/vismach/5axis/table-rotary-tilting/demos/boat-xyzac.ngc";
+    std::string program;
+    if (std::filesystem::exists(installed)) {
+        program = test::readText(installed);
+    } else {
+        const std::string git = "/work/.mirror/LinuxCNC+linuxcnc/repo";
+        if (!std::filesystem::exists(git))
+            GTEST_SKIP() << "neither " << installed << " (Debian package linuxcnc-uspace) nor a LinuxCNC mirror at " << git
+                         << ": boat demo not checked";
+        test::ScratchDir dir("pp-tcp-boat");
+        const std::string file = dir.file("boat-xyzac.ngc");
+        const std::string cmd = "git --git-dir=" + git +
+                                " show HEAD:configs/sim/axis/vismach/5axis/table-rotary-tilting/demos/boat-xyzac.ngc > " +
+                                file + " 2>/dev/null";
+        if (std::system(cmd.c_str()) != 0 || std::filesystem::file_size(file) == 0)
+            GTEST_SKIP() << "boat-xyzac.ngc not found in " << git;
+        program = test::readText(file);
+    }
     // One block passes through: "Z5" before the program has named X and Y.
-    expectTcpAccurate("boat-xyzac.ngc", test::readText(file), 30.0, 1500, 1);
+    expectTcpAccurate("boat-xyzac.ngc", program, 30.0, 1500, 1);
 }
 
 TEST(PostprocTcp, IdentityKeepsTcpProgramsByteForByte) {
