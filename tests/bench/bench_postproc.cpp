@@ -80,18 +80,23 @@ protected:
     }
 };
 
+/// Corrects the program at `path` once into a counting sink.
+postproc::CorrectSummary correctOnce(const MachineModel& m, const DeviationSet& d, const std::string& path,
+                                     const postproc::CorrectOptions& o) {
+    std::ifstream in(path, std::ios::binary);
+    CountingBuf sink;
+    std::ostream out(&sink);
+    const postproc::CorrectSummary s = postproc::correctProgram(m, d, in, out, o);
+    benchmark::DoNotOptimize(sink.bytes);
+    return s;
+}
+
 /// Corrects the program at `path` once per iteration into a counting sink; lines/s, bytes/s and what was done.
 void measure(benchmark::State& state, const MachineModel& m, const DeviationSet& d, const std::string& path,
              const postproc::CorrectOptions& o) {
     const auto bytes = std::filesystem::file_size(path);
     postproc::CorrectSummary s;
-    for (auto _ : state) {
-        std::ifstream in(path, std::ios::binary);
-        CountingBuf sink;
-        std::ostream out(&sink);
-        s = postproc::correctProgram(m, d, in, out, o);
-        benchmark::DoNotOptimize(sink.bytes);
-    }
+    for (auto _ : state) s = correctOnce(m, d, path, o);
     state.counters["lines/s"] = benchmark::Counter(double(s.lines) * state.iterations(), benchmark::Counter::kIsRate);
     state.counters["lines"] = double(s.lines);
     state.counters["split"] = double(s.split);
@@ -217,12 +222,8 @@ void BM_PostprocImpellerPairs(benchmark::State& state) {
     const DeviationSet zero(*job.machine);
     const std::string& path = impeller().program;
     auto seconds = [&](const DeviationSet& d) {
-        std::ifstream in(path, std::ios::binary);
-        CountingBuf sink;
-        std::ostream out(&sink);
         const auto t0 = std::chrono::steady_clock::now();
-        postproc::correctProgram(*job.machine, d, in, out, job.options);
-        benchmark::DoNotOptimize(sink.bytes);
+        correctOnce(*job.machine, d, path, job.options);
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     };
     std::vector<double> ratios, identity, correction;
