@@ -1,5 +1,6 @@
 #include "cnccomp/kinematics_engine.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -241,6 +242,7 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
             ++a.count;
         }
     }
+    a.toolAxis = a.R * machine_->toolDirection;
 }
 
 template <bool Exact, class TrigOf>
@@ -375,16 +377,17 @@ void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double le
     axis.noalias() = w.R.transpose() * dirB;
 }
 
-template <bool WithPoint>
+template <bool WithPoint, bool WithDirection>
 void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const {
-    // w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base): op_1⁻¹ first.
+    // w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base): op_1⁻¹ first. The point's and the direction's arithmetic are
+    // independent: either alone gives the same bits as both.
     for (const Op& op : workpiece_.ops) {
         switch (op.kind) {
             case OpKind::Constant:
                 if constexpr (WithPoint) point -= op.t;
                 if (!op.identityR) {
                     if constexpr (WithPoint) point = op.R.transpose() * point;
-                    direction = op.R.transpose() * direction;
+                    if constexpr (WithDirection) direction = op.R.transpose() * direction;
                 }
                 break;
             case OpKind::Linear:
@@ -394,16 +397,31 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
                 if constexpr (WithPoint) rotateBack(op, c, sn, point);
-                rotateBack(op, c, sn, direction);
+                if constexpr (WithDirection) rotateBack(op, c, sn, direction);
                 break;
             }
             case OpKind::Component: {
                 const Pose E = componentError(op, q);
                 if constexpr (WithPoint) point = E.linear().transpose() * (point - E.translation());
-                direction = E.linear().transpose() * direction;
+                if constexpr (WithDirection) direction = E.linear().transpose() * direction;
                 break;
             }
         }
+    }
+}
+
+void KinematicsModel::toolInBase(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
+    bind(d);
+    if (tool_.affine.ok) {  // the tool frame directly (no cache entry written)
+        const Affine& a = tool_.affine;
+        tip = a.t0;
+        for (int k = 0; k < a.count; ++k) tip += a.col[k] * q[a.axis[k]];
+        axis = a.toolAxis;
+        tip += length * axis;
+    } else {
+        const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
+        axis = t.R * machine_->toolDirection;
+        tip = t.t + length * axis;
     }
 }
 
@@ -413,18 +431,54 @@ void KinematicsModel::toolPoseOnce(KinematicsData& d, const AxisVector& q, doubl
         toolPose(d, q, length, tip, axis);
         return;
     }
-    if (tool_.affine.ok) {  // the tool frame directly (no cache entry written)
-        const Affine& a = tool_.affine;
-        tip = a.t0;
-        for (int k = 0; k < a.count; ++k) tip += a.col[k] * q[a.axis[k]];
-        axis = a.R * machine_->toolDirection;  // base frame
-        tip += length * axis;
-    } else {
-        const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
-        axis = t.R * machine_->toolDirection;
-        tip = t.t + length * axis;
-    }
+    toolInBase(d, q, length, tip, axis);
     intoWorkpiece<true>(d, q, tip, axis);
+}
+
+Vec3 KinematicsModel::toolTipOnce(KinematicsData& d, const AxisVector& q, double length) const {
+    bind(d);
+    Vec3 tip, axis;
+    if (workpiece_.affine.ok) {
+        toolPose(d, q, length, tip, axis);
+        return tip;
+    }
+    toolInBase(d, q, length, tip, axis);
+    intoWorkpiece<true, false>(d, q, tip, axis);
+    return tip;
+}
+
+Vec3 KinematicsModel::workpiecePointToBase(KinematicsData& d, const AxisVector& q, const Vec3& p) const {
+    bind(d);
+    if (workpiece_.affine.ok) {
+        const Frame& w = cached(d, workpiece_, d.workpiece_, q, false).frame;
+        return w.R * p + w.t;
+    }
+    // bMw = op_1 ⋯ op_N: op_N first.
+    Vec3 r = p;
+    for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
+        const Op& op = *it;
+        switch (op.kind) {
+            case OpKind::Constant:
+                if (!op.identityR) r = op.R * r;
+                r += op.t;
+                break;
+            case OpKind::Linear:
+                r += op.dir * q[op.axis];
+                break;
+            case OpKind::Rotary: {
+                double c, sn;
+                trigOf(d, op, q[op.axis], c, sn);
+                rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
+                break;
+            }
+            case OpKind::Component: {
+                const Pose E = componentError(op, q);
+                r = E.linear() * r + E.translation();
+                break;
+            }
+        }
+    }
+    return r;
 }
 
 Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const {
@@ -434,7 +488,7 @@ Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const
         toolPose(d, q, 0.0, tip, axis);
         return axis;
     }
-    Vec3 axis = (tool_.affine.ok ? tool_.affine.R : cached(d, tool_, d.tool_, q, false).frame.R) * machine_->toolDirection;
+    Vec3 axis = tool_.affine.ok ? tool_.affine.toolAxis : Vec3(cached(d, tool_, d.tool_, q, false).frame.R * machine_->toolDirection);
     Vec3 unused;
     intoWorkpiece<false>(d, q, unused, axis);
     return axis;
@@ -464,6 +518,12 @@ Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, co
         }
     }
     return r;
+}
+
+void KinematicsModel::takeAngles(KinematicsData& d, const KinematicsModel& other, const KinematicsData& from) const {
+    bind(d);
+    if (exact_ || other.exact_ || machine_ != other.machine_ || from.model_ != other.id_) return;
+    std::copy(from.trig_, from.trig_ + rotarySlots_, d.trig_);
 }
 
 Vec3 KinematicsModel::toolTip(KinematicsData& d, const AxisVector& q, double length) const {

@@ -143,8 +143,21 @@ public:
     void toolPoseOnce(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
     /// The tool axis alone (as toolPoseOnce's, without the tool point's arithmetic).
     Vec3 toolAxisOnce(KinematicsData& d, const AxisVector& q) const;
+    /// The tool point alone (as toolPoseOnce's to the bit, without the tool axis' arithmetic).
+    Vec3 toolTipOnce(KinematicsData& d, const AxisVector& q, double length) const;
+    /// The tool point at `length` along the tool direction, and the tool direction, in the base (bed) frame at q.
+    void toolInBase(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const;
+    /// A point given in the workpiece frame, in the base frame at q: baseToWorkpiece(q) · p, the workpiece chain's
+    /// operations applied to it one by one (no frame built).
+    Vec3 workpiecePointToBase(KinematicsData& d, const AxisVector& q, const Vec3& p) const;
     /// A direction given in the workpiece frame, in the base (bed) frame at q: baseToWorkpiece(q).R · v.
     Vec3 workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const;
+    /// Gives `d` the cosines and sines of the rotary angles that `from`, a workspace of `other`, holds (the last
+    /// angles asked for and the bases of the angle addition), when `other` is a model of the same machine (its rotary
+    /// operations numbered alike) and both are Arithmetic::Fast; else nothing changes. The nominal and the erroneous
+    /// model of one machine are evaluated at the same angles in turn (a check of a corrected point): the second
+    /// evaluation then computes no cosine or sine.
+    void takeAngles(KinematicsData& d, const KinematicsModel& other, const KinematicsData& from) const;
     /// d(tip, axis)/dq (6 × n, workpiece frame, rows as cnccomp::toolPoseJacobian); also the pose at q.
     void jacobian(KinematicsData& d, const AxisVector& q, double length, PoseJacobian& J, Vec3& tip, Vec3& axis) const;
     /// The tool point at q and its derivatives by the three axes `axes` (linear axes: constant in them).
@@ -188,6 +201,7 @@ private:
         int axis[kMaxAxes] = {};
         Vec3 col[kMaxAxes];    ///< base-frame direction of each axis (also its joint line's direction)
         Vec3 start[kMaxAxes];  ///< where each axis' joint line starts with the axes before it at 0
+        Vec3 toolAxis = Vec3::UnitZ();  ///< R · the machine's tool direction (the tool chain's axis in the base frame)
     };
     struct ChainOps {
         Side side = Side::Tool;
@@ -212,7 +226,7 @@ private:
     static void rotateBack(const Op& op, double c, double s, Vec3& v);
     /// A base-frame point (WithPoint) and direction into the workpiece frame at q, the workpiece chain's operations
     /// inverted one by one (no frame built).
-    template <bool WithPoint>
+    template <bool WithPoint, bool WithDirection = true>
     void intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const;
     /// The error transform of a Component op at q.
     Pose componentError(const Op& op, const AxisVector& q) const;

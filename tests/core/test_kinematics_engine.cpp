@@ -1,7 +1,8 @@
 // The kinematics engine (src/cnccomp/kinematics_engine.hpp). Two kinds of check:
 // - Arithmetic::Fast (folded constant transforms, affine chains evaluated without walking them, rotations from the last
 //   angle by angle addition, two cached evaluations per chain in the caller's workspace; toolPoseOnce with the
-//   workpiece chain inverted onto the tool point) against cnccomp::Kinematics / toolPoseJacobian, the same model
+//   workpiece chain inverted onto the tool point, toolTipOnce, toolInBase, workpiecePointToBase, angles taken from
+//   the nominal model's workspace) against cnccomp::Kinematics / toolPoseJacobian, the same model
 //   walked link by link without folding, caches or angle addition: every machine in samples/machines (location and
 //   component errors), and an inclined rotary axis (a 45° head, the general rotation path), to 1e-12 mm and 1e-13 rad.
 //   Sequences of nearby and far poses exercise every cache path.
@@ -58,11 +59,13 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
     const Kinematics ref(m, d);
     const KinematicsModel k(m, &d);
     KinematicsData data = k.createData();
-    std::mt19937_64 rng(11);
+    const KinematicsModel nominal(m, nullptr);  // evaluated first at the same commands, its angles then taken
+    KinematicsData nominalData = nominal.createData();
+    std::mt19937_64 rng(11), rngPoint(13);  // (the poses' sequence as before the workpiece points were added)
     std::uniform_real_distribution<double> u(-1, 1);
     AxisVector q(m.axisCount());
     for (int i = 0; i < m.axisCount(); ++i) q[i] = m.axisLink(i).kind == AxisKind::Rotary ? u(rng) : 100 * u(rng);
-    double worstTip = 0, worstAxis = 0, worstJ = 0;
+    double worstTip = 0, worstAxis = 0, worstJ = 0, worstBase = 0, worstTaken = 0;
     for (int trial = 0; trial < 250; ++trial) {
         // Mostly small steps (Newton steps, neighbouring blocks: angle addition), sometimes a jump, sometimes a
         // pose seen two evaluations ago (the second cache entry).
@@ -93,6 +96,22 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
             worstTip = std::max(worstTip, (tipOnce - r.tip).norm());
             worstAxis = std::max(worstAxis, (axisOnce - r.axis).norm());
             worstAxis = std::max(worstAxis, (k.toolAxisOnce(data, q) - r.axis).norm());
+            // The tool point alone: toolPoseOnce's to the bit.
+            EXPECT_EQ(k.toolTipOnce(data, q, L), tipOnce) << name;
+            // In the bed: the tool frame's point and direction; a workpiece point through the workpiece frame.
+            Vec3 tipB, axisB;
+            k.toolInBase(data, q, L, tipB, axisB);
+            const Frame bt = k.baseToTool(data, q), bw = k.baseToWorkpiece(data, q);
+            worstBase = std::max(worstBase, (tipB - (bt.t + L * (bt.R * m.toolDirection))).norm());
+            worstAxis = std::max(worstAxis, (axisB - bt.R * m.toolDirection).norm());
+            const Vec3 p(100 * u(rngPoint), 100 * u(rngPoint), 100 * u(rngPoint));
+            worstBase = std::max(worstBase, (k.workpiecePointToBase(data, q, p) - (bw.R * p + bw.t)).norm());
+            worstBase = std::max(worstBase, (k.workpiecePointToBase(data, q, r.tip) - tipB).norm());
+            // The nominal machine at the same commands first, its cosines and sines taken: the erroneous pose still.
+            Vec3 tipN, axisN;
+            nominal.toolPoseOnce(nominalData, q, L, tipN, axisN);
+            k.takeAngles(data, nominal, nominalData);
+            worstTaken = std::max(worstTaken, (k.toolTipOnce(data, q, L) - r.tip).norm());
             // A workpiece direction into the bed: the frame's rotation, and back to the tool direction there.
             const Vec3 v(u(rng), u(rng), u(rng));
             worstAxis = std::max(worstAxis, (k.workpieceToBase(data, q, v) - k.baseToWorkpiece(data, q).R * v).norm());
@@ -100,10 +119,13 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
                                  (k.workpieceToBase(data, q, r.axis) - k.baseToTool(data, q).R * m.toolDirection).norm());
         }
     }
-    std::printf("[ engine   ] %-40s tip %.2g mm, axis %.2g, Jacobian %.2g\n", name.c_str(), worstTip, worstAxis, worstJ);
+    std::printf("[ engine   ] %-40s tip %.2g mm, axis %.2g, Jacobian %.2g, in the bed %.2g mm, angles taken %.2g mm\n",
+                name.c_str(), worstTip, worstAxis, worstJ, worstBase, worstTaken);
     EXPECT_LT(worstTip, 1e-12) << name;  // mm, at linear commands within ±500 mm: round-off
     EXPECT_LT(worstAxis, 1e-13) << name;
     EXPECT_LT(worstJ, 1e-9) << name;
+    EXPECT_LT(worstBase, 1e-12) << name;
+    EXPECT_LT(worstTaken, 1e-12) << name;
 }
 
 /// Every machine of samples/machines (at least the 12 there are), in name order.
