@@ -12,6 +12,15 @@ void lerpPoint(const ProgramPoint& a, const ProgramPoint& b, double t, bool vect
     out.p = a.p + t * (b.p - a.p);
     if (vector) out.v = slerpVector(a.v, b.v, t);
 }
+/// start += slope · step for N axes.
+template <int N>
+void addSlopeStep(const SmallMatrix& slope, const double* step, AxisVector& start) {
+    for (int i = 0; i < N; ++i) {
+        double v = 0;
+        for (int j = 0; j < N; ++j) v += slope(i, j) * step[j];
+        start[i] += v;
+    }
+}
 }  // namespace
 
 Vec3 slerpVector(const Vec3& a, const Vec3& b, double t) {
@@ -75,10 +84,10 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
 }
 
 Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) {
-    Vec3 tip, axis;
     AxisVector scratch;
-    actual_.toolPoseOnce(actualData_, model(c, scratch), toolLength, tip, axis);
-    return tip;
+    // Usually at the rotary angles the nominal machine was just evaluated at (the commands of a checked point).
+    actual_.takeAngles(actualData_, nominal_, nominalData_);
+    return actual_.toolTipOnce(actualData_, model(c, scratch), toolLength);
 }
 Vec3 Corrector::nominalTip(const AxisVector& c, double toolLength) {
     AxisVector scratch;
@@ -257,6 +266,12 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
     if (!cache.slopeKnown || cache.slopeLength != toolLength || lastDamped_) return;
     double step[kMaxAxes];
     for (int j = 0; j < n; ++j) step[j] = cNom[j] - cNomPrev[j];
+    switch (n) {  // unrolled for the usual axis counts (the same sums in the same order)
+        case 5: addSlopeStep<5>(cache.slope, step, start); return;
+        case 6: addSlopeStep<6>(cache.slope, step, start); return;
+        case 4: addSlopeStep<4>(cache.slope, step, start); return;
+        default: break;
+    }
     for (int i = 0; i < n; ++i) {
         double v = 0;
         for (int j = 0; j < n; ++j) v += cache.slope(i, j) * step[j];
@@ -339,8 +354,8 @@ SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, Jac
     const double w = options_.axisWeight;
     Eigen::Matrix<double, 6, 1> r;
     AxisVector step(n), offset(n);
-    if (!cacheUsable(cache, q, toolLength)) refreshJacobian(k, kd, cache, q, toolLength);
-    bool fresh = cache.q == q;  // evaluated at this very start (here or by solve())
+    // The kept Jacobian is usable at the start: solve() refreshed it there when it was not.
+    bool fresh = cache.q == q;  // evaluated at this very start (by solve())
     if (!factorUsable(cache, damping, free)) factor(cache, damping, free);
     double lastStep = HUGE_VAL, linStep = 0.0, rotStep = 0.0;
     auto newtonStep = [&]() {

@@ -216,6 +216,7 @@ private:
         bool any = false;
         SmallMatrix D;  ///< read only when `any` (left unset otherwise)
     };
+    /// Newton–Raphson (chord method) from `start`; `cache` must be usable there (cacheUsable: solve() sees to it).
     SolveResult solveOn(const KinematicsModel& k, KinematicsData& kd, JacobianCache& cache, const Vec3& targetTip, const Vec3& targetAxis,
                         double toolLength, const AxisVector& start, const AxisVector& reference, const Damping& damping,
                         AxisMask free, AxisVector& c);

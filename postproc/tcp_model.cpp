@@ -59,8 +59,9 @@ void TcpModel::forward(KinematicsData& d, const AxisVector& c, double length, Ve
 }
 
 void TcpModel::toProgram(KinematicsData& d, const AxisVector& c, double length, AxisVector& p) const {
-    Vec3 point, axis;
-    forward(d, c, length, point, axis);
+    AxisVector scratch;
+    const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);
+    const Vec3 point = R0_ * nominal_.toolTipOnce(d, q, length) + t0_;  // forward's point, without the axis
     p = c;
     for (int k = 0; k < 3; ++k) p[lin_[k]] = point[k];
 }
@@ -71,14 +72,19 @@ bool TcpModel::toJoints(KinematicsData& d, const AxisVector& p, double length, A
     const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);  // (may be c itself: read before c changes below)
     const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
     if (fixedSlides_) {
-        Vec3 tip, axis;
-        nominal_.toolPoseOnce(d, q, length, tip, axis);
-        // A = R0 · w.Rᵀ · D, A⁻¹ = D⁻¹ · w.R · R0ᵀ
-        const Vec3 dq = slidesInverse_ * nominal_.workpieceToBase(d, q, R0_.transpose() * (want - (R0_ * tip + t0_)));
+        // The world point is R0 · bMw⁻¹ · tipB + t0 with tipB − bTw affine in the slides (tipB − bTw moves by D · dq):
+        // it equals `want` when D · dq = bMw · pointFromWorld(want) − tipB — one walk of the workpiece chain, no
+        // Jacobian.
+        const bool pose = tipOut && axisOut;
+        const Vec3 wantW = pointFromWorld(want);
+        const Vec3 wantB = nominal_.workpiecePointToBase(d, q, wantW);
+        Vec3 tipB, axisB;
+        nominal_.toolInBase(d, q, length, tipB, axisB);
+        const Vec3 dq = slidesInverse_ * (wantB - tipB);
+        if (pose) *axisOut = nominal_.toolAxisOnce(d, q);  // the slides do not turn the tool (q read before c changes)
         for (int k = 0; k < 3; ++k) c[lin_[k]] += dq[k];
-        if (!tipOut || !axisOut) return false;
-        *tipOut = pointFromWorld(want);  // where the slides just put it (the point is affine in them)
-        *axisOut = axis;                 // the slides do not turn the tool
+        if (!pose) return false;
+        *tipOut = wantW;  // where the slides just put it (the point is affine in them)
         return true;
     }
     Mat3 J;

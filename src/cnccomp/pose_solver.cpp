@@ -26,6 +26,17 @@ void direct(const SmallMatrix& G, bool vectors, AxisConditioning& c) {
     if (vectors) c.V = eig.eigenvectors();
 }
 
+/// s = gain · r for N axes (fixed axes: 0), the sums in the order of the general loop of DampedNormalFactor::step.
+template <int N>
+void gainStep(const GainMatrix& gain, const Eigen::Matrix<double, 6, 1>& r, uint32_t free, double* s) {
+    for (int i = 0; i < N; ++i) {
+        double v = 0;
+        if (free & (1u << i))
+            for (int j = 0; j < 6; ++j) v += gain(i, j) * r[j];
+        s[i] = v;
+    }
+}
+
 /// A⁻¹ of the symmetric positive definite A by Cholesky (Eigen::LLT), column by column (Eigen's solve with a matrix
 /// right-hand side takes its blocked GEMM path, several times the instructions at these sizes). False when A is not
 /// positive definite or the inverse is not finite.
@@ -153,6 +164,14 @@ void DampedNormalFactor::step(const Eigen::Matrix<double, 6, 1>& r, const SmallM
             g[i] = v;
         }
     s.resize(n);
+    if (!D) {  // the common case: the gain alone, unrolled for the usual axis counts (the same sums in the same order)
+        switch (n) {
+            case 5: gainStep<5>(gain, r, free, s.data()); return;
+            case 6: gainStep<6>(gain, r, free, s.data()); return;
+            case 4: gainStep<4>(gain, r, free, s.data()); return;
+            default: break;
+        }
+    }
     for (int i = 0; i < n; ++i) {
         double v = 0;
         if (free & (1u << i)) {
