@@ -57,6 +57,8 @@ bool BlockEdits::add(uint32_t begin, uint32_t end, std::string_view text) {
     }
     edits_[count_] = {begin, end, static_cast<uint32_t>(at), static_cast<uint32_t>(text.size()),
                       static_cast<uint32_t>(count_)};
+    if (count_ > 0 && before(edits_[count_], edits_[count_ - 1])) sorted_ = false;
+    maxEnd_ = std::max({maxEnd_, begin, end});
     ++count_;
     return true;
 }
@@ -70,32 +72,18 @@ char* BlockEdits::scratch(size_t need) {
 }
 
 void BlockEdits::apply(std::string_view line, OutputBuffer& out) {
-    const auto before = [](const Edit& a, const Edit& b) {
-        if (a.begin != b.begin) return a.begin < b.begin;
-        // At the same position: a replacement that ends there first? No: replacements start there; insertions
-        // (empty spans) go before replacements of the word that starts at the same byte.
-        const bool ai = a.begin == a.end, bi = b.begin == b.end;
-        if (ai != bi) return ai;
-        return a.order < b.order;
-    };
-    // Usually added in the order of the line already (the words, then what is appended after them).
-    if (!std::is_sorted(edits_.begin(), edits_.begin() + count_, before))
+    // Usually added in the order of the line already (the words, then what is appended after them): add() kept
+    // track (as std::is_sorted would find).
+    if (!sorted_) {
         std::sort(edits_.begin(), edits_.begin() + count_, before);
-    // The edited line's length first: it is copied into the output buffer in one reservation.
-    size_t total = 0;
-    bool inLine = true;
-    uint32_t pos = 0;
-    for (int i = 0; i < count_ && inLine; ++i) {
-        const Edit& e = edits_[i];
-        if (e.begin < pos) continue;
-        inLine = e.begin <= line.size() && e.end <= line.size();
-        total += (e.begin - pos) + e.textLen;
-        pos = e.end;
+        sorted_ = true;
     }
-    char* at = inLine ? out.reserve(total + (line.size() - pos)) : nullptr;
+    // Copied into the output buffer in one reservation of at most the line and all replacement text.
+    const bool inLine = maxEnd_ <= line.size();
+    char* at = inLine ? out.reserve(line.size() + used_) : nullptr;
+    uint32_t pos = 0;
     if (at) {
         char* const start = at;
-        pos = 0;
         for (int i = 0; i < count_; ++i) {
             const Edit& e = edits_[i];
             if (e.begin < pos) continue;

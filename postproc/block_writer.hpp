@@ -94,6 +94,8 @@ public:
         count_ = 0;
         used_ = 0;
         overflow_ = false;
+        sorted_ = true;
+        maxEnd_ = 0;
     }
     /// Replace [begin, end) by `text` (insert when begin == end). Returns false when full (the caller then
     /// writes the block unchanged and reports it).
@@ -109,11 +111,21 @@ private:
     struct Edit {
         uint32_t begin, end, textBegin, textLen, order;
     };
+    /// The order apply() writes the edits in: by position; at one position insertions (empty spans) before
+    /// replacements; else as added.
+    static bool before(const Edit& a, const Edit& b) {
+        if (a.begin != b.begin) return a.begin < b.begin;
+        const bool ai = a.begin == a.end, bi = b.begin == b.end;
+        if (ai != bi) return ai;
+        return a.order < b.order;
+    }
     std::array<Edit, kMaxEdits> edits_{};
     std::array<char, kArena> arena_{};
     int count_ = 0;
     size_t used_ = 0;
     bool overflow_ = false;
+    bool sorted_ = true;   ///< added in apply()'s order so far (usually: the words, then what follows them)
+    uint32_t maxEnd_ = 0;  ///< the largest span end added (all edits within a line at least that long)
 };
 
 }  // namespace cnccomp::postproc

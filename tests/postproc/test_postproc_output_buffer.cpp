@@ -73,7 +73,7 @@ TEST(PostprocOutputBuffer, NothingReachesTheStreamBeforeTheCapacityIsExceededOrF
 // 0 to 16 by overlapping fixed-size moves, more by memcpy), and falls back to piecewise writes when the line exceeds
 // the buffer's capacity. Oracle: the splice written out here with std::string (replacements and insertions in position
 // order, insertions before a replacement starting at the same byte), over random lines and edits of every size from 0
-// to 40 bytes, into a large and a small buffer.
+// to 40 bytes, added in order or shuffled, into a large and a small buffer.
 TEST(PostprocOutputBuffer, EditedLinesAreTheSpliceOfTheirEditsWhateverTheSizes) {
     std::mt19937 rng(11);
     for (const size_t capacity : {size_t{64}, size_t{1} << 20}) {
@@ -99,7 +99,11 @@ TEST(PostprocOutputBuffer, EditedLinesAreTheSpliceOfTheirEditsWhateverTheSizes) 
                 pos = end + 1;  // not touching: replacements of neighbouring words have a separator between them
             }
             edits.clear();
-            for (const Span& s : spans) ASSERT_TRUE(edits.add(s.begin, s.end, s.text));
+            // Every other line's edits added out of order (apply sorts them: the same splice).
+            std::vector<const Span*> order;
+            for (const Span& s : spans) order.push_back(&s);
+            if (i % 2) std::shuffle(order.begin(), order.end(), rng);
+            for (const Span* s : order) ASSERT_TRUE(edits.add(s->begin, s->end, s->text));
             std::string spliced;
             uint32_t at = 0;
             for (const Span& s : spans) {
