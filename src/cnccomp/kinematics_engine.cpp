@@ -494,32 +494,6 @@ Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const
     return axis;
 }
 
-Vec3 KinematicsModel::workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const {
-    bind(d);
-    if (workpiece_.affine.ok) return workpiece_.affine.R * v;
-    Vec3 r = v;
-    for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
-        const Op& op = *it;
-        switch (op.kind) {
-            case OpKind::Constant:
-                if (!op.identityR) r = op.R * r;
-                break;
-            case OpKind::Linear:
-                break;
-            case OpKind::Rotary: {
-                double c, sn;
-                trigOf(d, op, q[op.axis], c, sn);
-                rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
-                break;
-            }
-            case OpKind::Component:
-                r = componentError(op, q).linear() * r;
-                break;
-        }
-    }
-    return r;
-}
-
 void KinematicsModel::takeAngles(KinematicsData& d, const KinematicsModel& other, const KinematicsData& from) const {
     bind(d);
     if (exact_ || other.exact_ || machine_ != other.machine_ || from.model_ != other.id_) return;

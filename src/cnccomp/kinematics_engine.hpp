@@ -150,8 +150,6 @@ public:
     /// A point given in the workpiece frame, in the base frame at q: baseToWorkpiece(q) · p, the workpiece chain's
     /// operations applied to it one by one (no frame built).
     Vec3 workpiecePointToBase(KinematicsData& d, const AxisVector& q, const Vec3& p) const;
-    /// A direction given in the workpiece frame, in the base (bed) frame at q: baseToWorkpiece(q).R · v.
-    Vec3 workpieceToBase(KinematicsData& d, const AxisVector& q, const Vec3& v) const;
     /// Gives `d` the cosines and sines of the rotary angles that `from`, a workspace of `other`, holds (the last
     /// angles asked for and the bases of the angle addition), when `other` is a model of the same machine (its rotary
     /// operations numbered alike) and both are Arithmetic::Fast; else nothing changes. The nominal and the erroneous

@@ -112,11 +112,10 @@ void compare(const MachineModel& m, const DeviationSet& d, const std::string& na
             nominal.toolPoseOnce(nominalData, q, L, tipN, axisN);
             k.takeAngles(data, nominal, nominalData);
             worstTaken = std::max(worstTaken, (k.toolTipOnce(data, q, L) - r.tip).norm());
-            // A workpiece direction into the bed: the frame's rotation, and back to the tool direction there.
+            // A workpiece direction: the difference of two points, the frame's rotation of it.
             const Vec3 v(u(rng), u(rng), u(rng));
-            worstAxis = std::max(worstAxis, (k.workpieceToBase(data, q, v) - k.baseToWorkpiece(data, q).R * v).norm());
-            worstAxis = std::max(worstAxis,
-                                 (k.workpieceToBase(data, q, r.axis) - k.baseToTool(data, q).R * m.toolDirection).norm());
+            worstBase = std::max(worstBase, (k.workpiecePointToBase(data, q, p + v) - k.workpiecePointToBase(data, q, p) -
+                                             bw.R * v).norm());
         }
     }
     std::printf("[ engine   ] %-40s tip %.2g mm, axis %.2g, Jacobian %.2g, in the bed %.2g mm, angles taken %.2g mm\n",
