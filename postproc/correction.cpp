@@ -12,12 +12,13 @@ void lerpPoint(const ProgramPoint& a, const ProgramPoint& b, double t, bool vect
     out.p = a.p + t * (b.p - a.p);
     if (vector) out.v = slerpVector(a.v, b.v, t);
 }
-/// start += slope · step for N axes.
+/// start += slope · step for n axes; N > 0: n = N known at compile time (the loops unrolled, the same sums).
 template <int N>
-void addSlopeStep(const SmallMatrix& slope, const double* step, AxisVector& start) {
-    for (int i = 0; i < N; ++i) {
+void addSlopeStep(const SmallMatrix& slope, const double* step, AxisVector& start, int n = N) {
+    const int m = N > 0 ? N : n;
+    for (int i = 0; i < m; ++i) {
         double v = 0;
-        for (int j = 0; j < N; ++j) v += slope(i, j) * step[j];
+        for (int j = 0; j < m; ++j) v += slope(i, j) * step[j];
         start[i] += v;
     }
 }
@@ -270,12 +271,7 @@ void Corrector::predictStart(const AxisVector& cNom, const AxisVector& cNomPrev,
         case 5: addSlopeStep<5>(cache.slope, step, start); return;
         case 6: addSlopeStep<6>(cache.slope, step, start); return;
         case 4: addSlopeStep<4>(cache.slope, step, start); return;
-        default: break;
-    }
-    for (int i = 0; i < n; ++i) {
-        double v = 0;
-        for (int j = 0; j < n; ++j) v += cache.slope(i, j) * step[j];
-        start[i] += v;
+        default: addSlopeStep<0>(cache.slope, step, start, n); return;
     }
 }
 

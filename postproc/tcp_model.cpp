@@ -51,7 +51,7 @@ TcpModel::TcpModel(const KinematicsModel& nominal, KinematicsData& data) : nomin
 
 void TcpModel::forward(KinematicsData& d, const AxisVector& c, double length, Vec3& point, Vec3& axis) const {
     AxisVector scratch;
-    const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);
+    const AxisVector& q = model(c, scratch);
     Vec3 pw, aw;
     nominal_.toolPoseOnce(d, q, length, pw, aw);
     point = R0_ * pw + t0_;
@@ -60,7 +60,7 @@ void TcpModel::forward(KinematicsData& d, const AxisVector& c, double length, Ve
 
 void TcpModel::toProgram(KinematicsData& d, const AxisVector& c, double length, AxisVector& p) const {
     AxisVector scratch;
-    const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);
+    const AxisVector& q = model(c, scratch);
     const Vec3 point = R0_ * nominal_.toolTipOnce(d, q, length) + t0_;  // forward's point, without the axis
     p = c;
     for (int k = 0; k < 3; ++k) p[lin_[k]] = point[k];
@@ -69,7 +69,7 @@ void TcpModel::toProgram(KinematicsData& d, const AxisVector& c, double length, 
 bool TcpModel::toJoints(KinematicsData& d, const AxisVector& p, double length, AxisVector& c, Vec3* tipOut, Vec3* axisOut) const {
     c = p;  // rotary angles as programmed; linear axes start at the world coordinates
     AxisVector scratch;
-    const AxisVector& q = zeroIsZero_ ? c : (scratch = c + zero_);  // (may be c itself: read before c changes below)
+    const AxisVector& q = model(c, scratch);  // (may be c itself: read before c changes below)
     const Vec3 want(p[lin_[0]], p[lin_[1]], p[lin_[2]]);
     if (fixedSlides_) {
         // The world point is R0 · bMw⁻¹ · tipB + t0 with tipB − bTw affine in the slides (tipB − bTw moves by D · dq):

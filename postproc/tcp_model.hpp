@@ -46,6 +46,13 @@ public:
     const int* linearAxes() const { return lin_; }
 
 private:
+    /// Model commands of machine coordinates c: c itself when machine zero is the model's zero, else c + zero_ in
+    /// `scratch`.
+    const AxisVector& model(const AxisVector& c, AxisVector& scratch) const {
+        if (zeroIsZero_) return c;
+        scratch = c + zero_;
+        return scratch;
+    }
     const KinematicsModel& nominal_;
     AxisVector zero_;  ///< model commands of the controller's machine zero
     bool zeroIsZero_ = true;

@@ -26,10 +26,12 @@ void direct(const SmallMatrix& G, bool vectors, AxisConditioning& c) {
     if (vectors) c.V = eig.eigenvectors();
 }
 
-/// s = gain · r for N axes (fixed axes: 0), the sums in the order of the general loop of DampedNormalFactor::step.
+/// s = gain · r for n axes (fixed axes: 0), the sums in the order of DampedNormalFactor::step's damped loop; N > 0:
+/// n = N known at compile time (the loops unrolled).
 template <int N>
-void gainStep(const GainMatrix& gain, const Eigen::Matrix<double, 6, 1>& r, uint32_t free, double* s) {
-    for (int i = 0; i < N; ++i) {
+void gainStep(const GainMatrix& gain, const Eigen::Matrix<double, 6, 1>& r, uint32_t free, double* s, int n = N) {
+    const int m = N > 0 ? N : n;
+    for (int i = 0; i < m; ++i) {
         double v = 0;
         if (free & (1u << i))
             for (int j = 0; j < 6; ++j) v += gain(i, j) * r[j];
@@ -169,15 +171,14 @@ void DampedNormalFactor::step(const Eigen::Matrix<double, 6, 1>& r, const SmallM
             case 5: gainStep<5>(gain, r, free, s.data()); return;
             case 6: gainStep<6>(gain, r, free, s.data()); return;
             case 4: gainStep<4>(gain, r, free, s.data()); return;
-            default: break;
+            default: gainStep<0>(gain, r, free, s.data(), n); return;
         }
     }
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < n; ++i) {  // damped: the gain's sum less A⁻¹ D (q − ref)
         double v = 0;
         if (free & (1u << i)) {
             for (int j = 0; j < 6; ++j) v += gain(i, j) * r[j];
-            if (D)
-                for (int j = 0; j < n; ++j) v -= inverse(i, j) * g[j];
+            for (int j = 0; j < n; ++j) v -= inverse(i, j) * g[j];
         }
         s[i] = v;
     }
