@@ -9,6 +9,58 @@
 namespace cnccomp::postproc::iso {
 
 bool FrontEnd::next(Record& rec) {
+    if (!read(rec)) return false;
+    place(rec);
+    return true;
+}
+
+size_t FrontEnd::fill(Record* recs, size_t max, size_t maxBytes, bool& end, std::exception_ptr& error) {
+    size_t count = 0, bytes = 0;
+    end = false;
+    error = nullptr;
+    try {
+        while (count < max && bytes < maxBytes) {
+            Record& rec = recs[count];
+            if (!read(rec)) {
+                end = true;
+                break;
+            }
+            bytes += rec.text.size();
+            ++count;
+            if (placeBeforeReading(rec)) break;
+        }
+    } catch (...) {
+        error = std::current_exception();
+        end = true;
+    }
+    for (size_t k = 0; k < count; ++k) {
+        try {
+            place(recs[k]);
+        } catch (...) {  // an error in an earlier record than the reading error's comes first
+            error = std::current_exception();
+            end = true;
+            return k;
+        }
+    }
+    return count;
+}
+
+void FrontEnd::place(Record& rec) {
+    if (rec.partial) {
+        if (rec.overlongCode && (rec.overlongModal || rec.r.words)) nomAt_.known = false;
+        return;
+    }
+    switch (rec.r.kind) {
+        case BlockKind::Empty: break;
+        case BlockKind::NoMotion:
+            if (rec.r.modeSwitch) switchMode(rec.r);
+            break;
+        case BlockKind::PassThrough: afterPassThrough(rec.r); break;
+        case BlockKind::Move: move(rec); break;
+    }
+}
+
+bool FrontEnd::read(Record& rec) {
     if (!reader_.next(line_)) return false;
     const Line& ln = line_;
     rec.text.assign(ln.text);
@@ -27,22 +79,13 @@ bool FrontEnd::next(Record& rec) {
         long_.feed(ln.text);
         if (ln.lastPiece && long_.code) {
             rec.overlongCode = true;
-            rec.overlongModal = interp_.forgetOverlong(long_, rec.r);
-            if (rec.overlongModal || rec.r.words) nomAt_.known = false;
+            rec.overlongModal = interp_.forgetOverlong(long_, rec.r);  // place() forgets the nominal position
         }
         return true;
     }
     lexBlock(rec.text, dialect_, rec.b, ln.number == 1);
     interp_.interpret(rec.text, rec.b, rec.r);
     rec.assumed = interp_.assumed();
-    switch (rec.r.kind) {
-        case BlockKind::Empty: break;
-        case BlockKind::NoMotion:
-            if (rec.r.modeSwitch) switchMode(rec.r);
-            break;
-        case BlockKind::PassThrough: afterPassThrough(rec.r); break;
-        case BlockKind::Move: move(rec); break;
-    }
     return true;
 }
 
