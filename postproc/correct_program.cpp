@@ -37,11 +37,6 @@ int threadsFor(const CorrectOptions& o) {
 constexpr size_t kLines = 64;
 constexpr size_t kBytes = size_t{256} << 10;
 
-/// A record's text buffer goes when a long line made it large.
-void shrinkText(Record& rec) {
-    if (rec.text.capacity() > (size_t{64} << 10)) std::string().swap(rec.text);
-}
-
 /// The front end on its own thread, handing records to the back end (the calling thread) in batches, in program
 /// order: the same computations as on one thread, so the same output byte for byte. Constant memory: a fixed number
 /// of batches.
@@ -63,10 +58,7 @@ public:
                     std::unique_lock lock(mutex_);
                     changed_.wait(lock, [&] { return b.full; });
                 }
-                for (size_t k = 0; k < b.count; ++k) {
-                    consume(b.records[k]);
-                    shrinkText(b.records[k]);
-                }
+                for (size_t k = 0; k < b.count; ++k) consume(b.records[k]);
                 const bool last = b.last;
                 const std::exception_ptr error = b.error;
                 {
@@ -177,16 +169,14 @@ CorrectSummary correctProgram(const MachineModel& machine, const DeviationSet& d
     auto consume = [&](Record& rec) {
         back.line(rec);
         if (options.progress && (rec.number & 0x1fff) == 0 && rec.lastPiece) options.progress(rec.bytesConsumed);
+        if (rec.text.capacity() > (size_t{64} << 10)) std::string().swap(rec.text);  // a long line's buffer goes
     };
     if (threadsFor(options) < 2) {
         std::vector<Record> batch(kLines);
         for (bool end = false; !end;) {
             std::exception_ptr error;
             const size_t count = front.fill(batch.data(), kLines, kBytes, end, error);
-            for (size_t k = 0; k < count; ++k) {
-                consume(batch[k]);
-                shrinkText(batch[k]);
-            }
+            for (size_t k = 0; k < count; ++k) consume(batch[k]);
             if (error) std::rethrow_exception(error);
         }
     } else {
