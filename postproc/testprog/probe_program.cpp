@@ -87,6 +87,7 @@ public:
         switch (d_) {
             case postproc::Dialect::Printer:  // refused by makeProbeProgram
             case postproc::Dialect::Rs274ngc:
+                block(kSettleDwell);  // before every probing move: see probe_program.hpp, "LinuxCNC's stale DONE"
                 block(fmt::format("G38.3 {} F{}", words(to, linear()), f));
                 if (zShift != 0) {
                     // #5063 is in the program's coordinates, i.e. less the tool length: the log carries the machine Z.

@@ -12,10 +12,21 @@
 // LinuxCNC (the contract with tests/linuxcnc): (LOGOPEN,<log>) at the top; the run's tool length L given with
 // G43.1 Z<L> and every Z word written as the machine coordinate minus L (as the ball-bar and R-test programs:
 // program_syntax.hpp passToolLength); each touch
+//     G4 P0.05
 //     G38.3 X.. Y.. Z.. F<feed>
 //     #100=[#5063+L]
 //     (LOG,TOUCH <pose> <touch> #5070 #5061 #5062 #100 #5064 #5065 #5066)
-// (with L = 0: no G43.1, and #5063 itself)
+// (with L = 0: no G43.1, and #5063 itself), each G38.3 after a dwell `G4 P0.05` (kSettleDwell).
+// LinuxCNC's stale DONE, why the dwell: task sends a probe once motion reports DONE, i.e. in position with an empty
+// queue (src/emc/task/emctaskmain.cc emcTaskCheckPreconditions: EMC_TRAJ_PROBE_TYPE waits for motion and IO;
+// src/emc/task/taskintf.cc emcTrajUpdate: DONE = inpos && queue == 0). Motion echoes a command in its command handler
+// (src/emc/motion/command.c) but counts the queue later in the servo cycle (control.c: depth = tpQueueDepth), so a
+// status read between the two shows the rapids just sent as done while the stylus still sits on the last contact.
+// The probe then starts tripped: G38.2 stops with "Probe is already tripped", G38.3 records the old contact as a new
+// touch (control.c process_probe_inputs), a silent wrong touch. The dwell is timed by task (EMC_TRAJ_DELAY: waits for
+// motion, then for its time), so the probe's own check reads a status of a later servo cycle. Seen twice in cnccomp's
+// headless LinuxCNC tests (tests/linuxcnc/test_linuxcnc_virtual_sphere.cpp, G38.2, on a loaded 2-core machine with
+// non-realtime threads); on a realtime machine the window is shorter, not closed.
 // G38.3 = probe towards the piece, stop on contact, NO error when the probe does not trip: #5070 = 1 tripped, 0 not,
 // #5061–#5069 = X Y Z A B C U V W of the controlled point where it tripped (the programmed point if it did not), in the
 // current work coordinate system (LinuxCNC docs/src/gcode/g-code.adoc "G38.n Straight Probe";
@@ -45,6 +56,10 @@
 #include "postproc/testprog/program_syntax.hpp"
 
 namespace cnccomp::postproc::testprog {
+
+/// The dwell before each LinuxCNC probing move (the header: "LinuxCNC's stale DONE"); 0.05 s = 5 task cycles at
+/// [TASK] CYCLE_TIME 0.010, 50 at 0.001.
+inline constexpr const char* kSettleDwell = "G4 P0.05";
 
 struct ProbeProgramOptions {
     postproc::Dialect dialect = postproc::Dialect::Rs274ngc;

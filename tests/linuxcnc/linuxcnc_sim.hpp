@@ -130,13 +130,14 @@ struct RunResult {
     std::vector<Sample> samples;
     double seconds = 0;
     long overruns = 0;  ///< samples lost by the sampler's FIFO (must be 0)
-    int retries = 0;    ///< runs started again after LinuxCNC's "Queue is not empty after probing" (run())
+    int retries = 0;    ///< runs started again after one of LinuxCNC's probing races (run())
 };
 
 /// Runs LinuxCNC on the configuration with a job (lines `mdi <G-code>` / `record <label>` / `auto <program file>` /
 /// `sample <program file>` / `setp <pin or parameter> <value>`, see driver.py) and returns the records. Throws std::runtime_error with the end of
 /// LinuxCNC's log when the run fails; a run that LinuxCNC aborted with "Queue is not empty after probing" (an upstream
-/// race after probe moves, see run()) starts again, at most 6 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
+/// race after probe moves, see run()) or with "Probe is already tripped when starting G38.2" (its stale DONE before a
+/// probe move, postproc/testprog/probe_program.hpp) starts again, at most 6 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
 /// (INI, HAL, job, log) is copied there.
 /// `suspect`, when given, is asked after a run that succeeded: a non-empty answer (why) marks the run as hit by that race
 /// all the same (its silent form: the read-ahead passes the queue test with the stale status and the LOG line after the

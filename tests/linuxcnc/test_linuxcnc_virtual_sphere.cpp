@@ -32,6 +32,7 @@
 #include "cnccomp/kinematics.hpp"
 #include "linuxcnc/linuxcnc_sim.hpp"
 #include "linuxcnc/virtual_sphere.hpp"
+#include "postproc/testprog/probe_program.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp::test {
@@ -71,7 +72,7 @@ std::vector<Vec3> directions() {
 /// offset); true: `G43.1 Z<tool length>` and every Z word minus it, as cnccomp testprog's LinuxCNC programs do, so the
 /// kinematics component holds the ball centre exact (its tool-offset pin). Per pose: up to a safe height, turn A and C,
 /// then per direction: above the start point, down to it (approach 0.5 mm from contact), G38.2 to 0.5 mm inside the
-/// sphere, LOG, back, up.
+/// sphere (after the settling dwell of cnccomp's own probing programs), LOG, back, up.
 std::string program(const MachineModel& m, const vs::Setup& s, const std::string& log, bool g43 = false) {
     const Kinematics nominal(m);
     const double reach = s.sphereRadius + s.ballRadius, L = s.toolLength, offset = g43 ? L : 0.0;
@@ -90,7 +91,10 @@ std::string program(const MachineModel& m, const vs::Setup& s, const std::string
         for (size_t t = 0; t < dirs.size(); ++t) {
             const Vec3 start = centre + (reach + 0.5) * dirs[t], end = centre + (reach - 0.5) * dirs[t];
             const Vec3 above(start.x(), start.y(), std::max(start.z(), centre.z() + reach + 5));
-            p += fmt::format("G0 X{:.6f} Y{:.6f}\nG0 {}\nG0 {}\nG38.2 {} F{:g}\n", above.x(), above.y(), xyz(above), xyz(start), xyz(end), kFeed);
+            // The dwell before the probe: LinuxCNC's stale DONE (postproc/testprog/probe_program.hpp), which started
+            // this program's G38.2 tripped, on the last touch's contact, twice (a CI run, a fresh-clone run; loaded machine).
+            p += fmt::format("G0 X{:.6f} Y{:.6f}\nG0 {}\nG0 {}\n{}\nG38.2 {} F{:g}\n", above.x(), above.y(), xyz(above), xyz(start),
+                             postproc::testprog::kSettleDwell, xyz(end), kFeed);
             p += fmt::format("(LOG,TOUCH {} {} #5070 #5061 #5062 #5063 #5064 #5065 #5066)\n", k, t);
             p += fmt::format("G0 {}\nG0 {}\n", xyz(start), xyz(above));
         }

@@ -77,10 +77,18 @@ TEST(ProbeProgram, LinuxCncShapeIsTheContract) {
     // kinematics component keeps the point at that length exact); the log carries the machine's Z, #5063 + L.
     EXPECT_NE(t.find("\nG43.1 Z100.000000\n"), std::string::npos);
     EXPECT_LT(t.find("G43.1"), t.find("G38.3"));
-    EXPECT_NE(t.find("\nG38.3 X100.000000 Y50.000000 Z54.500000 F100\n"
+    EXPECT_NE(t.find("\nG4 P0.05\nG38.3 X100.000000 Y50.000000 Z54.500000 F100\n"
                      "#100=[#5063+100.000000]\n"
                      "(LOG,TOUCH 0 0 #5070 #5061 #5062 #100 #5064 #5065 #5066)\n"),
               std::string::npos);
+    // Every probing move after the settling dwell (LinuxCNC's stale DONE, probe_program.hpp).
+    size_t probes = 0, settled = 0;
+    for (size_t at = t.find("G38.3"); at != std::string::npos; at = t.find("G38.3", at + 1)) {
+        ++probes;
+        settled += at >= 9 && t.compare(at - 9, 9, "G4 P0.05\n") == 0;
+    }
+    EXPECT_EQ(probes, static_cast<size_t>(p.touches));
+    EXPECT_EQ(settled, probes);
     EXPECT_NE(t.find("(LOG,TOUCH 22 4 #5070 #5061 #5062 #100 #5064 #5065 #5066)"), std::string::npos);
     EXPECT_NE(t.find("G49\n(LOGCLOSE)\nM2\n"), std::string::npos);
     EXPECT_LT(t.find("(LOGOPEN"), t.find("G38.3"));
