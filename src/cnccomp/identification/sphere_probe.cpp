@@ -1,5 +1,6 @@
 #include "cnccomp/identification/sphere_probe.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
@@ -275,6 +276,21 @@ std::vector<std::vector<std::vector<AxisVector>>> checkedTouches(const MachineMo
                              "±{:g} mm of sphere run '{}'{}; not fitted",
                              dev, rc.run.touchWindow(), rc.run.name,
                              std::abs(dev + rc.run.approach) < 1e-3 ? " (at the end of its probing move: a missed touch)" : ""));
+        // On its own probing move: the probe stops on the commanded line (approach → target in the linear axes; the
+        // controllers log the trip position of that move). A contact on the sphere but off that line is another
+        // move's, e.g. LinuxCNC's stale DONE repeating the last contact (postproc/testprog/probe_program.hpp).
+        const SphereTouchCommand& tc = pc.touches[static_cast<size_t>(t.touch)];
+        double uu = 0, ud = 0, dd = 0;
+        for (int a = 0; a < m.axisCount(); ++a) {
+            if (m.axisLink(a).kind != AxisKind::Linear) continue;
+            const double u = q[a] - tc.approach[a], d = tc.target[a] - tc.approach[a];
+            uu += u * u, ud += u * d, dd += d * d;
+        }
+        const double off = std::sqrt(std::max(0.0, dd > 0 ? uu - ud * ud / dd : uu));
+        if (off > rc.run.touchWindow())
+            fail(fmt::format("the probe stopped {:.4f} mm off the line of its probing move (more than the window ±{:g} mm "
+                             "of sphere run '{}'): the position of another touch? not fitted",
+                             off, rc.run.touchWindow(), rc.run.name));
         out[w.run][w.pose][static_cast<size_t>(t.touch)] = q;
     }
     for (size_t r = 0; r < commands.runs.size(); ++r)

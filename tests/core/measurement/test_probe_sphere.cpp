@@ -259,6 +259,13 @@ TEST(ProbeLog, MissedOutOfWindowDuplicatedAndMissingTouchesAreNamedNeverFitted) 
         }
         expectError(noFlag, 5, "pose 0 touch 4: missed: the probe stopped at the end of its probing move");
     }
+    // Pose 2 touch 2 logged at touch 1's contact (as LinuxCNC's stale DONE would repeat it): on the sphere, inside the
+    // radial window, but 10+ mm off its own probing move.
+    {
+        const ProbeLog sim = simulateSphereProbing(Kinematics(m), c);
+        expectError(logWith(m, c, 12, [&](ProbeTouch& t) { t.q = sim.touches[11].q; }), 13,
+                    "pose 2 touch 2: the probe stopped");
+    }
     // The rotary axes of another pose.
     expectError(logWith(m, c, 20, [&](ProbeTouch& t) { t.q[m.axisIndex("C")] += 1 * kDeg; }), 21, "axis C");
     // Twice the same touch; a touch the file does not have.
