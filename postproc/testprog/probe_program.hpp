@@ -16,8 +16,8 @@
 //     G38.3 X.. Y.. Z.. F<feed>
 //     #100=[#5063+L]
 //     (LOG,TOUCH <pose> <touch> #5070 #5061 #5062 #100 #5064 #5065 #5066)
-// (with L = 0: no G43.1, and #5063 itself), each G38.3 after a dwell `G4 P0.05` (kSettleDwell).
-// LinuxCNC's stale DONE, why the dwell: task sends a probe once motion reports DONE, i.e. in position with an empty
+// (with L = 0: no G43.1, and #5063 itself).
+// LinuxCNC's stale DONE, why the dwell (kSettleDwell): task sends a probe once motion reports DONE, i.e. in position with an empty
 // queue (src/emc/task/emctaskmain.cc emcTaskCheckPreconditions: EMC_TRAJ_PROBE_TYPE waits for motion and IO;
 // src/emc/task/taskintf.cc emcTrajUpdate: DONE = inpos && queue == 0). Motion echoes a command in its command handler
 // (src/emc/motion/command.c) but counts the queue later in the servo cycle (control.c: depth = tpQueueDepth), so a

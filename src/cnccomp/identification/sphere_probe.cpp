@@ -260,12 +260,12 @@ std::vector<std::vector<std::vector<AxisVector>>> checkedTouches(const MachineMo
                                  m.axisNames[static_cast<size_t>(a)], q[a] / kDeg, pc.safe[a] / kDeg));
             }
         }
+        const SphereTouchCommand& tc = pc.touches[static_cast<size_t>(t.touch)];  // its commanded probing move
         // No flag in the file (Fanuc, HEIDENHAIN): a touch at the end of its probing move did not trigger.
         if (t.triggered < 0) {
-            const AxisVector& end = pc.touches[static_cast<size_t>(t.touch)].target;
             bool atEnd = true;
             for (int a = 0; a < m.axisCount(); ++a)
-                if (m.axisLink(a).kind == AxisKind::Linear) atEnd = atEnd && std::abs(q[a] - end[a]) < 1e-4;
+                if (m.axisLink(a).kind == AxisKind::Linear) atEnd = atEnd && std::abs(q[a] - tc.target[a]) < 1e-4;
             if (atEnd)
                 fail(fmt::format("missed: the probe stopped at the end of its probing move (sphere run '{}'); not fitted",
                                  rc.run.name));
@@ -279,7 +279,6 @@ std::vector<std::vector<std::vector<AxisVector>>> checkedTouches(const MachineMo
         // On its own probing move: the probe stops on the commanded line (approach → target in the linear axes; the
         // controllers log the trip position of that move). A contact on the sphere but off that line is another
         // move's, e.g. LinuxCNC's stale DONE repeating the last contact (postproc/testprog/probe_program.hpp).
-        const SphereTouchCommand& tc = pc.touches[static_cast<size_t>(t.touch)];
         double uu = 0, ud = 0, dd = 0;
         for (int a = 0; a < m.axisCount(); ++a) {
             if (m.axisLink(a).kind != AxisKind::Linear) continue;
