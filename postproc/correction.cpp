@@ -8,8 +8,16 @@ namespace cnccomp::postproc {
 
 namespace {
 
+/// out = a + t (b − a) element by element (as the Eigen expression; a loop, which Eigen's runtime-size assignment is not
+/// inlined as).
+inline void lerpAxes(const AxisVector& a, const AxisVector& b, double t, AxisVector& out) {
+    const int n = static_cast<int>(a.size());
+    out.resize(n);
+    for (int i = 0; i < n; ++i) out[i] = a[i] + t * (b[i] - a[i]);
+}
+
 void lerpPoint(const ProgramPoint& a, const ProgramPoint& b, double t, bool vector, ProgramPoint& out) {
-    out.p = a.p + t * (b.p - a.p);
+    lerpAxes(a.p, b.p, t, out.p);
     if (vector) out.v = slerpVector(a.v, b.v, t);
 }
 /// start += slope · step for n axes; N > 0: n = N known at compile time (the loops unrolled, the same sums).
@@ -56,7 +64,7 @@ MovePath MovePath::arc(const AxisVector& start, const AxisVector& end, const Arc
 }
 
 void MovePath::at(double t, ProgramPoint& q) const {
-    q.p = start + t * (end - start);
+    lerpAxes(start, end, t, q.p);
     if (vector) q.v = slerpVector(v0, v1, t);
     if (!circular) return;
     const double th = theta0 + t * sweep, r = r0 + t * (r1 - r0);
@@ -119,7 +127,7 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
             } else {
                 tcp_.toJoints(nominalData_, p.p, s.controlLength, c);
             }
-            return c.allFinite();
+            return allFinite(c);
         case ProgramMode::TcpVector: {
             // The tool axis depends on the rotary axes only: Gauss–Newton on them (fresh Jacobian, limited steps),
             // then the linear axes exactly for the point, as in angles mode.
@@ -179,7 +187,7 @@ bool Corrector::toJoints(const MoveSpace& s, const ProgramPoint& p, const AxisVe
             for (int i = 0; i < n; ++i)
                 if (rotary_ & (1u << i)) withAngles[i] = best[i];
             tcp_.toJoints(nominalData_, withAngles, s.controlLength, c);
-            return c.allFinite();
+            return allFinite(c);
         }
     }
     return false;
@@ -390,7 +398,7 @@ SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, Jac
             break;
         }
     }
-    if (!std::isfinite(res.tipError) || !q.allFinite()) {
+    if (!std::isfinite(res.tipError) || !allFinite(q)) {
         res.converged = false;
         cache.valid = false;
         cache.factored = false;

@@ -47,13 +47,24 @@ inline Mat3 angleAxisMatrix(const Vec3& u, double c, double s) {
 
 }  // namespace
 
-void KinematicsModel::rotateBack(const Op& op, double c, double s, Vec3& v) {
+namespace {
+/// Rot(k, θ)ᵀ v in the plane (I, J) of a coordinate axis k: (c v_I + s v_J, −s v_I + c v_J). The plane's indices are
+/// constants, so that v can stay in registers through a walk.
+template <int I, int J>
+[[gnu::always_inline]] inline void rotateBackInPlane(double c, double s, Vec3& v) {
+    const double a = v[I], b = v[J];
+    v[I] = c * a + s * b;
+    v[J] = c * b - s * a;
+}
+}  // namespace
+
+[[gnu::always_inline]] inline void KinematicsModel::rotateBack(const Op& op, double c, double s, Vec3& v) {
     if (op.unit >= 0) {
-        // Rot(k, θ)ᵀ v: in the plane (i, j) of the axis, (c vᵢ + s vⱼ, −s vᵢ + c vⱼ).
-        const int i = op.ui, j = op.uj;
-        const double a = v[i], b = v[j];
-        v[i] = c * a + s * b;
-        v[j] = c * b - s * a;
+        switch (op.unit) {  // the plane (i, j) = ((k + 1) % 3, (k + 2) % 3) of axis k
+            case 0: rotateBackInPlane<1, 2>(c, s, v); return;
+            case 1: rotateBackInPlane<2, 0>(c, s, v); return;
+            default: rotateBackInPlane<0, 1>(c, s, v); return;
+        }
     } else {
         // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
         const Vec3& u = op.dir;
@@ -213,7 +224,7 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
             op.slot = slots++;
         }
         for (int k = 0; k < 3; ++k)
-            if (l.direction == Vec3::Unit(k)) op.unit = k, op.ui = (k + 1) % 3, op.uj = (k + 2) % 3;
+            if (l.direction == Vec3::Unit(k)) op.unit = k;
         ops.push_back(op);
         if (!components.empty()) {
             Op c;
@@ -380,44 +391,48 @@ void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double le
 template <bool WithPoint, bool WithDirection>
 void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3& point, Vec3& direction) const {
     // w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base): op_1⁻¹ first. The point's and the direction's arithmetic are
-    // independent: either alone gives the same bits as both.
+    // independent: either alone gives the same bits as both. Walked on local copies (kept in registers: the references
+    // could alias the model's operations).
+    Vec3 p = point, dir = direction;
     for (const Op& op : workpiece_.ops) {
         switch (op.kind) {
             case OpKind::Constant:
-                if constexpr (WithPoint) point -= op.t;
+                if constexpr (WithPoint) p -= op.t;
                 if (!op.identityR) {
-                    if constexpr (WithPoint) point = op.R.transpose() * point;
-                    if constexpr (WithDirection) direction = op.R.transpose() * direction;
+                    if constexpr (WithPoint) p = op.R.transpose() * p;
+                    if constexpr (WithDirection) dir = op.R.transpose() * dir;
                 }
                 break;
             case OpKind::Linear:
-                if constexpr (WithPoint) point -= op.dir * q[op.axis];
+                if constexpr (WithPoint) p -= op.dir * q[op.axis];
                 break;
             case OpKind::Rotary: {
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
-                if constexpr (WithPoint) rotateBack(op, c, sn, point);
-                if constexpr (WithDirection) rotateBack(op, c, sn, direction);
+                if constexpr (WithPoint) rotateBack(op, c, sn, p);
+                if constexpr (WithDirection) rotateBack(op, c, sn, dir);
                 break;
             }
             case OpKind::Component: {
                 const Pose E = componentError(op, q);
-                if constexpr (WithPoint) point = E.linear().transpose() * (point - E.translation());
-                if constexpr (WithDirection) direction = E.linear().transpose() * direction;
+                if constexpr (WithPoint) p = E.linear().transpose() * (p - E.translation());
+                if constexpr (WithDirection) dir = E.linear().transpose() * dir;
                 break;
             }
         }
     }
+    if constexpr (WithPoint) point = p;
+    if constexpr (WithDirection) direction = dir;
 }
 
 void KinematicsModel::toolInBase(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
     bind(d);
     if (tool_.affine.ok) {  // the tool frame directly (no cache entry written)
         const Affine& a = tool_.affine;
-        tip = a.t0;
-        for (int k = 0; k < a.count; ++k) tip += a.col[k] * q[a.axis[k]];
+        Vec3 t = a.t0;  // summed in a local (the reference could alias the model)
+        for (int k = 0; k < a.count; ++k) t += a.col[k] * q[a.axis[k]];
         axis = a.toolAxis;
-        tip += length * axis;
+        tip = t + length * a.toolAxis;
     } else {
         const Frame& t = cached(d, tool_, d.tool_, q, false).frame;
         axis = t.R * machine_->toolDirection;

@@ -181,7 +181,6 @@ private:
         int axis = -1;
         int slot = -1;  ///< Rotary op: its Trig in KinematicsData
         int unit = -1;  ///< rotary direction is +X / +Y / +Z exactly: 0 / 1 / 2; else −1
-        int ui = 1, uj = 2;  ///< with `unit`: the plane it turns, (unit + 1) % 3 and (unit + 2) % 3
         Mat3 R = Mat3::Identity();
         Vec3 t = Vec3::Zero();
         Vec3 dir = Vec3::UnitZ();
