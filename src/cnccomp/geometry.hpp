@@ -1,5 +1,7 @@
 #pragma once
 // Small geometric vocabulary: poses are Eigen isometries named aMb (pose of frame b in frame a).
+#include <cmath>
+
 #include <Eigen/Geometry>
 #include <numbers>
 
@@ -9,6 +11,16 @@ using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Pose = Eigen::Isometry3d;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+/// Every entry finite, as Eigen's allFinite, whose x − x test runs as an out-of-line loop at a runtime size (the hot
+/// paths of `correct` ask it per solve, of an AxisVector and of the normal matrix' inverse).
+template <class Derived>
+bool allFinite(const Eigen::DenseBase<Derived>& m) {
+    for (Eigen::Index c = 0; c < m.cols(); ++c)
+        for (Eigen::Index r = 0; r < m.rows(); ++r)
+            if (!std::isfinite(m(r, c))) return false;
+    return true;
+}
 
 inline constexpr double kPi = std::numbers::pi;
 inline constexpr double kTwoPi = 2.0 * std::numbers::pi;

@@ -2,7 +2,6 @@
 // The machine model: two serial chains from the bed (workpiece side, tool side), each link one axis
 // (linear, rotary or fixed) plus a fixed placement, and the named deviation parameters the machine admits.
 // Immutable once built; algorithms take it by const reference (Model/Data split as in Pinocchio).
-#include <cmath>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -16,13 +15,6 @@ inline constexpr int kMaxAxes = 9;
 /// Commanded positions of the controlled axes, in the machine's axis order (mm for linear, rad for rotary).
 /// Fixed capacity so that hot loops never allocate.
 using AxisVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxAxes, 1>;
-/// Every entry finite (as AxisVector::allFinite, whose x − x test Eigen runs as a loop call for a runtime size: the
-/// hot paths of `correct` ask it per solve).
-inline bool allFinite(const AxisVector& v) {
-    for (int i = 0; i < v.size(); ++i)
-        if (!std::isfinite(v[i])) return false;
-    return true;
-}
 
 enum class AxisKind { Linear, Rotary, Fixed };
 enum class Side { Workpiece, Tool };

@@ -57,10 +57,7 @@ bool invertFixed(const SmallMatrix& A, SmallMatrix& inverse) {
         llt.solveInPlace(e);
         inverse.col(c) = e;
     }
-    for (int c = 0; c < n; ++c)  // as inverse.allFinite() (a loop call for a runtime size)
-        for (int r = 0; r < n; ++r)
-            if (!std::isfinite(inverse(r, c))) return false;
-    return true;
+    return allFinite(inverse);
 }
 
 }  // namespace
