@@ -123,8 +123,12 @@ void FrontEnd::refuse(Record& rec, const char* reason) {
 
 void FrontEnd::move(Record& rec) {
     BlockResult& r = rec.r;
-    const MoveSpace space{r.mode, r.controlLength, r.tipLength};
-    rec.space = space;
+    // Field by field into the record: a MoveSpace built on the stack and copied whole was read back as 16 bytes over
+    // its one-byte mode and a half of the lengths' store, a load the processor cannot forward (it waits for both).
+    rec.space.mode = r.mode;
+    rec.space.controlLength = r.controlLength;
+    rec.space.toolLength = r.tipLength;
+    const MoveSpace& space = rec.space;
     const bool tcp = space.mode != ProgramMode::Joints;
     if (tcp && !corrector_.tcp().supported()) {
         refuse(rec, corrector_.tcp().why());

@@ -374,13 +374,18 @@ SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, Jac
         return linStep + 100.0 * rotStep;
     };
     Vec3 tip, axis;
+    // The residuals' norms are taken once after the loop, of the last evaluation's squares (a square root's latency
+    // stood on the loop's path; `norm` is the square root of `squaredNorm`, so the values are the same).
+    double tip2 = 0.0, axis2 = 0.0;
+    bool evaluated = false;
     for (res.iterations = 0; res.iterations < options_.maxIterations; ++res.iterations) {
         k.toolPoseOnce(kd, q, toolLength, tip, axis);
         const Vec3 et = targetTip - tip, ea = targetAxis - axis;
         for (int j = 0; j < 3; ++j) r[j] = et[j], r[3 + j] = ea[j] * w;
-        res.tipError = et.norm();
-        res.axisError = ea.norm();
-        if (!std::isfinite(res.tipError)) break;
+        tip2 = et.squaredNorm();
+        axis2 = ea.squaredNorm();
+        evaluated = true;
+        if (!std::isfinite(tip2)) break;
         double size = newtonStep();
         // Chord method: the kept Jacobian while the steps shrink fast, a fresh one when they do not.
         if (!fresh && size > 0.25 * lastStep) {
@@ -397,6 +402,10 @@ SolveResult Corrector::solveOn(const KinematicsModel& k, KinematicsData& kd, Jac
             ++res.iterations;
             break;
         }
+    }
+    if (evaluated) {
+        res.tipError = std::sqrt(tip2);
+        res.axisError = std::sqrt(axis2);
     }
     if (!std::isfinite(res.tipError) || !allFinite(q)) {
         res.converged = false;

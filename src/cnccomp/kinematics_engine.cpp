@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
+#include "cnccomp/xyz.hpp"
 
 namespace cnccomp {
 
@@ -71,6 +72,27 @@ template <int I, int J>
         v = c * v - s * u.cross(v) + (1 - c) * u.dot(v) * u;
     }
 }
+
+namespace {
+using xyz::toVec3;
+using xyz::toXyz;
+using xyz::Xyz;
+/// KinematicsModel::rotateBack on three scalars (the general direction through the Vec3 one: the same expression).
+template <class Op>
+[[gnu::always_inline]] inline void rotateBackXyz(const Op& op, double c, double s, Xyz& v,
+                                                 void (*general)(const Op&, double, double, Vec3&)) {
+    switch (op.unit) {  // the plane (i, j) = ((k + 1) % 3, (k + 2) % 3) of axis k
+        case 0: xyz::turnBack(c, s, v.y, v.z); return;
+        case 1: xyz::turnBack(c, s, v.z, v.x); return;
+        case 2: xyz::turnBack(c, s, v.x, v.y); return;
+        default: {
+            Vec3 w = toVec3(v);
+            general(op, c, s, w);
+            v = toXyz(w);
+        }
+    }
+}
+}  // namespace
 
 Pose KinematicsModel::componentError(const Op& op, const AxisVector& q) const {
     Vec6 e = Vec6::Zero();
@@ -393,36 +415,39 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
     // w⁻¹ = op_N⁻¹ ⋯ op_1⁻¹ (op_1 nearest the base): op_1⁻¹ first. The point's and the direction's arithmetic are
     // independent: either alone gives the same bits as both. Walked on local copies (kept in registers: the references
     // could alias the model's operations).
-    Vec3 p = point, dir = direction;
+    Xyz p = toXyz(point), dir = toXyz(direction);
     for (const Op& op : workpiece_.ops) {
         switch (op.kind) {
             case OpKind::Constant:
-                if constexpr (WithPoint) p -= op.t;
+                if constexpr (WithPoint) p = {p.x - op.t[0], p.y - op.t[1], p.z - op.t[2]};
                 if (!op.identityR) {
-                    if constexpr (WithPoint) p = op.R.transpose() * p;
-                    if constexpr (WithDirection) dir = op.R.transpose() * dir;
+                    if constexpr (WithPoint) p = xyz::transposeTimes(op.R, p);
+                    if constexpr (WithDirection) dir = xyz::transposeTimes(op.R, dir);
                 }
                 break;
             case OpKind::Linear:
-                if constexpr (WithPoint) p -= op.dir * q[op.axis];
+                if constexpr (WithPoint) {
+                    const double v = q[op.axis];
+                    p = {p.x - op.dir[0] * v, p.y - op.dir[1] * v, p.z - op.dir[2] * v};
+                }
                 break;
             case OpKind::Rotary: {
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
-                if constexpr (WithPoint) rotateBack(op, c, sn, p);
-                if constexpr (WithDirection) rotateBack(op, c, sn, dir);
+                if constexpr (WithPoint) rotateBackXyz(op, c, sn, p, &rotateBack);
+                if constexpr (WithDirection) rotateBackXyz(op, c, sn, dir, &rotateBack);
                 break;
             }
             case OpKind::Component: {
                 const Pose E = componentError(op, q);
-                if constexpr (WithPoint) p = E.linear().transpose() * (p - E.translation());
-                if constexpr (WithDirection) dir = E.linear().transpose() * dir;
+                if constexpr (WithPoint) p = toXyz(E.linear().transpose() * (toVec3(p) - E.translation()));
+                if constexpr (WithDirection) dir = toXyz(E.linear().transpose() * toVec3(dir));
                 break;
             }
         }
     }
-    if constexpr (WithPoint) point = p;
-    if constexpr (WithDirection) direction = dir;
+    if constexpr (WithPoint) point = toVec3(p);
+    if constexpr (WithDirection) direction = toVec3(dir);
 }
 
 void KinematicsModel::toolInBase(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
@@ -469,31 +494,33 @@ Vec3 KinematicsModel::workpiecePointToBase(KinematicsData& d, const AxisVector& 
         return w.R * p + w.t;
     }
     // bMw = op_1 ⋯ op_N: op_N first.
-    Vec3 r = p;
+    Xyz r = toXyz(p);
     for (auto it = workpiece_.ops.rbegin(); it != workpiece_.ops.rend(); ++it) {
         const Op& op = *it;
         switch (op.kind) {
             case OpKind::Constant:
-                if (!op.identityR) r = op.R * r;
-                r += op.t;
+                if (!op.identityR) r = xyz::times(op.R, r);
+                r = {r.x + op.t[0], r.y + op.t[1], r.z + op.t[2]};
                 break;
-            case OpKind::Linear:
-                r += op.dir * q[op.axis];
+            case OpKind::Linear: {
+                const double v = q[op.axis];
+                r = {r.x + op.dir[0] * v, r.y + op.dir[1] * v, r.z + op.dir[2] * v};
                 break;
+            }
             case OpKind::Rotary: {
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
-                rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
+                rotateBackXyz(op, c, -sn, r, &rotateBack);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }
             case OpKind::Component: {
                 const Pose E = componentError(op, q);
-                r = E.linear() * r + E.translation();
+                r = toXyz(E.linear() * toVec3(r) + E.translation());
                 break;
             }
         }
     }
-    return r;
+    return toVec3(r);
 }
 
 Vec3 KinematicsModel::toolAxisOnce(KinematicsData& d, const AxisVector& q) const {

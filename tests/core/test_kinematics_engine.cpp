@@ -8,9 +8,11 @@
 //   Sequences of nearby and far poses exercise every cache path.
 // - The exact walk itself (cnccomp::Kinematics, and Arithmetic::AsExactModel with its workspace) against ReferenceChain,
 //   an independent transcription of the model's equations, to the bit.
+// - The walks' scalar arithmetic (cnccomp/xyz.hpp) against the Eigen expressions it stands for, to the bit.
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <filesystem>
 #include <random>
 
@@ -18,6 +20,7 @@
 #include "cnccomp/inverse_kinematics.hpp"
 #include "cnccomp/io/machine_xml.hpp"
 #include "cnccomp/kinematics_engine.hpp"
+#include "cnccomp/xyz.hpp"
 #include "test_support.hpp"
 
 namespace cnccomp {
@@ -299,6 +302,40 @@ TEST(KinematicsEngine, TheExactModelIsTheLinkByLinkTranscriptionToTheBit) {
     const MachineModel m = readMachineXml(dir.file("m.xml"));
     compareBits(m, DeviationSet(m), "inclined head nominal");
     compareBits(m, randomSet(m, rng), "inclined head with errors");
+}
+
+/// The fast walks keep a point as three scalars (cnccomp/xyz.hpp) and write Eigen's products out term by term in its
+/// order of summation; the bits are Eigen's: random matrices of mixed magnitudes and signs (not only rotations), as the
+/// walks use them (the product assigned back to its operand).
+TEST(KinematicsEngine, ScalarWalkArithmeticIsEigensToTheBit) {
+    std::mt19937_64 rng(20261127);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::uniform_int_distribution<int> e(-30, 30);
+    auto any = [&] { return std::ldexp(u(rng), e(rng)); };
+    auto same = [](const Vec3& a, const xyz::Xyz& b) {
+        return std::bit_cast<uint64_t>(a[0]) == std::bit_cast<uint64_t>(b.x) &&
+               std::bit_cast<uint64_t>(a[1]) == std::bit_cast<uint64_t>(b.y) &&
+               std::bit_cast<uint64_t>(a[2]) == std::bit_cast<uint64_t>(b.z);
+    };
+    int differ = 0;
+    for (int k = 0; k < 200000; ++k) {
+        Mat3 R;
+        for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = any();
+        const Vec3 p(any(), any(), any());
+        Vec3 a = p;
+        a = R.transpose() * a;
+        Vec3 b = p;
+        b = R * b;
+        const double c = u(rng), s = u(rng);
+        Vec3 t = p;
+        const double ty = t[1], tz = t[2];
+        t[1] = c * ty + s * tz;
+        t[2] = c * tz - s * ty;
+        xyz::Xyz q = xyz::toXyz(p);
+        xyz::turnBack(c, s, q.y, q.z);
+        differ += !same(a, xyz::transposeTimes(R, xyz::toXyz(p))) + !same(b, xyz::times(R, xyz::toXyz(p))) + !same(t, q);
+    }
+    EXPECT_EQ(differ, 0);
 }
 
 }  // namespace
