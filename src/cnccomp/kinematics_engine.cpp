@@ -49,50 +49,24 @@ inline Mat3 angleAxisMatrix(const Vec3& u, double c, double s) {
 }  // namespace
 
 namespace {
-/// Rot(k, θ)ᵀ v in the plane (I, J) of a coordinate axis k: (c v_I + s v_J, −s v_I + c v_J). The plane's indices are
-/// constants, so that v can stay in registers through a walk.
-template <int I, int J>
-[[gnu::always_inline]] inline void rotateBackInPlane(double c, double s, Vec3& v) {
-    const double a = v[I], b = v[J];
-    v[I] = c * a + s * b;
-    v[J] = c * b - s * a;
-}
-}  // namespace
-
-[[gnu::always_inline]] inline void KinematicsModel::rotateBack(const Op& op, double c, double s, Vec3& v) {
-    if (op.unit >= 0) {
-        switch (op.unit) {  // the plane (i, j) = ((k + 1) % 3, (k + 2) % 3) of axis k
-            case 0: rotateBackInPlane<1, 2>(c, s, v); return;
-            case 1: rotateBackInPlane<2, 0>(c, s, v); return;
-            default: rotateBackInPlane<0, 1>(c, s, v); return;
-        }
-    } else {
-        // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
-        const Vec3& u = op.dir;
-        v = c * v - s * u.cross(v) + (1 - c) * u.dot(v) * u;
-    }
-}
-
-namespace {
 using xyz::toVec3;
 using xyz::toXyz;
 using xyz::Xyz;
-/// KinematicsModel::rotateBack on three scalars (the general direction through the Vec3 one: the same expression).
-template <class Op>
-[[gnu::always_inline]] inline void rotateBackXyz(const Op& op, double c, double s, Xyz& v,
-                                                 void (*general)(const Op&, double, double, Vec3&)) {
-    switch (op.unit) {  // the plane (i, j) = ((k + 1) % 3, (k + 2) % 3) of axis k
+}  // namespace
+
+[[gnu::always_inline]] inline void KinematicsModel::rotateBack(const Op& op, double c, double s, Xyz& v) {
+    switch (op.unit) {  // a coordinate axis k turns its plane (i, j) = ((k + 1) % 3, (k + 2) % 3)
         case 0: xyz::turnBack(c, s, v.y, v.z); return;
         case 1: xyz::turnBack(c, s, v.z, v.x); return;
         case 2: xyz::turnBack(c, s, v.x, v.y); return;
         default: {
-            Vec3 w = toVec3(v);
-            general(op, c, s, w);
-            v = toXyz(w);
+            // Rodrigues with −θ: v c − s (u × v) + (1 − c)(u · v) u.
+            const Vec3& u = op.dir;
+            const Vec3 w = toVec3(v);
+            v = toXyz(c * w - s * u.cross(w) + (1 - c) * u.dot(w) * u);
         }
     }
 }
-}  // namespace
 
 Pose KinematicsModel::componentError(const Op& op, const AxisVector& q) const {
     Vec6 e = Vec6::Zero();
@@ -434,8 +408,8 @@ void KinematicsModel::intoWorkpiece(KinematicsData& d, const AxisVector& q, Vec3
             case OpKind::Rotary: {
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
-                if constexpr (WithPoint) rotateBackXyz(op, c, sn, p, &rotateBack);
-                if constexpr (WithDirection) rotateBackXyz(op, c, sn, dir, &rotateBack);
+                if constexpr (WithPoint) rotateBack(op, c, sn, p);
+                if constexpr (WithDirection) rotateBack(op, c, sn, dir);
                 break;
             }
             case OpKind::Component: {
@@ -510,7 +484,7 @@ Vec3 KinematicsModel::workpiecePointToBase(KinematicsData& d, const AxisVector& 
             case OpKind::Rotary: {
                 double c, sn;
                 trigOf(d, op, q[op.axis], c, sn);
-                rotateBackXyz(op, c, -sn, r, &rotateBack);  // Rot(θ) = Rot(−θ)ᵀ
+                rotateBack(op, c, -sn, r);  // Rot(θ) = Rot(−θ)ᵀ
                 break;
             }
             case OpKind::Component: {

@@ -27,6 +27,7 @@
 
 #include "cnccomp/deviations.hpp"
 #include "cnccomp/machine.hpp"
+#include "cnccomp/xyz.hpp"
 
 namespace cnccomp {
 
@@ -219,8 +220,8 @@ private:
     void trigOf(KinematicsData& d, const Op& op, double angle, double& c, double& s) const;
     /// std::cos and std::sin (as Eigen's AngleAxis) through the workspace's table of the last angles.
     void exactTrig(KinematicsData& d, const Op& op, double angle, double& c, double& s) const;
-    /// v ← Rot(op's direction, θ)ᵀ v, given c = cos θ and s = sin θ.
-    static void rotateBack(const Op& op, double c, double s, Vec3& v);
+    /// v ← Rot(op's direction, θ)ᵀ v, given c = cos θ and s = sin θ (a point or direction of a walk, xyz.hpp).
+    static void rotateBack(const Op& op, double c, double s, xyz::Xyz& v);
     /// A base-frame point (WithPoint) and direction into the workpiece frame at q, the workpiece chain's operations
     /// inverted one by one (no frame built).
     template <bool WithPoint, bool WithDirection = true>
