@@ -1,12 +1,21 @@
 #include "postproc/correction.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 
 namespace cnccomp::postproc {
 
 namespace {
+
+/// 2√k for k rotary axes, the same values as computed in place (std::sqrt rounds correctly): read from a table, the
+/// square root's latency stood on the path of dampingFor's comparison.
+const std::array<double, kMaxAxes + 1> kTwoRootOf = [] {
+    std::array<double, kMaxAxes + 1> a{};
+    for (int k = 0; k <= kMaxAxes; ++k) a[k] = 2.0 * std::sqrt(double(k));
+    return a;
+}();
 
 /// out = a + t (b − a) element by element (as the Eigen expression; a loop, which Eigen's runtime-size assignment is not
 /// inlined as).
@@ -322,7 +331,7 @@ void Corrector::dampingFor(const AxisVector& cNom, double toolLength, AxisMask f
         int k = 0;
         for (int i = 0; i < n; ++i)
             if (axes & (1u << i)) moved += std::fabs(cache_.sigmaQ[i] - (cNom[i] + zero_[i])), ++k;
-        if (cache_.sigma >= s0 + 2.0 * std::sqrt(double(k)) * moved + 0.01) return;
+        if (cache_.sigma >= s0 + kTwoRootOf[k] * moved + 0.01) return;
     }
     // The nominal machine's at the target, exactly: the one singular-pose policy (pose_solver.hpp), D = λ² Σ φ(σᵢ) vᵢ vᵢᵀ,
     // φ(σ) = (1 − σ/σ0)² below σ0 and 0 above, λ² = rotaryDamping² + continuity², so that damping and continuity act

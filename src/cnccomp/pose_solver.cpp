@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -39,9 +40,84 @@ void gainStep(const GainMatrix& gain, const Eigen::Matrix<double, 6, 1>& r, uint
     }
 }
 
+/// Σ p[0 … K) as Eigen's unrolled reduction without packets sums it (redux_novec_unroller: the two halves, each summed
+/// the same way).
+template <int K>
+inline double halvesSum(const double* p) {
+    if constexpr (K == 1) return p[0];
+    else return halvesSum<K / 2>(p) + halvesSum<K - K / 2>(p + K / 2);
+}
+
+/// The two lanes of the sum of P packets p[2i], p[2i + 1] (by halves).
+template <int P>
+inline void packetLanes(const double* p, double* lanes) {
+    if constexpr (P == 1) {
+        lanes[0] = p[0];
+        lanes[1] = p[1];
+    } else {
+        double a[2], b[2];
+        packetLanes<P / 2>(p, a);
+        packetLanes<P - P / 2>(p + 2 * (P / 2), b);
+        lanes[0] = a[0] + b[0];
+        lanes[1] = a[1] + b[1];
+    }
+}
+
+/// Σ p[0 … K) as Eigen's unrolled reduction with SSE2 packets of two sums it (redux_vec_unroller, then predux and the
+/// odd last term): the packets summed by halves lane by lane, the two lanes added, then p[K − 1] when K is odd.
+template <int K>
+inline double packetSum(const double* p) {
+    if constexpr (K == 1) {
+        return p[0];
+    } else {
+        double lanes[2];
+        packetLanes<K / 2>(p, lanes);
+        const double s = lanes[0] + lanes[1];
+        if constexpr (K % 2 == 1) return s + p[K - 1];
+        else return s;
+    }
+}
+
+/// Column c of A⁻¹ = L⁻ᵀ L⁻¹ e_c from the Cholesky factor (lower triangle of `llt`, column-major), with the arithmetic
+/// of Eigen::LLT<Matrix<double, N, N>>::solveInPlace on e_c, operation for operation (to the bit: test
+/// PoseSolver.InverseColumnsAreEigensToTheBit), written out so that the values stay in registers: Eigen's unrolled
+/// solve stores each xᵢ alone and reads the next sum's two at once (a load the processor cannot forward from two
+/// smaller stores: it waits for them; most of the factorisation's time). Forward, L y = e_c: yᵢ = (e_c,ᵢ − Σⱼ Lᵢⱼ yⱼ) /
+/// Lᵢᵢ, the row's sum without packets (a row is strided); yᵢ = +0 above c, as Eigen's 0 − (±0) / Lᵢᵢ gives, so its
+/// divisions are skipped there. Backward, Lᵀ x = y: xᵢ = (yᵢ − Σⱼ Lⱼᵢ xⱼ) / Lᵢᵢ, the column's sum with packets.
+template <int N>
+inline void inverseColumn(const double* L, int c, double* x) {
+    auto l = [L](int i, int j) { return L[i + N * j]; };
+    for (int i = 0; i < N; ++i) x[i] = 0.0;
+    x[c] = 1.0;
+    [&]<int... I>(std::integer_sequence<int, I...>) {
+        auto forward = [&]<int Row>(std::integral_constant<int, Row>) {
+            if (Row < c) return;  // +0
+            if constexpr (Row > 0) {
+                double p[Row];
+                for (int j = 0; j < Row; ++j) p[j] = l(Row, j) * x[j];
+                x[Row] -= halvesSum<Row>(p);
+            }
+            x[Row] /= l(Row, Row);
+        };
+        (forward(std::integral_constant<int, I>{}), ...);
+        auto backward = [&]<int Row>(std::integral_constant<int, Row>) {
+            constexpr int K = N - 1 - Row;
+            if constexpr (K > 0) {
+                double p[K];
+                for (int j = 0; j < K; ++j) p[j] = l(Row + 1 + j, Row) * x[Row + 1 + j];
+                x[Row] -= packetSum<K>(p);
+            }
+            x[Row] /= l(Row, Row);
+        };
+        (backward(std::integral_constant<int, N - 1 - I>{}), ...);
+    }(std::make_integer_sequence<int, N>{});
+}
+
 /// A⁻¹ of the symmetric positive definite A by Cholesky (Eigen::LLT), column by column (Eigen's solve with a matrix
-/// right-hand side takes its blocked GEMM path, several times the instructions at these sizes). False when A is not
-/// positive definite or the inverse is not finite.
+/// right-hand side takes its blocked GEMM path, several times the instructions at these sizes; for a fixed N the
+/// columns are solved by inverseColumn, Eigen's arithmetic written out). False when A is not positive definite or the
+/// inverse is not finite.
 template <int N>
 bool invertFixed(const SmallMatrix& A, SmallMatrix& inverse) {
     using M = Eigen::Matrix<double, N, N, 0, N == Eigen::Dynamic ? kMaxAxes : N, N == Eigen::Dynamic ? kMaxAxes : N>;
@@ -50,12 +126,21 @@ bool invertFixed(const SmallMatrix& A, SmallMatrix& inverse) {
     const M a = A;
     const Eigen::LLT<M> llt(a);
     if (llt.info() != Eigen::Success) return false;
-    V e = V::Zero(n);
-    for (int c = 0; c < n; ++c) {
-        e.setZero();
-        e[c] = 1.0;
-        llt.solveInPlace(e);
-        inverse.col(c) = e;
+    if constexpr (N != Eigen::Dynamic) {
+        const double* L = llt.matrixLLT().data();
+        for (int c = 0; c < N; ++c) {
+            double x[N];
+            inverseColumn<N>(L, c, x);
+            for (int i = 0; i < N; ++i) inverse(i, c) = x[i];
+        }
+    } else {
+        V e = V::Zero(n);
+        for (int c = 0; c < n; ++c) {
+            e.setZero();
+            e[c] = 1.0;
+            llt.solveInPlace(e);
+            inverse.col(c) = e;
+        }
     }
     return allFinite(inverse);
 }

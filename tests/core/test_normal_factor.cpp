@@ -1,12 +1,17 @@
 // The factorised normal matrix of the damped Gauss–Newton step (DampedNormalFactor, pose_solver.hpp): its inverse and
 // gain against an independent solve (Eigen's full-pivoting LU of the same A = JᵀJ + D with identity rows and columns
 // for fixed axes, written out from its definition), for every axis count the solvers meet (the fixed sizes 3–6 and
-// the generic 1, 2, 7–9), with and without damping and fixed axes; and the refusal of a matrix that is not positive
+// the generic 1, 2, 7–9), with and without damping and fixed axes; for the fixed sizes, the inverse bit for bit against
+// Eigen's own LLT solve (the columns are its arithmetic written out); and the refusal of a matrix that is not positive
 // definite (no step rather than a wrong one).
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <random>
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
 #include "cnccomp/pose_solver.hpp"
@@ -63,6 +68,48 @@ TEST(NormalFactor, InverseAndGainAgreeWithAnLuSolveForEveryAxisCount) {
             ++checked;
         }
     EXPECT_EQ(checked, 4 * kMaxAxes);
+}
+
+/// For the fixed sizes the inverse's columns are Eigen::LLT's solveInPlace on the unit vectors written out (registers
+/// instead of Eigen's stores and reloads); the bits must stay Eigen's: random positive definite matrices of mixed
+/// magnitudes (condition numbers up to ~1e12) against Eigen's own fixed-size LLT, every entry compared bit for bit.
+TEST(NormalFactor, FixedSizeInverseIsEigensLltSolveToTheBit) {
+    std::mt19937_64 rng(20261128);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::uniform_int_distribution<int> e(-3, 3);
+    auto check = [&]<int N>(std::integral_constant<int, N>) {
+        int differ = 0;
+        for (int k = 0; k < 20000; ++k) {
+            PoseJacobian J(6, N);
+            for (int r = 0; r < 6; ++r)
+                for (int c = 0; c < N; ++c) J(r, c) = std::ldexp(u(rng), 3 * e(rng));
+            SmallMatrix JtJ;
+            normalMatrix(J, JtJ);
+            SmallMatrix B(N, N);
+            for (int i = 0; i < N; ++i)
+                for (int j = 0; j < N; ++j) B(i, j) = u(rng);
+            const SmallMatrix D = B * B.transpose();  // N > 6 rows would need it; here it varies the matrices
+            const bool damped = k % 2 == 1;
+            DampedNormalFactor f;
+            if (!f.factor(J, JtJ, damped ? &D : nullptr, (1u << N) - 1u, 1e-12)) continue;
+            Eigen::Matrix<double, N, N> A = JtJ;
+            if (damped) A += D;
+            for (int i = 0; i < N; ++i) A(i, i) += 1e-12 * (1.0 + A(i, i));
+            const Eigen::LLT<Eigen::Matrix<double, N, N>> llt(A);
+            for (int c = 0; c < N; ++c) {
+                Eigen::Matrix<double, N, 1> x = Eigen::Matrix<double, N, 1>::Zero();
+                x[c] = 1.0;
+                llt.solveInPlace(x);
+                for (int i = 0; i < N; ++i)
+                    differ += std::bit_cast<uint64_t>(x[i]) != std::bit_cast<uint64_t>(f.inverse(i, c));
+            }
+        }
+        EXPECT_EQ(differ, 0) << "N " << N;
+    };
+    check(std::integral_constant<int, 3>{});
+    check(std::integral_constant<int, 4>{});
+    check(std::integral_constant<int, 5>{});
+    check(std::integral_constant<int, 6>{});
 }
 
 TEST(NormalFactor, RefusesAMatrixThatIsNotPositiveDefinite) {
