@@ -80,11 +80,11 @@ inline double packetSum(const double* p) {
 
 /// Column c of A⁻¹ = L⁻ᵀ L⁻¹ e_c from the Cholesky factor (lower triangle of `llt`, column-major), with the arithmetic
 /// of Eigen::LLT<Matrix<double, N, N>>::solveInPlace on e_c, operation for operation (to the bit: test
-/// PoseSolver.InverseColumnsAreEigensToTheBit), written out so that the values stay in registers: Eigen's unrolled
-/// solve stores each xᵢ alone and reads the next sum's two at once (a load the processor cannot forward from two
-/// smaller stores: it waits for them; most of the factorisation's time). Forward, L y = e_c: yᵢ = (e_c,ᵢ − Σⱼ Lᵢⱼ yⱼ) /
-/// Lᵢᵢ, the row's sum without packets (a row is strided); yᵢ = +0 above c, as Eigen's 0 − (±0) / Lᵢᵢ gives, so its
-/// divisions are skipped there. Backward, Lᵀ x = y: xᵢ = (yᵢ − Σⱼ Lⱼᵢ xⱼ) / Lᵢᵢ, the column's sum with packets.
+/// NormalFactor.FixedSizeInverseIsEigensLltSolveToTheBit), written out so that the values stay in registers: Eigen's
+/// unrolled solve stores each xᵢ alone and reads the next sum's two at once (a load the processor cannot forward from
+/// two smaller stores: it waits for them; most of the factorisation's time). Forward, L y = e_c: yᵢ = (e_c,ᵢ − Σⱼ Lᵢⱼ
+/// yⱼ) / Lᵢᵢ, the row's sum without packets (a row is strided); yᵢ = +0 above c, as Eigen's 0 − (±0) / Lᵢᵢ gives, so
+/// its divisions are skipped there. Backward, Lᵀ x = y: xᵢ = (yᵢ − Σⱼ Lⱼᵢ xⱼ) / Lᵢᵢ, the column's sum with packets.
 template <int N>
 inline void inverseColumn(const double* L, int c, double* x) {
     auto l = [L](int i, int j) { return L[i + N * j]; };
