@@ -137,7 +137,7 @@ struct RunResult {
 /// `sample <program file>` / `setp <pin or parameter> <value>`, see driver.py) and returns the records. Throws std::runtime_error with the end of
 /// LinuxCNC's log when the run fails; a run that LinuxCNC aborted with "Queue is not empty after probing" (an upstream
 /// race after probe moves, see run()) or with "Probe is already tripped when starting G38.2" (its stale DONE before a
-/// probe move, postproc/testprog/probe_program.hpp) starts again, at most 6 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
+/// probe move, postproc/testprog/probe_program.hpp) starts again, at most 12 times in all (RunResult::retries). With the environment variable CNCCOMP_LINUXCNC_KEEP=<folder> the run's folder
 /// (INI, HAL, job, log) is copied there.
 /// `suspect`, when given, is asked after a run that succeeded: a non-empty answer (why) marks the run as hit by that race
 /// all the same (its silent form: the read-ahead passes the queue test with the stale status and the LOG line after the
