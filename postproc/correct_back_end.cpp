@@ -80,6 +80,7 @@ void ProgramCorrector::updateOutputAfterPassThrough() {
 }
 
 void ProgramCorrector::passThrough(const Line& ln, uint64_t no) {
+    lastEnd_.valid = false;
     ++summary_.passedThrough;
     if (!r_->report) ++summary_.notCorrected;
     edits_.clear();
@@ -249,7 +250,17 @@ bool ProgramCorrector::findPieces(const Record& rec, ProgramPoint qEnd, MovePiec
         path.v1 = nomEnd.v;
         const bool measurable = nomStartKnown && outStartKnown && !identity;
         const bool subdivide = measurable && !isRapid && !r_->stop;
-        if (measurable && !isRapid) corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
+        const MidpointBound& bound = corrector_.midpointBound();
+        p.endBounded = bound.usable() && rec.corrected && space.mode == ProgramMode::TcpAngles;
+        if (p.endBounded)
+            p.endBound = bound.endBound(rec.tipResidual, rec.cEnd, space.toolLength, options_.corrector.solveTolerance);
+        if (measurable && !isRapid) {
+            if (p.endBounded) {
+                ctx.midpointBound = midpointBound(rec, ctx, qEnd, p.endBound);
+                ctx.measured = summary_.maxPathDeviation;
+            }
+            corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
+        }
         else pieces_.push_back({1.0, qEnd});
     }
     countPath(stats, summary_, options_.report, no);
@@ -257,6 +268,20 @@ bool ProgramCorrector::findPieces(const Record& rec, ProgramPoint qEnd, MovePiec
     if (pieces_.size() > 1 && inverseTime && r_->feedWord < 0)
         notice(true, no, "inverse-time move without F split: the pieces carry no feed");
     return true;
+}
+
+double ProgramCorrector::midpointBound(const Record& rec, const PathContext& ctx, const ProgramPoint& qEnd,
+                                       double endBound) const {
+    // The bound's premises (midpoint_bound.hpp): the move starts where the last corrected one ended (the same
+    // nominal point, the output's digits of its corrected end, no offset to blend out) in the same space.
+    const MoveSpace& s = rec.space;
+    if (!lastEnd_.valid || offCourse_ || lastEnd_.space.mode != s.mode || lastEnd_.space.toolLength != s.toolLength ||
+        lastEnd_.space.controlLength != s.controlLength)
+        return HUGE_VAL;
+    for (int a = 0; a < layout_.count; ++a)
+        if (!(r_->start[a] == lastEnd_.nominal[a])) return HUGE_VAL;
+    return corrector_.midpointBound().midpoint(s.toolLength, s.controlLength, ctx.outStart.p, qEnd.p, r_->start,
+                                               r_->end, lastEnd_.corrected, lastEnd_.bound, endBound);
 }
 
 void ProgramCorrector::writeMove(const Record& rec, const Line& ln, const MovePieces& p) {
@@ -402,6 +427,13 @@ void ProgramCorrector::writeMove(const Record& rec, const Line& ln, const MovePi
                  pieces_.back().q.v, vector};
     if (!vector) outVectorKnown_ = false;
     offCourse_ = false;
+    lastEnd_.valid = p.endBounded && !isArc;
+    if (lastEnd_.valid) {
+        lastEnd_.space = space;
+        lastEnd_.corrected = pieces_.back().q.p;
+        lastEnd_.nominal = r_->end;
+        lastEnd_.bound = p.endBound;
+    }
 }
 
 void ProgramCorrector::overlong(const Record& rec) {
@@ -440,6 +472,7 @@ void ProgramCorrector::line(Record& rec) {
         notice(true, no, "lines end with a lone CR (classic Mac OS line ends): read as line ends and kept");
     }
     if (ln.partial) {
+        lastEnd_.valid = false;
         out_.write(ln.text);
         out_.write(ln.eol);
         if (ln.lastPiece) overlong(rec);
@@ -456,6 +489,7 @@ void ProgramCorrector::line(Record& rec) {
             if (fresh & (1u << a)) outPos_[a] = r_->start[a];
         outKnown_ |= fresh;
     }
+    if (r_->kind != BlockKind::Move && r_->kind != BlockKind::Empty) lastEnd_.valid = false;
     switch (r_->kind) {
         case BlockKind::Empty:
             out_.write(ln.text);

@@ -68,7 +68,19 @@ private:
         bool arcKept = false, arcToLines = false;
         ArcFit fit;
         AxisVector outStart;  ///< the output's position at the start of the move
+        bool endBounded = false;  ///< a corrected straight TCP-angles move: the next may bound its midpoint from here
+        double endBound = 0;      ///< mm: MidpointBound::endBound of this move's end
     };
+    /// The last move's end as the midpoint bound of the next move needs it (postproc/midpoint_bound.hpp): valid after a
+    /// corrected straight TCP-angles move written as corrected, until any block other than a move or an empty one.
+    struct BoundedEnd {
+        bool valid = false;
+        MoveSpace space;
+        AxisVector corrected, nominal;  ///< program space: the unrounded corrected end, the nominal end
+        double bound = 0;               ///< mm: MidpointBound::endBound
+    };
+    /// The midpoint bound of the current straight move (HUGE_VAL where the bound does not apply).
+    double midpointBound(const Record& rec, const PathContext& ctx, const ProgramPoint& qEnd, double endBound) const;
     /// A move: the summary's counts, then its pieces (findPieces), then its words (writeMove).
     void move(Record& rec);
     /// The pieces of the move ending at the corrected program position `qEnd`: the arc kept (refitted), the arc as
@@ -127,6 +139,7 @@ private:
     bool outVectorKnown_ = false;
     Where outAt_;
     bool offCourse_ = true;      ///< the output's position is not the corrected nominal one (start, after pass-through)
+    BoundedEnd lastEnd_;
     Motion outMotion_ = Motion::Unknown;
     std::vector<Piece> pieces_;
     int linearCount_ = 0, rotaryCount_ = 0;

@@ -75,6 +75,7 @@ void blendStartOffset(Corrector& corrector, const ProgramPoint& nomStart, double
 
 void countPath(const SplitStats& stats, CorrectSummary& summary, std::ostream* report, uint64_t line) {
     summary.maxPathDeviation = std::max(summary.maxPathDeviation, stats.maxDeviation);
+    if (stats.bounded) ++summary.boundedChecks;
     if (!stats.limited) return;
     ++summary.limited;
     addNotice(summary, report, true, line,

@@ -63,6 +63,7 @@ struct CorrectSummary {
     double maxTipResidual = 0;      ///< mm: solver residual at endpoints
     double maxAxisResidual = 0;     ///< rad: tool-axis residual at endpoints (non-zero only near singular poses)
     double maxPathDeviation = 0;    ///< mm: at the checked midpoints / arc samples
+    uint64_t boundedChecks = 0;     ///< midpoint checks settled by the midpoint bound, not evaluated (not printed)
     uint64_t unconverged = 0;
     uint64_t limited = 0;           ///< moves where the subdivision limit left the tolerance unmet
     uint64_t tcpMoves = 0;          ///< moves corrected in tool-tip (TCP) mode

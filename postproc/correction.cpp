@@ -99,6 +99,7 @@ Corrector::Corrector(const MachineModel& machine, const DeviationSet& deviations
         if (machine.axisLink(i).kind == AxisKind::Rotary) rotary_ |= 1u << i;
     zero_ = machine.fromController(AxisVector::Zero(machine.axisCount()));
     zeroIsZero_ = (zero_.array() == 0.0).all();
+    if (!identity_ && options_.boundChecks) bound_ = MidpointBound(nominal_, actual_, tcp_, affine_);
 }
 
 Vec3 Corrector::actualTip(const AxisVector& c, double toolLength) {
@@ -525,6 +526,13 @@ void Corrector::split(const MovePath& path, const PathContext& ctx, const Progra
                       std::vector<Piece>& pieces, SplitStats& stats) {
     if (identity_) {
         pieces.push_back({1.0, end});
+        return;
+    }
+    if (ctx.midpointBound < ctx.tolerance && ctx.midpointBound < ctx.measured) {
+        // The midpoint's deviation is at most the bound: the check would keep the move whole and leave the largest
+        // deviation reported as it is. Not evaluated.
+        pieces.push_back({1.0, end});
+        stats.bounded = true;
         return;
     }
     if (affine_ && !path.circular && !path.vector) {

@@ -7,10 +7,12 @@
 // (mm, rad) after work offsets — its machine coordinates (joint mode), or in TCP mode the world point of the tool and
 // the rotary angles / tool vector (postproc/tcp_model.hpp). Machine coordinates are the controller's: the model's
 // commands are machine coordinates + machine-zero (MachineModel::fromController), converted here where they meet it.
+#include <cmath>
 #include <vector>
 
 #include "cnccomp/kinematics_engine.hpp"
 #include "cnccomp/pose_solver.hpp"
+#include "postproc/midpoint_bound.hpp"
 #include "postproc/modal.hpp"
 #include "postproc/tcp_model.hpp"
 
@@ -35,6 +37,8 @@ struct CorrectorOptions {
     int maxIterations = 30;
     int maxDepth = 14;             ///< subdivision levels per move
     int maxPieces = 16384;         ///< pieces per move
+    bool boundChecks = true;       ///< leave out a midpoint check whose result the midpoint bound settles (it changes
+                                   ///< nothing written or reported: postproc/midpoint_bound.hpp)
 };
 
 /// The nominal machine's tool point at `length` along the tool and its tool axis (spindle → tip), workpiece frame.
@@ -91,6 +95,7 @@ struct SplitStats {
     double maxDeviation = 0.0;  ///< mm: largest tip deviation left at a checked midpoint
     int solves = 0;
     bool limited = false;       ///< depth or piece limit reached with the tolerance not met
+    bool bounded = false;       ///< the midpoint check was settled by PathContext::midpointBound (not evaluated)
 };
 
 struct ArcFit {
@@ -109,6 +114,10 @@ struct PathContext {
     Vec3 startOffset = Vec3::Zero();
     double tolerance = 1e-3;
     AxisVector guess;  ///< machine coordinates near the move (start of the inverse TCP kinematics in vector mode)
+    /// mm: a proven bound of the deviation at the move's midpoint (MidpointBound; HUGE_VAL: none), and the largest
+    /// deviation already measured: a bound below both and below the tolerance settles the first midpoint check.
+    double midpointBound = HUGE_VAL;
+    double measured = 0.0;
 };
 
 class Corrector {
@@ -121,6 +130,8 @@ public:
     const KinematicsModel& nominal() const { return nominal_; }
     const KinematicsModel& actual() const { return actual_; }
     const TcpModel& tcp() const { return tcp_; }
+    /// The midpoint bound of this machine and deviation set (usable() false outside its class).
+    const MidpointBound& midpointBound() const { return bound_; }
 
     /// Machine coordinates of a program position (nominal controller). false when the TCP inverse fails. `pose`
     /// (optional): the nominal tool point and axis there, when the inverse gives them on the way (TCP angles mode).
@@ -239,6 +250,7 @@ private:
     KinematicsData nominalData_, actualData_;  ///< the workspaces of nominal_ (shared with tcp_) and actual_
     TcpModel tcp_;
     CorrectorOptions options_;
+    MidpointBound bound_;
     AxisVector zero_;      ///< model commands of the controller's machine zero (machine-zero per axis)
     bool zeroIsZero_ = true;  ///< zero_ is 0 on every axis: model commands are the machine coordinates
     /// Model commands of machine coordinates c: c + zero_ (in `scratch`), or c itself when zero_ is 0.

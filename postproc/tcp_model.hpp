@@ -43,6 +43,9 @@ public:
     Vec3 axisFromWorld(const Vec3& axisWorld) const { return R0_.transpose() * axisWorld; }
     Vec3 pointFromWorld(const Vec3& pWorld) const { return R0_.transpose() * (pWorld - t0_); }
     int linearAxis(int k) const { return lin_[k]; }
+    /// The slides move along fixed bed directions: the inverse is exact (one linear solve with slidesInverse()).
+    bool fixedSlides() const { return fixedSlides_; }
+    const Mat3& slidesInverse() const { return slidesInverse_; }
     const int* linearAxes() const { return lin_; }
 
 private:
