@@ -256,8 +256,8 @@ bool ProgramCorrector::findPieces(const Record& rec, ProgramPoint qEnd, MovePiec
             p.endBound = bound.endBound(rec.tipResidual, rec.cEnd, space.toolLength, options_.corrector.solveTolerance);
         if (measurable && !isRapid) {
             if (p.endBounded) {
-                ctx.midpointBound = midpointBound(rec, ctx, qEnd, p.endBound);
-                ctx.measured = summary_.maxPathDeviation;
+                ctx.midpointBound = currentMidpointBound(rec, ctx, qEnd, p.endBound);
+                ctx.largestMeasured = summary_.maxPathDeviation;
             }
             corrector_.split(path, ctx, qEnd, subdivide, pieces_, stats);
         }
@@ -270,8 +270,8 @@ bool ProgramCorrector::findPieces(const Record& rec, ProgramPoint qEnd, MovePiec
     return true;
 }
 
-double ProgramCorrector::midpointBound(const Record& rec, const PathContext& ctx, const ProgramPoint& qEnd,
-                                       double endBound) const {
+double ProgramCorrector::currentMidpointBound(const Record& rec, const PathContext& ctx, const ProgramPoint& qEnd,
+                                              double endBound) const {
     // The bound's premises (midpoint_bound.hpp): the move starts where the last corrected one ended (the same
     // nominal point, the output's digits of its corrected end, no offset to blend out) in the same space.
     const MoveSpace& s = rec.space;

@@ -80,7 +80,8 @@ private:
         double bound = 0;               ///< mm: MidpointBound::endBound
     };
     /// The midpoint bound of the current straight move (HUGE_VAL where the bound does not apply).
-    double midpointBound(const Record& rec, const PathContext& ctx, const ProgramPoint& qEnd, double endBound) const;
+    double currentMidpointBound(const Record& rec, const PathContext& ctx, const ProgramPoint& qEnd,
+                                double endBound) const;
     /// A move: the summary's counts, then its pieces (findPieces), then its words (writeMove).
     void move(Record& rec);
     /// The pieces of the move ending at the corrected program position `qEnd`: the arc kept (refitted), the arc as

@@ -528,7 +528,7 @@ void Corrector::split(const MovePath& path, const PathContext& ctx, const Progra
         pieces.push_back({1.0, end});
         return;
     }
-    if (ctx.midpointBound < ctx.tolerance && ctx.midpointBound < ctx.measured) {
+    if (ctx.midpointBound < ctx.tolerance && ctx.midpointBound < ctx.largestMeasured) {
         // The midpoint's deviation is at most the bound: the check would keep the move whole and leave the largest
         // deviation reported as it is. Not evaluated.
         pieces.push_back({1.0, end});

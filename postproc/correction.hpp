@@ -117,7 +117,7 @@ struct PathContext {
     /// mm: a proven bound of the deviation at the move's midpoint (MidpointBound; HUGE_VAL: none), and the largest
     /// deviation already measured: a bound below both and below the tolerance settles the first midpoint check.
     double midpointBound = HUGE_VAL;
-    double measured = 0.0;
+    double largestMeasured = 0.0;
 };
 
 class Corrector {

@@ -170,7 +170,8 @@ void MidpointBound::parts(double toolLength, double controlLength, const AxisVec
     curvature = (epsR_ * (4 * om2 * P + 4 * om * v) + 4 * om2 * tau_ + k_ * (4 * om2 * (P + cw_) + 4 * om * v) +
                  om2 * wn + dl * (epsR_ * om2 + omBar * omBar * std::max(d0, d1) + 2 * omBar * dd)) /
                 8;
-    const double lever = 2 * epsR_ * P0 + 2 * tau_ + 2 * k_ * (P0 + cw_) + (w + (toolLength - controlLength) * u_).norm();
+    const double v0 = (w + (toolLength - controlLength) * u_).norm();
+    const double lever = 2 * epsR_ * P0 + 2 * tau_ + 2 * k_ * (P0 + cw_) + v0;
     start = (1 + k_) * (s - pe).norm() + turn * lever;
 }
 

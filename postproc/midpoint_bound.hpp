@@ -11,7 +11,9 @@
 // The proof (d = the deviation vector along the move, t ∈ [0, 1], both ends' program points interpolated linearly):
 //   |d(½)| ≤ |d(0) + d(1)| / 2 + max|d''| / 8                                   (Taylor, integral remainder)
 // - The chain from the base to the workpiece as a product of exponentials, W(θ) = Πᵢ exp(ξᵢθᵢ) · W(0) (joint lines
-//   at θ = 0), written as constants between rotations about fixed unit axes; the erroneous chain is the same with
+//   at θ = 0; Murray, Li, Sastry, "A Mathematical Introduction to Robotic Manipulation", 1994, §3.2), with rotation
+//   R(θ) and translation t(θ) = Σᵢ (rotations before constant i) cᵢ, written as constants between rotations about
+//   fixed unit axes; the erroneous chain is the same with
 //   other constants (an axis tilted by φ: a constant turn Q, ‖Q − I‖ = |ω̃ − ω|, on either side of the rotation).
 //   εR = Σ ‖R̃ᵢ − Rᵢ‖, εt = Σ |c̃ᵢ − cᵢ|, CW = Σ |cᵢ| over the constants (rotation, translation).
 // - With R(θ) a product of rotations, each angle moving at rate Δθₖ: |R⁽ᵐ⁾| ≤ ωᵐ, ω = Σₖ |Δθₖ|, and
@@ -20,7 +22,8 @@
 // - Then d(t) = (R̂ − I) p + t̂ + (p − pₙ) + R̃ᵀK(R p + t) + R̃ᵀ w + (L − Lc)[R̃ᵀ(θc) − Rᵀ(θn)] u with R̂ = R̃ᵀR,
 //   t̂ = R̃ᵀ(t − t̃), w = (T̃0 − T0) − K (T0 + Lc u) + L (ũ − u), p the workpiece point of the corrected interpolation
 //   (θc its angles), pₙ and θn the nominal path's. Term by term (τ = εR CW + εt, P = max |p|, v = |Δp|,
-//   ω̄ = max(ω, ωn), δ the rotary corrections θc − θn at the ends, Δδ their change):
+//   ω, ωn the rotary steps of the corrected and the nominal move, ω̄ = max(ω, ωn), δ the rotary corrections θc − θn
+//   at the ends, Δδ their change):
 //   |d''| ≤ εR (4ω²P + 4ωv) + 4ω²τ + |K| (4ω²(P + CW) + 4ωv) + ω²|w| + |L − Lc| (εR ω² + ω̄² max|δ|₁ + 2ω̄ |Δδ|₁).
 // - d(1): the end solve's tip residual before its last step, plus that step's effect (≤ solveTolerance per slide,
 //   solveTolerance / 100 per rotary axis, times the slides' and the rotary axes' levers).
@@ -39,7 +42,8 @@ public:
     MidpointBound() = default;
     /// The bound of one machine: `nominal` and `actual` its nominal and erroneous models, `tcp` the controller's TCP
     /// kinematics on `nominal`, `locationOnly` the deviation set has no component error.
-    MidpointBound(const KinematicsModel& nominal, const KinematicsModel& actual, const TcpModel& tcp, bool locationOnly);
+    MidpointBound(const KinematicsModel& nominal, const KinematicsModel& actual, const TcpModel& tcp,
+                  bool locationOnly);
 
     /// The machine and its deviation set are in the class (see the file comment).
     bool usable() const { return usable_; }

@@ -216,7 +216,8 @@ TEST(MidpointBound, ChangesNoByteOfTheImpellerDemo) {
         EXPECT_GT(s.boundedChecks, s.moves * 8 / 10);
     }
     // Twenty times the deviations: more splits, still the same bytes.
-    const CorrectSummary big = sameWithAndWithout(program, m, randomLocationErrors(m, rng, 0.2, 200 * kArcsec), 30.0, 1);
+    const DeviationSet large = randomLocationErrors(m, rng, 0.2, 200 * kArcsec);
+    const CorrectSummary big = sameWithAndWithout(program, m, large, 30.0, 1);
     EXPECT_GT(big.split, 0u);
 }
 
@@ -243,7 +244,8 @@ TEST(MidpointBound, ChangesNoByteOfARandomProgramWithLongRotaryMoves) {
         const DeviationSet d = randomLocationErrors(m, rng, 0.01 * scale, 10 * kArcsec * scale);
         CorrectSummary s;
         for (const int threads : {1, 2}) s = sameWithAndWithout(program, m, d, 50.0, threads);
-        std::printf("[midpoint bound] random program (deviations x%g): %llu of %llu checks settled, %llu split\n", scale,
+        std::printf("[midpoint bound] random program (deviations x%g): %llu of %llu checks settled, %llu split\n",
+                    scale,
                     static_cast<unsigned long long>(s.boundedChecks), static_cast<unsigned long long>(s.moves),
                     static_cast<unsigned long long>(s.split));
         EXPECT_GT(s.boundedChecks, 0u);
