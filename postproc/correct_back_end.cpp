@@ -427,7 +427,7 @@ void ProgramCorrector::writeMove(const Record& rec, const Line& ln, const MovePi
                  pieces_.back().q.v, vector};
     if (!vector) outVectorKnown_ = false;
     offCourse_ = false;
-    lastEnd_.valid = p.endBounded && !isArc;
+    lastEnd_.valid = p.endBounded;  // set for straight moves only (findPieces)
     if (lastEnd_.valid) {
         lastEnd_.space = space;
         lastEnd_.corrected = pieces_.back().q.p;

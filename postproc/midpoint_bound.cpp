@@ -49,7 +49,6 @@ struct Exponentials {
     }
 };
 
-
 }  // namespace
 
 MidpointBound::MidpointBound(const KinematicsModel& nominal, const KinematicsModel& actual, const TcpModel& tcp,

@@ -13,8 +13,8 @@
 // - The chain from the base to the workpiece as a product of exponentials, W(θ) = Πᵢ exp(ξᵢθᵢ) · W(0) (joint lines
 //   at θ = 0; Murray, Li, Sastry, "A Mathematical Introduction to Robotic Manipulation", 1994, §3.2), with rotation
 //   R(θ) and translation t(θ) = Σᵢ (rotations before constant i) cᵢ, written as constants between rotations about
-//   fixed unit axes; the erroneous chain is the same with
-//   other constants (an axis tilted by φ: a constant turn Q, ‖Q − I‖ = |ω̃ − ω|, on either side of the rotation).
+//   fixed unit axes; the erroneous chain is the same with other constants (an axis tilted by φ: a constant turn Q,
+//   ‖Q − I‖ = |ω̃ − ω|, on either side of the rotation).
 //   εR = Σ ‖R̃ᵢ − Rᵢ‖, εt = Σ |c̃ᵢ − cᵢ|, CW = Σ |cᵢ| over the constants (rotation, translation).
 // - With R(θ) a product of rotations, each angle moving at rate Δθₖ: |R⁽ᵐ⁾| ≤ ωᵐ, ω = Σₖ |Δθₖ|, and
 //   |(R̃ − R)⁽ᵐ⁾| ≤ εR ωᵐ (telescoping, Leibniz). The tool slides: base tool point T0 + S x + L u (erroneous T̃0, S̃,

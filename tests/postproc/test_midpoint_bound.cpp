@@ -67,7 +67,7 @@ void runTrials(const MachineModel& m, const DeviationSet& d, std::mt19937& rng, 
     ASSERT_TRUE(bound.usable()) << m.name;
     const int n = m.axisCount();
     const TcpModel& tcp = corrector.tcp();
-    std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
     const double rotarySteps[] = {0.01 * kDeg, 0.5 * kDeg, 3 * kDeg, 20 * kDeg};
     const double linearSteps[] = {0.01, 0.5, 5.0};
     for (int trial = 0; trial < count; ++trial) {
