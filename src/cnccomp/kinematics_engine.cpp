@@ -96,25 +96,35 @@ void KinematicsModel::rebind(KinematicsData& d) const {
     d.model_ = id_;
     if (exact_) {
         d.angles_.assign(static_cast<size_t>(rotarySlots_), KinematicsData::AngleMemo());
-        d.workpieceFrames_.assign(kFrameMemo, KinematicsData::FrameEntry());
-        d.toolFrames_.assign(kFrameMemo, KinematicsData::FrameEntry());
+        d.workpieceFrames_.entries.assign(kFrameMemo, KinematicsData::FrameEntry());
+        d.toolFrames_.entries.assign(kFrameMemo, KinematicsData::FrameEntry());
+        for (auto [trace, c] : {std::pair{&d.workpieceWalk_, &workpiece_}, std::pair{&d.toolWalk_, &tool_}}) {
+            trace->key.assign(c->ops.size(), 0);
+            trace->before.assign(c->ops.size(), Frame{});
+        }
     }
 }
 
-const Frame& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, std::vector<KinematicsData::FrameEntry>& memo,
-                                        const AxisVector& q) const {
+KinematicsData::FrameEntry& KinematicsModel::memoFrame(KinematicsData& d, const ChainOps& c, KinematicsData::FrameMemo& memo,
+                                                       const AxisVector& q) const {
     static_assert(kFrameMemo == 64);
+    const auto holds = [&](const KinematicsData::FrameEntry& e) {
+        bool hit = e.valid;
+        for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == std::bit_cast<uint64_t>(q[c.axes[k]]);
+        return hit;
+    };
+    if (KinematicsData::FrameEntry& e = memo.entries[memo.last]; holds(e)) return e;
     uint64_t h = 0;
     for (int a : c.axes) h = (h ^ std::bit_cast<uint64_t>(q[a])) * 0x9E3779B97F4A7C15ULL;
-    KinematicsData::FrameEntry& e = memo[static_cast<size_t>(h >> 58)];
-    bool hit = e.valid;
-    for (size_t k = 0; k < c.axes.size() && hit; ++k) hit = e.key[k] == std::bit_cast<uint64_t>(q[c.axes[k]]);
-    if (!hit) {
+    memo.last = static_cast<size_t>(h >> 58);
+    KinematicsData::FrameEntry& e = memo.entries[memo.last];
+    if (!holds(e)) {
         evaluate(d, c, q, e.frame, nullptr);
         for (size_t k = 0; k < c.axes.size(); ++k) e.key[k] = std::bit_cast<uint64_t>(q[c.axes[k]]);
         e.valid = true;
+        e.hasInverse = false;
     }
-    return e.frame;
+    return e;
 }
 
 // Inlined into the Fast path's evaluations (one call per rotary operation and evaluation, about a tenth of correct's
@@ -253,12 +263,26 @@ void KinematicsModel::compile(const Chain& chain, Side side, ChainOps& c, int& s
 }
 
 template <bool Exact, class TrigOf>
-void KinematicsModel::walk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const {
+void KinematicsModel::walk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf,
+                           KinematicsData::WalkTrace* trace) const {
     // Link by link as the model's equations read ([MultiTasking] eq. (7), (10)). Exact: from the identity, every
     // product done, rotations as Eigen's AngleAxis builds them; Fast: a leading constant transform is the frame so far,
     // identity rotations skipped, rotations about a coordinate axis turning two columns.
     auto it = c.ops.begin();
-    if (!Exact && it != c.ops.end() && it->kind == OpKind::Constant) {
+    const auto dependsOnAxis = [](const Op& op) { return op.kind != OpKind::Constant; };
+    if (Exact && trace && trace->valid && !lines) {
+        // Resumed: the frame before the first operation whose axis changed is the one the last walk had there (the
+        // same operations on the same bits before it), so the walk goes on from there with the same arithmetic.
+        it = c.ops.end();
+        for (auto k = c.ops.begin(); k != c.ops.end(); ++k) {
+            const size_t i = static_cast<size_t>(k - c.ops.begin());
+            if (dependsOnAxis(*k) && trace->key[i] != std::bit_cast<uint64_t>(q[k->axis])) {
+                it = k;
+                break;
+            }
+        }
+        f = it == c.ops.end() ? trace->last : trace->before[static_cast<size_t>(it - c.ops.begin())];
+    } else if (!Exact && it != c.ops.end() && it->kind == OpKind::Constant) {
         f.R = it->R;
         f.t = it->t;
         ++it;
@@ -268,6 +292,11 @@ void KinematicsModel::walk(const ChainOps& c, const AxisVector& q, Frame& f, Joi
     }
     for (; it != c.ops.end(); ++it) {
         const Op& op = *it;
+        if (Exact && trace && dependsOnAxis(op)) {
+            const size_t i = static_cast<size_t>(it - c.ops.begin());
+            trace->key[i] = std::bit_cast<uint64_t>(q[op.axis]);
+            trace->before[i] = f;
+        }
         switch (op.kind) {
             case OpKind::Constant:
                 f.t += f.R * op.t;
@@ -305,6 +334,10 @@ void KinematicsModel::walk(const ChainOps& c, const AxisVector& q, Frame& f, Joi
             }
         }
     }
+    if (Exact && trace) {
+        trace->last = f;
+        trace->valid = true;
+    }
 }
 
 Frame KinematicsModel::chainFrame(Side side, const AxisVector& q, JointFrames* joints) const {
@@ -330,7 +363,8 @@ void KinematicsModel::evaluate(KinematicsData& d, const ChainOps& c, const AxisV
         return;
     }
     if (exact_)
-        walk<true>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { exactTrig(d, op, angle, cs, sn); });
+        walk<true>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { exactTrig(d, op, angle, cs, sn); },
+                   c.side == Side::Workpiece ? &d.workpieceWalk_ : &d.toolWalk_);
     else
         walk<false>(c, q, f, lines, [&](const Op& op, double angle, double& cs, double& sn) { trig(d.trig_[op.slot], angle, cs, sn); });
 }
@@ -365,14 +399,19 @@ const KinematicsModel::ChainEntry& KinematicsModel::cached(KinematicsData& d, co
 void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double length, Vec3& tip, Vec3& axis) const {
     bind(d);
     if (exact_) {  // toolPose(Kinematics, q, toolPoint(length)) in inverse_kinematics.cpp, operation for operation
-        const Frame& w = memoFrame(d, workpiece_, d.workpieceFrames_, q);
-        const Frame& t = memoFrame(d, tool_, d.toolFrames_, q);
-        Pose bMw = Pose::Identity(), bMt = Pose::Identity();
-        bMw.linear() = w.R;
-        bMw.translation() = w.t;
+        KinematicsData::FrameEntry& w = memoFrame(d, workpiece_, d.workpieceFrames_, q);
+        const Frame& t = memoFrame(d, tool_, d.toolFrames_, q).frame;
+        if (!w.hasInverse) {  // a grid's workpiece frames recur: each inverted once
+            Pose bMw = Pose::Identity();
+            bMw.linear() = w.frame.R;
+            bMw.translation() = w.frame.t;
+            w.inverse = bMw.inverse(Eigen::Isometry);
+            w.hasInverse = true;
+        }
+        Pose bMt = Pose::Identity();
         bMt.linear() = t.R;
         bMt.translation() = t.t;
-        const Pose wMt = bMw.inverse(Eigen::Isometry) * bMt;
+        const Pose wMt = w.inverse * bMt;
         tip = wMt * Vec3(machine_->toolDirection * length + Vec3::Zero());
         axis = wMt.linear() * machine_->toolDirection;
         return;

@@ -18,8 +18,9 @@
 //   a model evaluated without a workspace (chainFrame: simulation, identification, the inverse solver, the
 //   controllers' apply models); with a workspace (the volumetric map) the frames and toolPose are bit for bit the same,
 //   with the savings that change no bit: the last kFrameMemo frames of each chain (keyed by the bit patterns of the
-//   chain's own axes) and the cosines and sines of the last kAngleMemo angles of each rotary operation (a grid's
-//   innermost axis, or a rotary axis, takes few distinct values).
+//   chain's own axes; the one found last is looked at first), the inverse of each kept workpiece frame, a chain's walk
+//   resumed at its first operation whose axis changed, and the cosines and sines of the last kAngleMemo angles of each
+//   rotary operation (a grid's innermost axis, or a rotary axis, takes few distinct values).
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -112,10 +113,27 @@ private:
     /// direct-mapped by the bit patterns of the chain's own axes; a grid's innermost axis takes few values).
     struct FrameEntry {
         bool valid = false;
+        bool hasInverse = false;  ///< `inverse` holds the frame's inverse (computed once, when toolPose first needs it)
         uint64_t key[kMaxAxes] = {};
         Frame frame;
+        Pose inverse = Pose::Identity();  ///< the frame as an isometry, inverted as toolPose(Kinematics) inverts it
     };
-    std::vector<FrameEntry> workpieceFrames_, toolFrames_;
+    struct FrameMemo {
+        std::vector<FrameEntry> entries;
+        size_t last = 0;  ///< the entry found last (looked at first: a grid's outer axes hold still for many points)
+    };
+    FrameMemo workpieceFrames_, toolFrames_;
+    /// With Arithmetic::AsExactModel: the last walk of one chain, to be resumed. For every operation that depends on
+    /// an axis (linear, rotary, component error), the bits of that axis and the frame before the operation; a walk at
+    /// new commands starts from the first such operation whose axis changed (the operations before it would compute the
+    /// same bits again: a grid varies its last axes fastest).
+    struct WalkTrace {
+        bool valid = false;
+        std::vector<uint64_t> key;  ///< per operation (those that depend on no axis: unused)
+        std::vector<Frame> before;  ///< per operation: the frame before it
+        Frame last;                 ///< the frame after the last operation
+    };
+    WalkTrace workpieceWalk_, toolWalk_;
 };
 
 class KinematicsModel {
@@ -230,15 +248,17 @@ private:
     Pose componentError(const Op& op, const AxisVector& q) const;
     /// The walk of chain c's operations with the exact model's arithmetic (Exact; see chainFrame) or the fast one;
     /// `trigOf(op, angle, c, s)` gives cos and sin of a rotary op's angle.
+    /// `trace` (Exact only, or nullptr): resumed where the commands of `trace`'s walk first differ from q, and updated.
     template <bool Exact, class TrigOf>
-    void walk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf) const;
+    void walk(const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines, TrigOf&& trigOf,
+              KinematicsData::WalkTrace* trace = nullptr) const;
     void evaluate(KinematicsData& d, const ChainOps& c, const AxisVector& q, Frame& f, JointFrames* lines) const;
     /// The evaluation of chain c at q (with its joint lines when `lines`), valid until the next call on `cache`.
     const ChainEntry& cached(KinematicsData& d, const ChainOps& c, ChainCache& cache, const AxisVector& q,
                              bool lines) const;
     /// Arithmetic::AsExactModel: the frame of chain c at q from the workspace's frame table `memo`.
-    const Frame& memoFrame(KinematicsData& d, const ChainOps& c, std::vector<KinematicsData::FrameEntry>& memo,
-                           const AxisVector& q) const;
+    KinematicsData::FrameEntry& memoFrame(KinematicsData& d, const ChainOps& c, KinematicsData::FrameMemo& memo,
+                                          const AxisVector& q) const;
 
     const MachineModel* machine_;
     bool exact_ = false;  ///< Arithmetic::AsExactModel
