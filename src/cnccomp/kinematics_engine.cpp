@@ -408,12 +408,12 @@ void KinematicsModel::toolPose(KinematicsData& d, const AxisVector& q, double le
             w.inverse = bMw.inverse(Eigen::Isometry);
             w.hasInverse = true;
         }
-        Pose bMt = Pose::Identity();
-        bMt.linear() = t.R;
-        bMt.translation() = t.t;
-        const Pose wMt = w.inverse * bMt;
-        tip = wMt * Vec3(machine_->toolDirection * length + Vec3::Zero());
-        axis = wMt.linear() * machine_->toolDirection;
+        const Mat3 wRb = w.inverse.linear();
+        const Vec3 wtb = w.inverse.translation();
+        const Mat3 R = wRb * t.R;
+        const Vec3 tr = wRb * t.t + wtb;
+        tip = R * Vec3(machine_->toolDirection * length + Vec3::Zero()) + tr;
+        axis = R * machine_->toolDirection;
         return;
     }
     const Frame& w = cached(d, workpiece_, d.workpiece_, q, false).frame;

@@ -2,8 +2,13 @@
 // orientation mode against axes mode, thread independence, CSV round trip, SVG content, CLI.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <span>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "cnccomp/error.hpp"
 #include "cnccomp/inverse_kinematics.hpp"
@@ -298,6 +303,45 @@ TEST(Map, AFailingSinkStopsTheStreamAndLeavesNoFile) {
     test::ScratchDir dir("map_stream_fail");
     EXPECT_THROW(streamMapCsv(dir.file("m.csv"), r, {m.name, "x"}, std::vector<long>{5, 3}), ModelError);  // not increasing
     EXPECT_FALSE(std::filesystem::exists(dir.file("m.csv")));
+}
+
+TEST(Map, AWorkerThatFailsStopsTheStreamAtItsBlock) {
+    // A block whose evaluation fails (here the sink's `evaluated`, on a worker thread): streamMap throws that error
+    // after handing on exactly the blocks before it, with one to four threads (the other workers are waiting for a
+    // slot or evaluating later blocks; none may hang), and a failure in the first and in the last block.
+    const MachineModel& m = test::multitasking();
+    DeviationSet d(m);
+    d.set("EX0C", 0.01);
+    MapRequest r = req(m, d, "X=-200:200:1 Y=-100:100:10 C=0:90:90", 50.0);  // 16842 points, 16 blocks of 1053
+    class Failing : public MapSink {
+    public:
+        explicit Failing(long failAt) : failAt_(failAt) {}
+        std::atomic<int> evaluatedBlocks{0};
+        std::vector<long> handedOn;
+        void evaluated(int, long first, std::span<const MapPoint>) override {
+            ++evaluatedBlocks;
+            if (first == failAt_) throw ModelError(fmt::format("block at {} failed", first));
+        }
+        void inOrder(int, long first, std::span<const MapPoint>) override { handedOn.push_back(first); }
+
+    private:
+        long failAt_;
+    };
+    for (int threads : {1, 2, 3, 4}) {
+        for (long failBlock : {0L, 5L, 15L}) {
+            r.threads = threads;
+            Failing sink(failBlock * 1053);
+            try {
+                streamMap(r, sink);
+                ADD_FAILURE() << "no error, " << threads << " threads";
+            } catch (const ModelError& e) {
+                EXPECT_NE(std::string(e.what()).find(fmt::format("block at {} failed", failBlock * 1053)), std::string::npos) << e.what();
+            }
+            ASSERT_EQ(sink.handedOn.size(), static_cast<size_t>(failBlock)) << threads << " threads";
+            for (long b = 0; b < failBlock; ++b) EXPECT_EQ(sink.handedOn[static_cast<size_t>(b)], b * 1053);
+            EXPECT_LE(sink.evaluatedBlocks.load(), 16);
+        }
+    }
 }
 
 TEST(Map, CommandLine) {
