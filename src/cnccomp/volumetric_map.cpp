@@ -124,9 +124,10 @@ void prepare(Plan& p) {
                                      m.name, centre.axis.x(), centre.axis.y(), centre.axis.z()));
 }
 
-/// One worker's workspaces of the nominal and the actual model: each keeps the last two poses of each chain (a grid
+/// One worker's workspaces of the nominal and the actual model: each keeps a table of each chain's frames (a grid
 /// varies its last axes fastest, so one chain's axes, often the longer tool chain's, stay put over many points and its
-/// pose is reused) and the sines of the rotary axes' last angles (a grid's rotary axis takes few values).
+/// frame is reused), each chain's last walk (resumed where its axes changed) and the cosines and sines of the rotary
+/// axes' last angles (a grid's rotary axis takes few values): kinematics_engine.hpp.
 struct Scratch {
     KinematicsData nominal, actual;
     AxisVector q;  ///< the commands of the point (axes mode: the axes not in the grid stay at the plan's base)
