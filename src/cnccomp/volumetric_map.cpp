@@ -259,14 +259,14 @@ MapStatistics run(const Plan& plan, MapSink& sink) {
     std::vector<Accumulator> acc(slots);
     std::vector<std::exception_ptr> errors(slots);
     std::vector<MapPoint*> where(slots, nullptr);
-    std::atomic<bool> stop{false};
-    std::atomic<long> delivered{0};               // blocks handed to sink.inOrder: their slots are free again
+    // Blocks handed to sink.inOrder (their slots are free again), or kStopped: the stream ends (an error).
+    constexpr long kStopped = std::numeric_limits<long>::max();
+    std::atomic<long> delivered{0};
     std::vector<std::atomic<long>> ready(static_cast<size_t>(slots));  // the block a slot holds evaluated (−1: none)
     for (auto& x : ready) x.store(-1);
     const auto slotOf = [&](long b) { return static_cast<int>((b / threads) % kRing) * threads + static_cast<int>(b % threads); };
     const auto stopAll = [&] {
-        stop = true;
-        delivered = std::numeric_limits<long>::max();  // wakes the workers waiting for a slot; they see `stop`
+        delivered = kStopped;  // also wakes the workers waiting for a slot
         delivered.notify_all();
     };
 
@@ -276,7 +276,7 @@ MapStatistics run(const Plan& plan, MapSink& sink) {
         for (long b = w; b < blocks; b += threads) {
             const long previous = b - static_cast<long>(kRing) * threads;  // the block this slot held before
             for (long got = delivered.load(); got <= previous; got = delivered.load()) delivered.wait(got);
-            if (stop.load()) return;
+            if (delivered.load() == kStopped) return;
             const int slot = slotOf(b);
             try {
                 const long lo = b * block, count = std::min(block, n - lo);
